@@ -1,0 +1,53 @@
+/// @file depth.hpp
+/// Non-owning view of a depth image: uint16 raw units with a scale (TUM: 5000 per metre) or float
+/// metres. "No measurement" is raw 0, a non-finite value, or a depth outside [min_m, max_m];
+/// depth_m() returns 0 for all of them, so callers test one thing.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+namespace dyncull {
+
+template <class Raw>
+struct DepthView {
+  static_assert(std::is_same<Raw, std::uint16_t>::value || std::is_same<Raw, float>::value ||
+                    std::is_same<Raw, double>::value,
+                "DepthView holds uint16 raw depth or float/double metres");
+  const Raw* data = nullptr;
+  int width = 0;
+  int height = 0;
+  std::ptrdiff_t stride = 0;    ///< elements (not bytes) between rows; 0 means width
+  float units_per_metre = 1.f;  ///< raw units per metre: 5000 for TUM PNGs, 1000 for mm, 1 for metres
+  float min_m = 0.f;            ///< valid range; TUM's sensor is reliable in about [0.4, 10] m
+  float max_m = 1e30f;
+
+  bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
+  std::ptrdiff_t row_stride() const { return stride > 0 ? stride : width; }
+  const Raw* row(int v) const { return data + static_cast<std::ptrdiff_t>(v) * row_stride(); }
+  Raw raw(int u, int v) const { return row(v)[u]; }
+  bool in_bounds(int u, int v) const { return u >= 0 && v >= 0 && u < width && v < height; }
+
+  /// Metres at integer pixel (u, v), or 0 for no measurement (also outside the image).
+  float depth_m(int u, int v) const {
+    if (!in_bounds(u, v)) return 0.f;
+    return to_metres(raw(u, v));
+  }
+  /// Converts a raw value with this view's scale and validity rules.
+  float to_metres(Raw r) const {
+    const float d = static_cast<float>(r) / units_per_metre;
+    return (std::isfinite(d) && d > 0.f && d >= min_m && d <= max_m) ? d : 0.f;
+  }
+  /// Raw value of a depth in metres (for comparing in raw units inside hot loops).
+  double to_raw(double metres) const { return metres * static_cast<double>(units_per_metre); }
+};
+
+/// TUM convention: uint16, 5000 units per metre, 0 = no measurement.
+inline DepthView<std::uint16_t> tum_depth_view(const std::uint16_t* data, int width, int height,
+                                               float min_m = 0.f, float max_m = 1e30f) {
+  return DepthView<std::uint16_t>{data, width, height, 0, 5000.f, min_m, max_m};
+}
+
+}  // namespace dyncull

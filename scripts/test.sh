@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Builds dyncull with warnings as errors and runs the whole ctest suite.
+#   scripts/test.sh            Release (-O2) build in build/test
+#   scripts/test.sh --asan     AddressSanitizer + UndefinedBehaviorSanitizer build in build/asan
+# DYNCULL_DATA_DIR (default: ../shared/data beside the checkout, when it exists) enables real-data tests.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+mode=${1:-release}
+jobs=${DYNCULL_JOBS:-$(nproc)}
+
+if [[ -z "${DYNCULL_DATA_DIR:-}" && -d "$root/../shared/data" ]]; then
+  export DYNCULL_DATA_DIR=$(cd "$root/../shared/data" && pwd)
+fi
+echo "test.sh: DYNCULL_DATA_DIR=${DYNCULL_DATA_DIR:-<unset: real-data tests will skip>}"
+
+case "$mode" in
+  release|"")
+    build="$root/build/test"
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_WERROR=ON \
+      -DDYNCULL_DATA_DIR="${DYNCULL_DATA_DIR:-}" >/dev/null
+    ;;
+  --asan)
+    build="$root/build/asan"
+    # Benchmarks and examples are not rebuilt under the sanitizers: the tests exercise the same headers.
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug -DDYNCULL_WERROR=ON \
+      -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF \
+      -DCMAKE_CXX_FLAGS="-O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+      -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+      -DDYNCULL_DATA_DIR="${DYNCULL_DATA_DIR:-}" >/dev/null
+    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    ;;
+  *) echo "usage: $0 [--asan]" >&2; exit 2 ;;
+esac
+cmake --build "$build" -j "$jobs"
+ctest --test-dir "$build" --output-on-failure -j "$jobs"

@@ -1,0 +1,16 @@
+// Consumer check: the installed headers compile on their own and compute a known answer.
+#include <dyncull/dyncull.hpp>
+#include <dyncull/version.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+int main() {
+  const dyncull::PinholeCamera<double> camera{535.4, 539.2, 320.1, 247.6, 640, 480};
+  const Eigen::Vector3d point(0.3, -0.2, 2.0);
+  const Eigen::Vector2d pixel = camera.project(point);
+  const Eigen::Vector3d back = camera.backproject(pixel, point.z());
+  const double error = (back - point).norm();
+  std::printf("dyncull %s consumer: round-trip error %.3g\n", DYNCULL_VERSION_STRING, error);
+  return error < 1e-12 ? 0 : 1;
+}
