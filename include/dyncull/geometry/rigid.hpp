@@ -1,0 +1,172 @@
+/// @file rigid.hpp
+/// Closed-form rigid (SE(3)) or similarity (Sim(3)) alignment of corresponding 3-D points:
+/// Umeyama 1991 eq. 34-42 / Kabsch with the reflection fix (as TUM evaluate_ate.py `align`), weighted.
+#pragma once
+
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SVD>
+
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <type_traits>
+
+namespace dyncull {
+
+struct AlignmentOptions {
+  /// Estimate a similarity (monocular trajectories); when false the scale is exactly 1.
+  bool estimate_scale = false;
+};
+
+template <class T>
+struct AlignmentResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  /// dst ~ scale * R * src + t. scale == 1 unless options.estimate_scale.
+  Sim3<T> dst_from_src;
+  /// Number of columns that entered the fit (weight > 0).
+  std::size_t num_points = 0;
+  /// The rotation and translation of dst_from_src (the scale is dropped; use with estimate_scale = false).
+  Rigid3<T> rigid() const {
+    Rigid3<T> out;
+    out.R = dst_from_src.R;
+    out.t = dst_from_src.t;
+    return out;
+  }
+};
+
+/// Least-squares dst_from_src minimising sum_i w_i |dst_i - (s R src_i + t)|^2.
+/// src and dst are 3xN (any Eigen expression, column i corresponds); weights (optional) points to N
+/// non-negative finite weights. Fails with TooFewPoints below 3 points, Degenerate when the
+/// cross-covariance has rank < 2 (collinear or coincident points), NonFinite on NaN/Inf input.
+/// Call it qualified, `dyncull::umeyama(src, dst)`: with two Eigen arguments an unqualified call also
+/// finds Eigen::umeyama by argument-dependent lookup and is ambiguous.
+/// Cost: one pass over the data (3x3 cross-covariance, centred on the first point so far-from-origin
+/// trajectories do not cancel) plus one 3x3 SVD.
+template <class DA, class DB>
+AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, const Eigen::MatrixBase<DB>& dst,
+                                             const AlignmentOptions& options = {},
+                                             const typename DA::Scalar* weights = nullptr) {
+  using T = typename DA::Scalar;
+  static_assert(std::is_floating_point<T>::value, "umeyama: scalar must be float or double");
+  static_assert(std::is_same<T, typename DB::Scalar>::value, "umeyama: src and dst must have the same scalar type");
+  static_assert(DA::RowsAtCompileTime == 3 || DA::RowsAtCompileTime == Eigen::Dynamic,
+                "umeyama: src must be 3xN (one point per column)");
+  static_assert(DB::RowsAtCompileTime == 3 || DB::RowsAtCompileTime == Eigen::Dynamic,
+                "umeyama: dst must be 3xN (one point per column)");
+  AlignmentResult<T> result;
+  if (src.rows() != 3 || dst.rows() != 3) {
+    result.status = Status::InvalidInput;
+    result.reason = "umeyama: src and dst must have 3 rows (one point per column)";
+    return result;
+  }
+  if (src.cols() != dst.cols()) {
+    result.status = Status::InvalidInput;
+    result.reason = "umeyama: src has " + std::to_string(src.cols()) + " columns but dst has " +
+                    std::to_string(dst.cols());
+    return result;
+  }
+  const Eigen::Index n = src.cols();
+  if (n < 3) {
+    result.status = Status::TooFewPoints;
+    result.reason = "umeyama: need at least 3 points, got " + std::to_string(n);
+    return result;
+  }
+
+  // Shift by the first pair: the one-pass moments then stay well conditioned for data far from the origin.
+  const Vec3<T> s0 = src.col(0);
+  const Vec3<T> d0 = dst.col(0);
+  Vec3<T> sum_s = Vec3<T>::Zero();
+  Vec3<T> sum_d = Vec3<T>::Zero();
+  Mat3<T> sum_ds = Mat3<T>::Zero();
+  T sum_ss = T(0);
+  T sum_w = T(0);
+  std::size_t used = 0;
+  if (weights == nullptr) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Vec3<T> s = src.col(i) - s0;
+      const Vec3<T> d = dst.col(i) - d0;
+      sum_s += s;
+      sum_d += d;
+      sum_ds.noalias() += d * s.transpose();
+      sum_ss += s.squaredNorm();
+    }
+    sum_w = T(n);
+    used = static_cast<std::size_t>(n);
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const T w = weights[i];
+      if (!(w >= T(0)) || !std::isfinite(w)) {
+        result.status = std::isfinite(w) ? Status::InvalidInput : Status::NonFinite;
+        result.reason = "umeyama: weight " + std::to_string(i) + " is negative or non-finite";
+        return result;
+      }
+      const Vec3<T> s = src.col(i) - s0;
+      const Vec3<T> d = dst.col(i) - d0;
+      const Vec3<T> ws = w * s;
+      sum_s += ws;
+      sum_d += w * d;
+      sum_ds.noalias() += d * ws.transpose();
+      sum_ss += ws.dot(s);
+      sum_w += w;
+      used += (w > T(0));
+    }
+  }
+  result.num_points = used;
+  // NaN/Inf anywhere in the input propagates into the sums: one check instead of one per element.
+  if (!sum_ds.allFinite() || !sum_s.allFinite() || !sum_d.allFinite() || !std::isfinite(sum_ss) ||
+      !s0.allFinite() || !d0.allFinite()) {
+    result.status = Status::NonFinite;
+    result.reason = "umeyama: non-finite coordinates in src or dst";
+    return result;
+  }
+  if (used < 3 || !(sum_w > T(0))) {
+    result.status = Status::TooFewPoints;
+    result.reason = "umeyama: need at least 3 points with positive weight, got " + std::to_string(used);
+    return result;
+  }
+
+  const T inv_w = T(1) / sum_w;
+  const Vec3<T> mean_s = sum_s * inv_w;
+  const Vec3<T> mean_d = sum_d * inv_w;
+  // Umeyama eq. 38: Sigma = 1/n sum (d - mu_d)(s - mu_s)^T, eq. 36: sigma_s^2 = 1/n sum |s - mu_s|^2.
+  const Mat3<T> sigma = sum_ds * inv_w - mean_d * mean_s.transpose();
+  const T var_s = sum_ss * inv_w - mean_s.squaredNorm();
+
+  Eigen::JacobiSVD<Mat3<T>> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Vec3<T> sv = svd.singularValues();
+  // Rank < 2 leaves the rotation about the points' line (or everything) undetermined (Umeyama's
+  // uniqueness condition rank(Sigma) >= m - 1). Relative threshold: 1000 machine epsilons.
+  const T rank_tol = T(1000) * Constants<T>::epsilon();
+  if (!(sv(0) > T(0)) || sv(1) <= rank_tol * sv(0)) {
+    result.status = Status::Degenerate;
+    result.reason = "umeyama: points are collinear or coincident (cross-covariance rank < 2)";
+    return result;
+  }
+  const Mat3<T>& U = svd.matrixU();
+  const Mat3<T>& V = svd.matrixV();
+  // Reflection fix (eq. 39-40): flip the smallest singular direction when det(U V^T) < 0.
+  Vec3<T> S(T(1), T(1), T(1));
+  if (U.determinant() * V.determinant() < T(0)) S(2) = T(-1);
+  const Mat3<T> R = U * S.asDiagonal() * V.transpose();
+  T scale = T(1);
+  if (options.estimate_scale) {
+    if (!(var_s > T(0))) {
+      result.status = Status::Degenerate;
+      result.reason = "umeyama: source points have zero spread, scale undefined";
+      return result;
+    }
+    scale = sv.dot(S) / var_s;  // eq. 42
+  }
+  result.dst_from_src.scale = scale;
+  result.dst_from_src.R = R;
+  // t maps the shifted frames back: d = s R (x - s0) + d0 + (mu_d - s R mu_s).
+  result.dst_from_src.t = d0 + mean_d - scale * (R * (s0 + mean_s));
+  return result;
+}
+
+}  // namespace dyncull
