@@ -1,0 +1,372 @@
+/// @file ransac.hpp
+/// Generic LO-RANSAC with MSAC scoring (Torr & Zisserman 2000; Chum et al. 2003 local optimisation),
+/// templated on an estimator; the adaptive stopping rule is k = log(1 - p) / log(1 - w^s) (Fischler & Bolles).
+#pragma once
+
+#include "dyncull/core/random.hpp"
+#include "dyncull/core/status.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace dyncull {
+
+/// Options shared by every RANSAC in dyncull (F, PnP, rigid alignment).
+struct RansacOptions {
+  double max_residual = 1.0;      ///< inlier threshold in the estimator's residual units (NOT squared)
+  double confidence = 0.99;       ///< probability p of drawing at least one all-inlier sample; in [0, 1]
+  std::size_t min_iterations = 0, max_iterations = 10000;  ///< bounds on drawn samples; max >= 1
+  std::uint64_t seed = 0;         ///< deterministic for a seed (the generator is owned by the call)
+  bool local_optimisation = true; ///< refit on inliers when a new best model is found, and at the end
+
+  /// Ok, or InvalidInput with a readable reason.
+  Status validate(std::string* reason = nullptr) const {
+    auto fail = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(max_residual > 0.0) || !std::isfinite(max_residual)) return fail("max_residual must be finite and > 0");
+    if (!(confidence >= 0.0 && confidence <= 1.0)) return fail("confidence must be in [0, 1]");
+    if (max_iterations == 0) return fail("max_iterations must be >= 1");
+    if (min_iterations > max_iterations) return fail("min_iterations must be <= max_iterations");
+    return Status::Ok;
+  }
+};
+
+/// Result of ransac(). `score` is the MSAC cost sum_i min(r_i^2, t^2) of `model` (lower is better,
+/// squared residual units); `inlier_mask[i]` is 1 when r_i < max_residual.
+template <class Model>
+struct RansacResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  Model model{};
+  std::vector<std::uint8_t> inlier_mask;
+  std::size_t num_inliers = 0;
+  std::size_t iterations = 0;  ///< samples drawn
+  double score = 0;
+};
+
+/// Number of samples needed so that, with probability `confidence`, at least one sample of size
+/// `sample_size` is all-inlier when a fraction `inlier_ratio` of the data are inliers.
+/// Guards: confidence <= 0 or inlier_ratio >= 1 -> 1; confidence >= 1, inlier_ratio <= 0 or a
+/// sample probability that underflows -> max_iterations. The result is clamped to [1, max_iterations].
+inline std::size_t ransac_required_iterations(double inlier_ratio, int sample_size, double confidence,
+                                              std::size_t max_iterations) {
+  const std::size_t cap = std::max<std::size_t>(max_iterations, 1);
+  if (!(confidence > 0.0)) return 1;
+  if (!(inlier_ratio > 0.0) || !(confidence < 1.0) || sample_size <= 0) return cap;
+  if (inlier_ratio >= 1.0) return 1;
+  const double all_inlier = std::pow(inlier_ratio, sample_size);
+  // log1p keeps precision when w^s is tiny; a zero denominator means the sample probability underflowed.
+  const double denom = std::log1p(-all_inlier);
+  if (!(denom < 0.0)) return cap;
+  const double k = std::ceil(std::log1p(-confidence) / denom);
+  if (!(k < static_cast<double>(cap))) return cap;
+  return std::max<std::size_t>(1, static_cast<std::size_t>(k));
+}
+
+namespace detail {
+template <class...> using ransac_void_t = void;
+
+template <class E, class = void> struct has_model_type : std::false_type {};
+template <class E> struct has_model_type<E, ransac_void_t<typename E::Model>> : std::true_type {};
+
+template <class E, class = void> struct has_scalar_type : std::false_type {};
+template <class E> struct has_scalar_type<E, ransac_void_t<typename E::Scalar>> : std::true_type {};
+
+template <class E, class = void> struct has_sample_size : std::false_type {};
+template <class E>
+struct has_sample_size<E, ransac_void_t<decltype(static_cast<int>(E::kSampleSize)),
+                                        decltype(static_cast<int>(E::kMaxModels))>> : std::true_type {};
+
+template <class E, class = void> struct has_num_data : std::false_type {};
+template <class E>
+struct has_num_data<E, ransac_void_t<decltype(static_cast<std::size_t>(std::declval<const E&>().num_data()))>>
+    : std::true_type {};
+
+template <class E, class = void> struct has_minimal_solve : std::false_type {};
+template <class E>
+struct has_minimal_solve<E, ransac_void_t<decltype(static_cast<int>(std::declval<const E&>().minimal_solve(
+                                std::declval<const std::uint32_t*>(), std::declval<typename E::Model*>())))>>
+    : std::true_type {};
+
+template <class E, class = void> struct has_residuals_sq : std::false_type {};
+template <class E>
+struct has_residuals_sq<E, ransac_void_t<decltype(std::declval<const E&>().residuals_sq(
+                               std::declval<const typename E::Model&>(), std::declval<typename E::Scalar*>()))>>
+    : std::true_type {};
+
+template <class E, class = void> struct has_refit : std::false_type {};
+template <class E>
+struct has_refit<E, ransac_void_t<decltype(static_cast<bool>(std::declval<const E&>().refit(
+                        std::declval<const std::uint32_t*>(), std::size_t{}, std::declval<typename E::Model*>())))>>
+    : std::true_type {};
+
+/// Optional: reject a sample before solving (collinear, duplicate, ...).
+template <class E, class = void> struct has_is_sample_good : std::false_type {};
+template <class E>
+struct has_is_sample_good<E, ransac_void_t<decltype(static_cast<bool>(
+                                 std::declval<const E&>().is_sample_good(std::declval<const std::uint32_t*>())))>>
+    : std::true_type {};
+
+/// Optional: residuals of data [begin, end) into out[0, end - begin). Enables early bail-out while
+/// scoring a model that can no longer beat the best one.
+template <class E, class = void> struct has_range_residuals_sq : std::false_type {};
+template <class E>
+struct has_range_residuals_sq<E, ransac_void_t<decltype(std::declval<const E&>().residuals_sq(
+                                     std::declval<const typename E::Model&>(), std::size_t{}, std::size_t{},
+                                     std::declval<typename E::Scalar*>()))>> : std::true_type {};
+
+template <class Estimator>
+class RansacRunner {
+ public:
+  using Model = typename Estimator::Model;
+  using Scalar = typename Estimator::Scalar;
+  static constexpr int kSampleSize = Estimator::kSampleSize;
+  static constexpr int kMaxModels = Estimator::kMaxModels;
+  static constexpr std::size_t kChunk = 256;  // bail-out granularity: small enough to stop early, large enough to vectorise
+
+  RansacRunner(const Estimator& estimator, const RansacOptions& options)
+      : est_(estimator), opt_(options), n_(estimator.num_data()) {
+    thr_sq_ = static_cast<Scalar>(opt_.max_residual * opt_.max_residual);
+    residuals_.resize(n_);
+    inliers_.resize(n_);
+  }
+
+  RansacResult<Model> run() {
+    RansacResult<Model> result;
+    Random rng(opt_.seed);
+    std::uint32_t sample[kSampleSize];
+    Model models[kMaxModels];
+    bool have_best = false;
+    double best_cost = std::numeric_limits<double>::infinity();
+    std::size_t best_inliers = 0;
+    std::size_t required = opt_.max_iterations;
+    std::size_t it = 0;
+    std::size_t solver_failures = 0;
+
+    while (it < opt_.max_iterations && (it < required || it < opt_.min_iterations)) {
+      ++it;
+      draw_sample(rng, sample);
+      if (!sample_good(sample)) continue;
+      const int m = est_.minimal_solve(sample, models);
+      if (m <= 0) {
+        ++solver_failures;
+        continue;
+      }
+      for (int k = 0; k < std::min(m, kMaxModels); ++k) {
+        const double cost = score(models[k], best_cost);
+        if (!(cost < best_cost)) continue;
+        best_cost = cost;
+        result.model = models[k];
+        best_inliers = count_inliers();
+        have_best = true;
+        if (opt_.local_optimisation) local_optimise(&result.model, &best_cost, &best_inliers, true);
+        required = ransac_required_iterations(static_cast<double>(best_inliers) / static_cast<double>(n_),
+                                              kSampleSize, opt_.confidence, opt_.max_iterations);
+      }
+    }
+    result.iterations = it;
+
+    if (!have_best) {
+      result.status = Status::Degenerate;
+      result.reason = "no minimal sample produced a model (" + std::to_string(solver_failures) + " of " +
+                      std::to_string(it) + " samples failed in the solver; degenerate or non-finite data)";
+      return result;
+    }
+    if (opt_.local_optimisation) local_optimise(&result.model, &best_cost, &best_inliers, false);
+
+    // Final labelling from the kept model (the residual buffer may hold a rejected refit).
+    est_.residuals_sq(result.model, residuals_.data());
+    result.inlier_mask.assign(n_, 0);
+    std::size_t count = 0;
+    double cost = 0;
+    for (std::size_t i = 0; i < n_; ++i) {
+      const Scalar r = residuals_[i];
+      const bool in = r < thr_sq_;
+      result.inlier_mask[i] = static_cast<std::uint8_t>(in);
+      count += in;
+      cost += static_cast<double>(in ? r : thr_sq_);
+    }
+    result.num_inliers = count;
+    result.score = cost;
+    if (count < static_cast<std::size_t>(kSampleSize)) {
+      result.status = Status::Degenerate;
+      result.reason = "best model has " + std::to_string(count) + " inliers, fewer than the minimal sample (" +
+                      std::to_string(kSampleSize) + ")";
+    }
+    return result;
+  }
+
+ private:
+  void draw_sample(Random& rng, std::uint32_t* sample) {
+    const auto n = static_cast<std::uint32_t>(n_);
+    for (int i = 0; i < kSampleSize; ++i) {
+      bool again = true;
+      while (again) {
+        sample[i] = rng.index(n);
+        again = false;
+        for (int j = 0; j < i; ++j) again = again || sample[j] == sample[i];
+      }
+    }
+  }
+
+  bool sample_good(const std::uint32_t* sample) const {
+    if constexpr (has_is_sample_good<Estimator>::value) {
+      return est_.is_sample_good(sample);
+    } else {
+      (void)sample;
+      return true;
+    }
+  }
+
+  /// MSAC cost of `model`; stops early (returning +inf) once the cost exceeds `bound`.
+  double score(const Model& model, double bound) {
+    const Scalar thr = thr_sq_;
+    if constexpr (has_range_residuals_sq<Estimator>::value) {
+      double cost = 0;
+      for (std::size_t begin = 0; begin < n_; begin += kChunk) {
+        const std::size_t end = std::min(n_, begin + kChunk);
+        Scalar* r = residuals_.data() + begin;
+        est_.residuals_sq(model, begin, end, r);
+        Scalar chunk = 0;
+        const std::size_t len = end - begin;
+        for (std::size_t i = 0; i < len; ++i) chunk += r[i] < thr ? r[i] : thr;
+        cost += static_cast<double>(chunk);
+        if (cost >= bound) return std::numeric_limits<double>::infinity();
+      }
+      return cost;
+    } else {
+      est_.residuals_sq(model, residuals_.data());
+      double cost = 0;
+      for (std::size_t i = 0; i < n_; ++i) {
+        const Scalar r = residuals_[i];
+        cost += static_cast<double>(r < thr ? r : thr);
+      }
+      (void)bound;
+      return cost;
+    }
+  }
+
+  /// Counts inliers in residuals_ (valid after a complete score()).
+  std::size_t count_inliers() const {
+    std::size_t count = 0;
+    const Scalar thr = thr_sq_;
+    for (std::size_t i = 0; i < n_; ++i) count += residuals_[i] < thr;
+    return count;
+  }
+
+  std::size_t collect_inliers() {
+    std::size_t count = 0;
+    const Scalar thr = thr_sq_;
+    for (std::size_t i = 0; i < n_; ++i) {
+      inliers_[count] = static_cast<std::uint32_t>(i);
+      count += residuals_[i] < thr;
+    }
+    return count;
+  }
+
+  /// Iterated least-squares refit on the inliers while the MSAC cost decreases (LO step).
+  /// `residuals_valid`: residuals_ already holds the residuals of *best (right after a full score()).
+  void local_optimise(Model* best, double* best_cost, std::size_t* best_inliers, bool residuals_valid) {
+    constexpr int kMaxRefits = 4;
+    if (!residuals_valid) est_.residuals_sq(*best, residuals_.data());
+    for (int r = 0; r < kMaxRefits; ++r) {
+      const std::size_t count = collect_inliers();
+      if (count < static_cast<std::size_t>(kSampleSize)) return;
+      Model candidate = *best;
+      if (!est_.refit(inliers_.data(), count, &candidate)) return;
+      est_.residuals_sq(candidate, residuals_.data());
+      double cost = 0;
+      const Scalar thr = thr_sq_;
+      std::size_t in = 0;
+      for (std::size_t i = 0; i < n_; ++i) {
+        const Scalar v = residuals_[i];
+        cost += static_cast<double>(v < thr ? v : thr);
+        in += v < thr;
+      }
+      if (!(cost < *best_cost)) {
+        est_.residuals_sq(*best, residuals_.data());
+        return;
+      }
+      *best = candidate;
+      *best_cost = cost;
+      *best_inliers = in;
+    }
+  }
+
+  const Estimator& est_;
+  const RansacOptions& opt_;
+  std::size_t n_;
+  Scalar thr_sq_;
+  std::vector<Scalar> residuals_;
+  std::vector<std::uint32_t> inliers_;
+};
+}  // namespace detail
+
+/// Runs LO-RANSAC with MSAC scoring on `estimator`. Estimator concept:
+///   using Model = ...; using Scalar = float|double;
+///   static constexpr int kSampleSize; static constexpr int kMaxModels;
+///   std::size_t num_data() const;
+///   int minimal_solve(const std::uint32_t* sample, Model* models) const;   // returns #models written
+///   void residuals_sq(const Model& m, Scalar* out) const;                   // all data, contiguous
+///   bool refit(const std::uint32_t* inliers, std::size_t n, Model* model) const;
+///   optional: bool is_sample_good(const std::uint32_t* sample) const;
+///   optional: void residuals_sq(const Model& m, std::size_t begin, std::size_t end, Scalar* out) const;
+/// Residuals are squared; NaN residuals count as outliers. Deterministic for options.seed.
+template <class Estimator>
+RansacResult<typename Estimator::Model> ransac(const Estimator& estimator, const RansacOptions& options) {
+  static_assert(detail::has_model_type<Estimator>::value, "dyncull::ransac: Estimator needs `using Model = ...;`");
+  static_assert(detail::has_scalar_type<Estimator>::value,
+                "dyncull::ransac: Estimator needs `using Scalar = float|double;`");
+  static_assert(std::is_floating_point<typename Estimator::Scalar>::value,
+                "dyncull::ransac: Estimator::Scalar must be float or double");
+  static_assert(detail::has_sample_size<Estimator>::value,
+                "dyncull::ransac: Estimator needs `static constexpr int kSampleSize` and `kMaxModels`");
+  static_assert(detail::has_num_data<Estimator>::value,
+                "dyncull::ransac: Estimator needs `std::size_t num_data() const`");
+  static_assert(detail::has_minimal_solve<Estimator>::value,
+                "dyncull::ransac: Estimator needs `int minimal_solve(const std::uint32_t*, Model*) const`");
+  static_assert(detail::has_residuals_sq<Estimator>::value,
+                "dyncull::ransac: Estimator needs `void residuals_sq(const Model&, Scalar*) const`");
+  static_assert(detail::has_refit<Estimator>::value,
+                "dyncull::ransac: Estimator needs `bool refit(const std::uint32_t*, std::size_t, Model*) const`");
+
+  RansacResult<typename Estimator::Model> result;
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
+    result.status = Status::InvalidInput;
+    result.reason = why;
+    return result;
+  }
+  if (Estimator::kSampleSize <= 0 || Estimator::kMaxModels <= 0) {
+    result.status = Status::InvalidInput;
+    result.reason = "estimator kSampleSize and kMaxModels must be positive";
+    return result;
+  }
+  const std::size_t n = estimator.num_data();
+  if (n < static_cast<std::size_t>(Estimator::kSampleSize)) {
+    result.status = Status::TooFewPoints;
+    result.reason = std::to_string(n) + " data, the minimal sample needs " + std::to_string(Estimator::kSampleSize);
+    result.inlier_mask.assign(n, 0);
+    return result;
+  }
+  if (n > static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max())) {
+    result.status = Status::InvalidInput;
+    result.reason = "more than 2^32 - 1 data";
+    return result;
+  }
+  detail::RansacRunner<Estimator> runner(estimator, options);
+  return runner.run();
+}
+
+}  // namespace dyncull
