@@ -1,0 +1,220 @@
+/// @file bfgs.hpp
+/// Small fixed-size BFGS minimiser (Nocedal & Wright Alg. 6.1) with an Armijo backtracking line search
+/// that interpolates and extrapolates; the inverse-Hessian update is seed 003 eq. 10-14.
+#pragma once
+
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+namespace dyncull {
+
+/// Stopping rules and line-search constants. Tolerances below the scalar's precision are raised to
+/// a few machine epsilons, so float problems stop instead of running to the iteration limit.
+struct BfgsOptions {
+  int max_iterations = 100;           ///< BFGS iterations (one line search each)
+  double gradient_tolerance = 1e-10;  ///< stop when max_i |g_i| <= this (absolute, objective units per x unit)
+  double function_tolerance = 1e-12;  ///< stop when |f_k - f_k+1| <= this * max(|f_k|, tiny)
+  double parameter_tolerance = 1e-12; ///< stop when |s| <= this * (|x| + this)
+  double armijo_c1 = 1e-4;            ///< sufficient-decrease constant of the Armijo condition
+  double wolfe_c2 = 0.9;              ///< curvature constant: extrapolate while g_new.p < c2 g.p
+  int max_line_search_steps = 30;     ///< function evaluations per line search
+};
+
+/// Outcome of bfgs_minimize. status: Ok (a tolerance was met), NotConverged (iteration limit or a
+/// line search that found no decrease while the gradient is not small), NonFinite (x0 or f(x0) not
+/// finite), InvalidInput (bad options).
+template <class T, int N>
+struct BfgsResult {
+  using Vector = Eigen::Matrix<T, N, 1>;
+  Status status = Status::Ok;
+  std::string reason;
+  Vector x = Vector::Zero();         ///< best point found (always the last accepted iterate)
+  T value = T(0);                    ///< f(x)
+  Vector gradient = Vector::Zero();  ///< gradient at x
+  int iterations = 0;                ///< accepted BFGS steps
+  int evaluations = 0;               ///< objective + gradient evaluations, line searches included
+  bool ok() const { return status == Status::Ok; }
+};
+
+/// Minimises f from x0. The functor is called as `T value = f(x, &gradient)` with
+/// x, gradient of type Eigen::Matrix<T, N, 1>; it must write the full gradient. A non-finite value is
+/// treated as "too far": the line search backs off. No allocation: everything is fixed-size.
+template <class T, int N, class Functor>
+BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x0, const BfgsOptions& options = {});
+
+// ------------------------------------------------------------------------------------------------
+// Implementation
+// ------------------------------------------------------------------------------------------------
+
+template <class T, int N, class Functor>
+BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x0, const BfgsOptions& options) {
+  static_assert(std::is_floating_point<T>::value, "dyncull::bfgs_minimize: scalar must be float or double");
+  static_assert(N > 0, "dyncull::bfgs_minimize: fixed positive dimension required");
+  static_assert(std::is_convertible<decltype(std::declval<const Functor&>()(
+                                        std::declval<const Eigen::Matrix<T, N, 1>&>(),
+                                        std::declval<Eigen::Matrix<T, N, 1>*>())),
+                                    T>::value,
+                "dyncull::bfgs_minimize: functor must be callable as `T f(const Vector& x, Vector* gradient) const`");
+  using Vector = Eigen::Matrix<T, N, 1>;
+  using Matrix = Eigen::Matrix<T, N, N>;
+  using std::abs;
+  using std::isfinite;
+  using std::max;
+  using std::min;
+
+  BfgsResult<T, N> result;
+  result.x = x0;
+  if (options.max_iterations < 0 || options.max_line_search_steps < 1 || !(options.armijo_c1 > 0) ||
+      !(options.wolfe_c2 > options.armijo_c1) || !(options.wolfe_c2 < 1)) {
+    result.status = Status::InvalidInput;
+    result.reason = "bfgs: need max_iterations >= 0, max_line_search_steps >= 1 and 0 < armijo_c1 < wolfe_c2 < 1";
+    return result;
+  }
+  if (!x0.allFinite()) {
+    result.status = Status::NonFinite;
+    result.reason = "bfgs: non-finite starting point";
+    return result;
+  }
+
+  // Tolerances no tighter than the scalar allows (float would otherwise never meet 1e-12).
+  const T eps = std::numeric_limits<T>::epsilon();
+  const T gtol = static_cast<T>(options.gradient_tolerance);
+  const T ftol = max(static_cast<T>(options.function_tolerance), T(4) * eps);
+  const T xtol = max(static_cast<T>(options.parameter_tolerance), T(4) * eps);
+  const T c1 = static_cast<T>(options.armijo_c1);
+  const T c2 = static_cast<T>(options.wolfe_c2);
+
+  Vector x = x0;
+  Vector g;
+  T fx = f(x, &g);
+  result.evaluations = 1;
+  if (!isfinite(fx) || !g.allFinite()) {
+    result.status = Status::NonFinite;
+    result.reason = "bfgs: objective or gradient not finite at the starting point";
+    result.value = fx;
+    result.gradient = g;
+    return result;
+  }
+
+  Matrix H = Matrix::Identity();  // inverse Hessian approximation B_k^-1 (eq. 11)
+  bool scaled = false;
+  Vector x_new, g_new, x_try, g_try;
+
+  auto finish = [&](Status status, std::string reason) {
+    result.status = status;
+    result.reason = std::move(reason);
+    result.x = x;
+    result.value = fx;
+    result.gradient = g;
+    return result;
+  };
+
+  for (int k = 0;; ++k) {
+    if (g.template lpNorm<Eigen::Infinity>() <= gtol) return finish(Status::Ok, "");
+    if (k >= options.max_iterations) {
+      return finish(Status::NotConverged, "bfgs: stopped at max_iterations = " + std::to_string(options.max_iterations));
+    }
+
+    Vector p = -(H * g);  // eq. 10
+    T dphi0 = g.dot(p);
+    if (!(dphi0 < T(0))) {  // H lost positive definiteness through round-off: restart as steepest descent
+      H.setIdentity();
+      scaled = false;
+      p = -g;
+      dphi0 = -g.squaredNorm();
+    }
+    // Before the first curvature pair the step length is unknown: make the first trial move the point
+    // by about one unit of x, then let the line search extrapolate.
+    T alpha = scaled ? T(1) : min(T(1), T(1) / g.template lpNorm<Eigen::Infinity>());
+
+    bool accepted = false;
+    T f_new = fx;
+    int steps = 0;
+    while (steps < options.max_line_search_steps) {
+      x_try = x + alpha * p;
+      const T f_try = f(x_try, &g_try);
+      ++steps;
+      ++result.evaluations;
+      if (!isfinite(f_try) || !g_try.allFinite()) {
+        alpha *= T(0.25);
+        continue;
+      }
+      if (f_try > fx + c1 * alpha * dphi0) {
+        // Armijo fails: minimise the quadratic through phi(0), phi'(0), phi(alpha), kept in [0.1, 0.5] alpha.
+        const T denom = T(2) * (f_try - fx - dphi0 * alpha);
+        T next = denom > T(0) ? -dphi0 * alpha * alpha / denom : T(0.5) * alpha;
+        alpha = min(max(next, T(0.1) * alpha), T(0.5) * alpha);
+        continue;
+      }
+      // Armijo holds. While the slope is still steep (curvature condition fails), extrapolate with the
+      // secant of phi' (exact for quadratics); keep the better of the two points.
+      accepted = true;
+      x_new = x_try;
+      g_new = g_try;
+      f_new = f_try;
+      T dphi = g_new.dot(p);
+      while (dphi < c2 * dphi0 && steps < options.max_line_search_steps) {
+        const T curvature = dphi - dphi0;
+        const T next = curvature > T(0) ? alpha * dphi0 / (dphi0 - dphi) : T(4) * alpha;
+        const T alpha_ext = min(next, T(100) * alpha);
+        if (!(alpha_ext > alpha)) break;
+        x_try = x + alpha_ext * p;
+        const T f_ext = f(x_try, &g_try);
+        ++steps;
+        ++result.evaluations;
+        if (!isfinite(f_ext) || !g_try.allFinite() || f_ext > fx + c1 * alpha_ext * dphi0 || f_ext >= f_new) break;
+        alpha = alpha_ext;
+        x_new = x_try;
+        g_new = g_try;
+        f_new = f_ext;
+        dphi = g_new.dot(p);
+      }
+      break;
+    }
+
+    if (!accepted) {
+      // No decrease along a descent direction: we are at the round-off floor of f. That is convergence
+      // only if the gradient is tiny compared with the objective's scale; otherwise say so.
+      const T g_inf = g.template lpNorm<Eigen::Infinity>();
+      if (g_inf <= std::sqrt(eps) * max(T(1), abs(fx))) {
+        return finish(Status::Ok, "");
+      }
+      return finish(Status::NotConverged, "bfgs: line search found no decrease (gradient " + std::to_string(g_inf) + ")");
+    }
+
+    const Vector s = x_new - x;  // eq. 12
+    const Vector y = g_new - g;  // eq. 13
+    const T f_old = fx;
+    x = x_new;
+    g = g_new;
+    fx = f_new;
+    ++result.iterations;
+
+    const T sy = s.dot(y);
+    // Update only with positive curvature (keeps H positive definite); eq. 11 with rho = 1 / y^T s (eq. 14).
+    if (sy > eps * s.norm() * y.norm()) {
+      if (!scaled) {
+        H = Matrix::Identity() * (sy / y.squaredNorm());  // Nocedal & Wright eq. 6.20
+        scaled = true;
+      }
+      const T rho = T(1) / sy;
+      const Vector Hy = H * y;
+      // Expanded form of (I - rho s y^T) H (I - rho y s^T) + rho s s^T.
+      H += (rho * rho * y.dot(Hy) + rho) * (s * s.transpose()) - rho * (Hy * s.transpose() + s * Hy.transpose());
+    }
+
+    if (abs(f_old - fx) <= ftol * max(abs(f_old), std::numeric_limits<T>::min())) return finish(Status::Ok, "");
+    if (s.norm() <= xtol * (x.norm() + xtol)) return finish(Status::Ok, "");
+  }
+}
+
+}  // namespace dyncull
