@@ -1,0 +1,344 @@
+/// @file multiview_check.hpp
+/// Multi-view depth check (seed 001 §III.A, after DynaSLAM): keyframe keypoints are back-projected with
+/// their depth, moved by the relative pose and projected; d_proj - d' > tau_d marks a moving surface at x'.
+#pragma once
+
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/depth.hpp"
+#include "dyncull/core/mask.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/labels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dyncull {
+
+/// Options of the multi-view check. Defaults follow seed 001 (30 deg, 0.4 m) and DynaSLAM's code
+/// for what the paper leaves out (depth gates 6 m / 7 m, region growing 0.2 m).
+template <class T>
+struct MultiViewOptions {
+  T max_parallax_deg = T(30);        ///< skip points whose viewing rays differ more (occlusion, not motion)
+  T depth_threshold_m = T(0.4);      ///< tau_d of seed 001 (DynaSLAM's code uses 0.6)
+  int search_radius_px = 2;          ///< d' is the valid depth closest to d_proj in a (2r+1)^2 window (DynaSLAM: 20)
+  T max_reference_depth_m = T(6);    ///< keyframe keypoints deeper than this are not used (DynaSLAM)
+  T max_projected_depth_m = T(7);    ///< projections deeper than this are not used (DynaSLAM)
+  T border_px = T(0);                ///< projections closer than this to the image edge are not used
+  T region_depth_tolerance_m = T(0.2);  ///< region growing: |d - d_seed| below this joins the region
+  std::size_t max_region_pixels = 0;     ///< cap per seed region (0 = no cap)
+};
+
+/// What happened to one keyframe point.
+enum class MultiViewOutcome : std::uint8_t {
+  Checked = 0,         ///< compared; label is Static or Dynamic
+  NoReferenceDepth,    ///< keyframe depth missing, non-positive or above max_reference_depth_m
+  BehindCamera,        ///< projects behind the current camera or beyond max_projected_depth_m
+  OutsideImage,        ///< projects outside the current image (or inside the border)
+  LargeParallax,       ///< viewing rays differ by more than max_parallax_deg: skipped
+  NoMeasuredDepth,     ///< no valid current depth around x'
+  NonFinite,           ///< NaN / Inf coordinates
+};
+
+constexpr const char* to_string(MultiViewOutcome o) noexcept {
+  switch (o) {
+    case MultiViewOutcome::Checked: return "checked";
+    case MultiViewOutcome::NoReferenceDepth: return "no reference depth";
+    case MultiViewOutcome::BehindCamera: return "behind camera or too deep";
+    case MultiViewOutcome::OutsideImage: return "outside image";
+    case MultiViewOutcome::LargeParallax: return "large parallax";
+    case MultiViewOutcome::NoMeasuredDepth: return "no measured depth";
+    case MultiViewOutcome::NonFinite: return "non-finite";
+  }
+  return "unknown";
+}
+
+/// Per keyframe point results (parallel to the keyframe's points) and counts.
+/// labels: Dynamic when d_proj - d' > tau_d, Static when checked and not, Candidate when not checked.
+template <class T>
+struct MultiViewResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  std::vector<FeatureLabel> labels;
+  std::vector<MultiViewOutcome> outcome;
+  std::vector<Vec2<T>> projected;     ///< x' in the current image (undefined unless projected)
+  std::vector<T> projected_depth_m;   ///< d_proj
+  std::vector<T> measured_depth_m;    ///< d' (0 when none)
+  std::size_t num_points = 0, num_checked = 0, num_dynamic = 0;
+  std::size_t num_large_parallax = 0, num_no_depth = 0, num_outside = 0;
+};
+
+namespace detail {
+
+template <class Raw, class T>
+T closest_depth_in_window(const DepthView<Raw>& depth, int u, int v, int radius, T target) {
+  T best = T(0), best_diff = std::numeric_limits<T>::infinity();
+  const int v0 = std::max(0, v - radius), v1 = std::min(depth.height - 1, v + radius);
+  const int u0 = std::max(0, u - radius), u1 = std::min(depth.width - 1, u + radius);
+  for (int y = v0; y <= v1; ++y) {
+    const Raw* row = depth.row(y);
+    for (int x = u0; x <= u1; ++x) {
+      const T d = T(depth.to_metres(row[x]));
+      if (d <= T(0)) continue;
+      const T diff = std::abs(d - target);
+      if (diff < best_diff) {
+        best_diff = diff;
+        best = d;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace detail
+
+/// Checks keyframe points against the current depth image, writing into `out` (its buffers are reused).
+/// ref_points: any point container (keyframe pixels); ref_depths_m: container of depths (metres) with
+/// operator[]; poses are cam_from_world. Status Skipped when there are no keyframe points or no pose.
+template <class C, class D, class Raw, class T>
+void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>& cam_from_world_ref,
+                     const Rigid3<T>& cam_from_world_cur, const DepthView<Raw>& depth, const PinholeCamera<T>& camera,
+                     const MultiViewOptions<T>& options, MultiViewResult<T>* out) {
+  static_assert(is_point_container_v<C>, "dyncull::check_multiview: ref_points must hold points (see PointTraits)");
+  MultiViewResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(ref_points.size());
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_points = n;
+  r.num_checked = r.num_dynamic = r.num_large_parallax = r.num_no_depth = r.num_outside = 0;
+  r.labels.assign(n, FeatureLabel::Candidate);
+  r.outcome.assign(n, MultiViewOutcome::NonFinite);
+  r.projected.resize(n);
+  r.projected_depth_m.assign(n, T(0));
+  r.measured_depth_m.assign(n, T(0));
+  if (n == 0) {
+    r.status = Status::Skipped;
+    r.reason = "no keyframe points yet: the multi-view check needs a keyframe with depth";
+    return;
+  }
+  if (!cam_from_world_ref.all_finite() || !cam_from_world_cur.all_finite()) {
+    r.status = Status::Skipped;
+    r.reason = "no valid pose for the keyframe or the current frame (tracking not initialised?)";
+    return;
+  }
+  if (depth.empty()) {
+    r.status = Status::Skipped;
+    r.reason = "no current depth image";
+    return;
+  }
+  if (!camera.valid() || !(options.depth_threshold_m > T(0)) || !(options.max_parallax_deg > T(0)) ||
+      options.search_radius_px < 0) {
+    r.status = Status::InvalidInput;
+    r.reason = "invalid camera or options (depth_threshold_m and max_parallax_deg must be > 0, search_radius_px >= 0)";
+    return;
+  }
+  const Rigid3<T> cur_from_ref = cam_from_world_cur * cam_from_world_ref.inverse();
+  // Parallax from camera centres (DynaSLAM used the translation column of Tcw, right only without rotation).
+  // In the reference frame: the ray from the reference centre is X, the current centre is c_cur.
+  const Vec3<T> c_cur_in_ref = cur_from_ref.inverse().t;
+  const T cos_max = std::cos(options.max_parallax_deg * Constants<T>::deg_to_rad());
+  const T max_ref = options.max_reference_depth_m, max_proj = options.max_projected_depth_m;
+  const T border = options.border_px;
+  for (std::size_t i = 0; i < n; ++i) {
+    const T u = point_x<T>(ref_points[i]), v = point_y<T>(ref_points[i]);
+    const T d = static_cast<T>(ref_depths_m[i]);
+    if (!std::isfinite(u) || !std::isfinite(v) || !std::isfinite(d)) continue;  // outcome NonFinite
+    if (!(d > T(0)) || d > max_ref) {
+      r.outcome[i] = MultiViewOutcome::NoReferenceDepth;
+      ++r.num_no_depth;
+      continue;
+    }
+    const Vec3<T> X_ref = camera.backproject(Vec2<T>(u, v), d);
+    const Vec3<T> X_cur = cur_from_ref.apply(X_ref);
+    if (!(X_cur.z() > T(0)) || X_cur.z() > max_proj) {
+      r.outcome[i] = MultiViewOutcome::BehindCamera;
+      ++r.num_outside;
+      continue;
+    }
+    const Vec2<T> x = camera.project(X_cur);
+    r.projected[i] = x;
+    r.projected_depth_m[i] = X_cur.z();
+    if (!camera.in_image(x.x(), x.y(), border)) {
+      r.outcome[i] = MultiViewOutcome::OutsideImage;
+      ++r.num_outside;
+      continue;
+    }
+    const Vec3<T> ray_cur = X_ref - c_cur_in_ref;
+    const T cosang = X_ref.dot(ray_cur) / (X_ref.norm() * ray_cur.norm());
+    if (!(cosang >= cos_max)) {
+      r.outcome[i] = MultiViewOutcome::LargeParallax;
+      ++r.num_large_parallax;
+      continue;
+    }
+    const int pu = static_cast<int>(std::lround(x.x())), pv = static_cast<int>(std::lround(x.y()));
+    const T measured = detail::closest_depth_in_window<Raw, T>(depth, pu, pv, options.search_radius_px, X_cur.z());
+    r.measured_depth_m[i] = measured;
+    if (!(measured > T(0))) {
+      r.outcome[i] = MultiViewOutcome::NoMeasuredDepth;
+      ++r.num_no_depth;
+      continue;
+    }
+    r.outcome[i] = MultiViewOutcome::Checked;
+    ++r.num_checked;
+    // Something now in front of the remembered surface: the thing at x' moved there (seed 001).
+    if (X_cur.z() - measured > options.depth_threshold_m) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      ++r.num_dynamic;
+    } else {
+      r.labels[i] = FeatureLabel::Static;
+    }
+  }
+  if (r.num_checked == 0) {
+    r.status = Status::TooFewPoints;
+    r.reason = "no keyframe point could be compared (all without depth, outside the image or at large parallax)";
+  }
+}
+
+/// Convenience overload returning a fresh result.
+template <class C, class D, class Raw, class T>
+MultiViewResult<T> check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>& cam_from_world_ref,
+                                   const Rigid3<T>& cam_from_world_cur, const DepthView<Raw>& depth,
+                                   const PinholeCamera<T>& camera, const MultiViewOptions<T>& options = {}) {
+  MultiViewResult<T> r;
+  check_multiview(ref_points, ref_depths_m, cam_from_world_ref, cam_from_world_cur, depth, camera, options, &r);
+  return r;
+}
+
+/// Grows the dynamic seeds x' of `result` over the current depth image (4-neighbour flood fill, pixels
+/// within region_depth_tolerance_m of the seed's measured depth d'), OR-ing into `mask` (same size as the
+/// depth image; resized and cleared when its size differs). DynaSLAM does the same before dilating.
+/// `stack` is caller-owned scratch, reused across frames. Returns the number of pixels set.
+template <class Raw, class T>
+std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const DepthView<Raw>& depth,
+                                   const MultiViewOptions<T>& options, Mask* mask, std::vector<std::uint32_t>* stack) {
+  if (depth.empty()) return 0;
+  const int w = depth.width, h = depth.height;
+  if (mask->width != w || mask->height != h) mask->reset(w, h, 0);
+  std::uint8_t* m = mask->pixels.data();
+  std::size_t set = 0;
+  const T tol = options.region_depth_tolerance_m;
+  for (std::size_t i = 0; i < result.labels.size(); ++i) {
+    if (result.labels[i] != FeatureLabel::Dynamic) continue;
+    const int su = static_cast<int>(std::lround(result.projected[i].x()));
+    const int sv = static_cast<int>(std::lround(result.projected[i].y()));
+    if (!depth.in_bounds(su, sv)) continue;
+    const T seed_d = result.measured_depth_m[i];
+    const std::size_t seed_idx = static_cast<std::size_t>(sv) * static_cast<std::size_t>(w) + static_cast<std::size_t>(su);
+    if (m[seed_idx]) continue;  // already inside a grown region
+    std::size_t region = 0;
+    stack->clear();
+    stack->push_back(static_cast<std::uint32_t>(seed_idx));
+    m[seed_idx] = 1;
+    ++set;
+    ++region;
+    while (!stack->empty()) {
+      const std::uint32_t idx = stack->back();
+      stack->pop_back();
+      const int x = static_cast<int>(idx % static_cast<std::uint32_t>(w)), y = static_cast<int>(idx / static_cast<std::uint32_t>(w));
+      const int nx[4] = {x - 1, x + 1, x, x};
+      const int ny[4] = {y, y, y - 1, y + 1};
+      for (int k = 0; k < 4; ++k) {
+        if (!depth.in_bounds(nx[k], ny[k])) continue;
+        const std::size_t nidx = static_cast<std::size_t>(ny[k]) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx[k]);
+        if (m[nidx]) continue;
+        const T d = T(depth.depth_m(nx[k], ny[k]));
+        if (!(d > T(0)) || std::abs(d - seed_d) >= tol) continue;
+        if (options.max_region_pixels > 0 && region >= options.max_region_pixels) continue;
+        m[nidx] = 1;
+        ++set;
+        ++region;
+        stack->push_back(static_cast<std::uint32_t>(nidx));
+      }
+    }
+  }
+  return set;
+}
+
+/// One stored keyframe: pose, pixels and depths of (static) keypoints.
+template <class T>
+struct MultiViewKeyframe {
+  Rigid3<T> cam_from_world;
+  std::vector<Vec2<T>> points;
+  std::vector<T> depth_m;
+};
+
+/// Caller-owned ring of recent keyframes (DynaSLAM keeps 20 and compares against 5). Slots are
+/// reused, so after the ring is full pushing allocates nothing once point counts have been seen.
+template <class T>
+class KeyframeRing {
+ public:
+  explicit KeyframeRing(std::size_t capacity = 20) : slots_(capacity > 0 ? capacity : 1) {}
+
+  std::size_t capacity() const { return slots_.size(); }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  void clear() { size_ = 0; }
+
+  /// Keyframe i, 0 = newest.
+  const MultiViewKeyframe<T>& operator[](std::size_t i) const {
+    return slots_[(head_ + slots_.size() - 1 - i) % slots_.size()];
+  }
+
+  /// Stores a keyframe: points with valid depth (and keep[i] != 0 when keep is given) are copied.
+  template <class C, class D>
+  void push(const Rigid3<T>& cam_from_world, const C& points, const D& depths_m, const std::uint8_t* keep = nullptr) {
+    MultiViewKeyframe<T>& slot = slots_[head_];
+    head_ = (head_ + 1) % slots_.size();
+    size_ = std::min(size_ + 1, slots_.size());
+    slot.cam_from_world = cam_from_world;
+    slot.points.clear();
+    slot.depth_m.clear();
+    const std::size_t n = static_cast<std::size_t>(points.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (keep && !keep[i]) continue;
+      const T d = static_cast<T>(depths_m[i]);
+      const T u = point_x<T>(points[i]), v = point_y<T>(points[i]);
+      if (!(d > T(0)) || !std::isfinite(d) || !std::isfinite(u) || !std::isfinite(v)) continue;
+      slot.points.emplace_back(u, v);
+      slot.depth_m.push_back(d);
+    }
+  }
+
+  /// Up to max_refs keyframe indices, largest pose difference first (DynaSLAM: 0.7 normalised
+  /// translation + 0.3 normalised rotation), so the check sees the most motion. Returns the count.
+  std::size_t select_references(const Rigid3<T>& cam_from_world_cur, std::size_t max_refs, std::size_t* out) const {
+    const std::size_t n = size_;
+    if (n == 0 || max_refs == 0) return 0;
+    T max_t = T(0), max_r = T(0);
+    score_.resize(n);
+    order_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Rigid3<T> rel = cam_from_world_cur * (*this)[i].cam_from_world.inverse();
+      const T dt = rel.t.norm(), dr = rotation_angle(rel.R);
+      score_[i] = {dt, dr};
+      max_t = std::max(max_t, dt);
+      max_r = std::max(max_r, dr);
+      order_[i] = i;
+    }
+    auto value = [&](std::size_t i) {
+      return T(0.7) * (max_t > T(0) ? score_[i].first / max_t : T(0)) +
+             T(0.3) * (max_r > T(0) ? score_[i].second / max_r : T(0));
+    };
+    std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return value(a) > value(b); });
+    const std::size_t k = std::min(n, max_refs);
+    for (std::size_t i = 0; i < k; ++i) out[i] = order_[i];
+    return k;
+  }
+
+ private:
+  std::vector<MultiViewKeyframe<T>> slots_;
+  std::size_t head_ = 0, size_ = 0;
+  mutable std::vector<std::pair<T, T>> score_;
+  mutable std::vector<std::size_t> order_;
+};
+
+}  // namespace dyncull

@@ -1,0 +1,196 @@
+// Tests of the multi-view depth check (seed 001 §III.A) on ray-cast scenes with known motion.
+#include "dyncull/culling/multiview_check.hpp"
+
+#include "support/culling_scenes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace dyncull {
+namespace {
+
+using test::SceneConfig;
+using test::SceneKind;
+using test::SceneWorld;
+
+template <class T>
+class MultiViewTest : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(MultiViewTest, Scalars);
+
+// Keyframe 8 frames back: the walking person has moved 0.32 m, the chair 0.24 m sideways.
+constexpr int kFramesBack = 8;
+
+TYPED_TEST(MultiViewTest, FlagsSurfacesThatMovedInFrontOfTheKeyframeView) {
+  using T = TypeParam;
+  SceneConfig config;
+  const SceneWorld world(config);
+  const auto scene = test::make_culling_scene<T>(config);
+  const auto kf = test::make_scene_keyframe<T>(config, kFramesBack, 1500);
+  const auto r = check_multiview(kf.keypoints, kf.depth_m, kf.cam_from_world, scene.cam_from_world,
+                                 scene.depth_view(), scene.camera, MultiViewOptions<T>{});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.labels.size(), kf.keypoints.size());
+  // Truth at x': which surface the current frame shows there, and whether the remembered surface is
+  // really more than tau_d behind it (then the keyframe point is now occluded by something that moved).
+  std::size_t tp = 0, fp = 0, fn = 0;
+  for (std::size_t i = 0; i < r.labels.size(); ++i) {
+    if (r.outcome[i] != MultiViewOutcome::Checked) continue;
+    Vec3<double> X;
+    double d = 0;
+    int part = -1;
+    ASSERT_TRUE(world.raycast(0.0, double(r.projected[i].x()), double(r.projected[i].y()), &X, &d, &part));
+    const bool on_mover = part >= 0 && world.parts()[static_cast<std::size_t>(part)].moving();
+    // The window search (radius 2) may find the remembered surface itself beside a mover's edge:
+    // a miss counts only when x' is at least 3 px inside the mover.
+    bool inside = on_mover;
+    for (int k = 0; k < 4 && inside; ++k) {
+      Vec3<double> Xk;
+      double dk = 0;
+      int pk = -1;
+      const double du = (k == 0) ? 3 : (k == 1 ? -3 : 0), dv = (k == 2) ? 3 : (k == 3 ? -3 : 0);
+      inside = world.raycast(0.0, double(r.projected[i].x()) + du, double(r.projected[i].y()) + dv, &Xk, &dk, &pk) &&
+               pk >= 0 && world.parts()[static_cast<std::size_t>(pk)].moving();
+    }
+    const bool occluded_by_mover = inside && double(r.projected_depth_m[i]) - d > 0.6;
+    const bool flagged = r.labels[i] == FeatureLabel::Dynamic;
+    tp += flagged && on_mover;
+    fp += flagged && !on_mover;
+    fn += !flagged && occluded_by_mover;
+  }
+  // Static surfaces project onto themselves up to the window search and rounding, so a flag on a
+  // static surface can only come from a depth edge within 2 px: allow at most 3 % of the flags.
+  EXPECT_GT(tp, 20u);
+  EXPECT_LE(double(fp), 0.03 * double(tp + fp)) << "tp " << tp << " fp " << fp;
+  // Points clearly (> 0.6 m) occluded by a mover, away from its edges, must all be caught.
+  EXPECT_EQ(fn, 0u) << "tp " << tp << " fn " << fn;
+  EXPECT_EQ(r.num_dynamic, tp + fp);
+}
+
+TYPED_TEST(MultiViewTest, RegionGrowingLabelsCurrentFeaturesOnTheWalkingPerson) {
+  using T = TypeParam;
+  SceneConfig config;
+  config.sitting = false;  // the sitting person's lean is too small for a 0.4 m depth test
+  const auto scene = test::make_culling_scene<T>(config);
+  const auto kf = test::make_scene_keyframe<T>(config, kFramesBack, 1500);
+  MultiViewOptions<T> options;
+  const auto r = check_multiview(kf.keypoints, kf.depth_m, kf.cam_from_world, scene.cam_from_world,
+                                 scene.depth_view(), scene.camera, options);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  Mask mask;
+  std::vector<std::uint32_t> stack;
+  const std::size_t pixels = grow_multiview_regions(r, scene.depth_view(), options, &mask, &stack);
+  EXPECT_GT(pixels, 1000u);
+  std::vector<std::uint8_t> predicted(scene.size());
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    predicted[i] = mask.test(int(std::lround(double(scene.keypoints[i].x()))), int(std::lround(double(scene.keypoints[i].y()))));
+  const auto pr = test::precision_recall(predicted, scene.truth_dynamic, scene.size());
+  // Region growing leaks into the floor where the feet touch it (same depth), so precision is
+  // bounded by that band; recall covers both movers' visible faces.
+  EXPECT_GE(pr.precision, 0.8) << "tp " << pr.tp << " fp " << pr.fp;
+  EXPECT_GE(pr.recall, 0.85) << "tp " << pr.tp << " fn " << pr.fn;
+}
+
+TYPED_TEST(MultiViewTest, Uint16TumDepthGivesTheSameLabels) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto scene = test::make_culling_scene<T>(config);
+  const auto kf = test::make_scene_keyframe<T>(config, kFramesBack, 600);
+  const auto raw = scene.depth_tum();
+  const auto a = check_multiview(kf.keypoints, kf.depth_m, kf.cam_from_world, scene.cam_from_world,
+                                 scene.depth_view(), scene.camera, MultiViewOptions<T>{});
+  const auto b = check_multiview(kf.keypoints, kf.depth_m, kf.cam_from_world, scene.cam_from_world,
+                                 tum_depth_view(raw.data(), scene.width, scene.height), scene.camera,
+                                 MultiViewOptions<T>{});
+  ASSERT_TRUE(a.ok() && b.ok());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.labels.size(); ++i) differ += a.labels[i] != b.labels[i];
+  // 0.2 mm quantisation can flip only points within 0.2 mm of the threshold: none expected.
+  EXPECT_LE(differ, 1u);
+  EXPECT_EQ(a.num_checked, b.num_checked);
+}
+
+TYPED_TEST(MultiViewTest, ReportsSkippedWithoutKeyframeOrPose) {
+  using T = TypeParam;
+  const auto scene = test::make_culling_scene<T>(SceneConfig{});
+  const std::vector<Vec2<T>> none;
+  const std::vector<T> no_depth;
+  const auto r = check_multiview(none, no_depth, scene.cam_from_world, scene.cam_from_world, scene.depth_view(),
+                                 scene.camera, MultiViewOptions<T>{});
+  EXPECT_EQ(r.status, Status::Skipped);
+  EXPECT_FALSE(r.reason.empty());
+
+  const std::vector<Vec2<T>> pts{Vec2<T>(100, 100)};
+  const std::vector<T> d{T(2)};
+  Rigid3<T> lost = scene.cam_from_world;
+  lost.t.x() = Constants<T>::nan();
+  const auto s = check_multiview(pts, d, scene.cam_from_world, lost, scene.depth_view(), scene.camera,
+                                 MultiViewOptions<T>{});
+  EXPECT_EQ(s.status, Status::Skipped);
+  EXPECT_NE(s.reason.find("pose"), std::string::npos);
+  EXPECT_EQ(s.labels.size(), 1u);
+  EXPECT_EQ(s.labels[0], FeatureLabel::Candidate);
+
+  const auto e = check_multiview(pts, d, scene.cam_from_world, scene.cam_from_world, DepthView<float>{},
+                                 scene.camera, MultiViewOptions<T>{});
+  EXPECT_EQ(e.status, Status::Skipped);
+}
+
+TYPED_TEST(MultiViewTest, SkipsLargeParallaxMissingDepthAndNonFinite) {
+  using T = TypeParam;
+  PinholeCamera<T> cam;
+  // Current frame: a flat wall at 1 m (so every projection finds depth).
+  std::vector<float> wall(static_cast<std::size_t>(cam.width * cam.height), 1.f);
+  const DepthView<float> depth{wall.data(), cam.width, cam.height};
+  Rigid3<T> ref, cur;
+  // Camera moved 1 m sideways and turned 45 deg back towards the point at (0, 0, 1): rays differ by 45 deg.
+  cur.R = Eigen::AngleAxis<T>(T(0.25) * Constants<T>::pi(), Vec3<T>::UnitY()).toRotationMatrix();
+  cur.t = -(cur.R * Vec3<T>(T(1), T(0), T(0)));
+  const std::vector<Vec2<T>> pts{Vec2<T>(cam.cx, cam.cy), Vec2<T>(cam.cx, cam.cy), Vec2<T>(Constants<T>::nan(), T(3))};
+  const std::vector<T> d{T(1), T(0), T(1)};
+  const auto r = check_multiview(pts, d, ref, cur, depth, cam, MultiViewOptions<T>{});
+  EXPECT_EQ(r.outcome[0], MultiViewOutcome::LargeParallax);
+  EXPECT_EQ(r.outcome[1], MultiViewOutcome::NoReferenceDepth);
+  EXPECT_EQ(r.outcome[2], MultiViewOutcome::NonFinite);
+  EXPECT_EQ(r.num_large_parallax, 1u);
+  EXPECT_EQ(r.status, Status::TooFewPoints);
+  for (auto l : r.labels) EXPECT_EQ(l, FeatureLabel::Candidate);
+
+  // With a 60 deg limit the same point is compared: it projects to the image centre at depth sqrt(2) and
+  // the wall at 1 m is in front of it, so it is dynamic only if that gap exceeds tau_d.
+  MultiViewOptions<T> wide;
+  wide.max_parallax_deg = T(60);
+  const auto w = check_multiview(pts, d, ref, cur, depth, cam, wide);
+  EXPECT_EQ(w.outcome[0], MultiViewOutcome::Checked);
+  EXPECT_NEAR(double(w.projected_depth_m[0]), std::sqrt(2.0), 1e-4);
+  EXPECT_EQ(w.labels[0], FeatureLabel::Dynamic);  // sqrt(2) - 1 = 0.414 > 0.4
+}
+
+TYPED_TEST(MultiViewTest, KeyframeRingKeepsNewestAndSelectsLargestMotionFirst) {
+  using T = TypeParam;
+  KeyframeRing<T> ring(5);
+  EXPECT_TRUE(ring.empty());
+  const std::vector<Vec2<T>> pts{Vec2<T>(1, 2), Vec2<T>(3, 4), Vec2<T>(5, 6)};
+  const std::vector<T> depth{T(1), T(0), T(2)};  // the middle one has no depth: not stored
+  for (int k = 0; k < 8; ++k) {
+    Rigid3<T> pose;
+    pose.t = Vec3<T>(T(0.1) * T(k), T(0), T(0));
+    ring.push(pose, pts, depth);
+  }
+  EXPECT_EQ(ring.size(), 5u);
+  EXPECT_NEAR(double(ring[0].cam_from_world.t.x()), 0.7, 1e-6);  // newest
+  EXPECT_NEAR(double(ring[4].cam_from_world.t.x()), 0.3, 1e-6);  // oldest kept
+  EXPECT_EQ(ring[0].points.size(), 2u);
+  std::size_t idx[3];
+  Rigid3<T> cur;
+  cur.t = Vec3<T>(T(0.8), T(0), T(0));
+  ASSERT_EQ(ring.select_references(cur, 3, idx), 3u);
+  EXPECT_EQ(idx[0], 4u);  // 0.5 m away
+  EXPECT_EQ(idx[1], 3u);
+  EXPECT_EQ(idx[2], 2u);
+}
+
+}  // namespace
+}  // namespace dyncull
