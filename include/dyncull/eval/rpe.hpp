@@ -1,0 +1,253 @@
+/// @file rpe.hpp
+/// Relative pose error exactly as TUM evaluate_rpe.py --fixed_delta (drift over a fixed delta in
+/// frames, seconds, metres or degrees): E = (P_i^-1 P_j)(Q_i^-1 Q_j)^-1, |t(E)| and angle(R(E)).
+#pragma once
+
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/eval/statistics.hpp"
+#include "dyncull/eval/trajectory.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace dyncull::eval {
+
+/// Unit of RpeOptions::delta (evaluate_rpe.py --delta_unit f / s / m / rad / deg).
+enum class DeltaUnit { Frames, Seconds, Metres, Radians, Degrees };
+
+constexpr const char* to_string(DeltaUnit unit) noexcept {
+  switch (unit) {
+    case DeltaUnit::Frames: return "frames";
+    case DeltaUnit::Seconds: return "seconds";
+    case DeltaUnit::Metres: return "metres";
+    case DeltaUnit::Radians: return "radians";
+    case DeltaUnit::Degrees: return "degrees";
+  }
+  return "unknown";
+}
+
+/// Pair selection is always TUM's --fixed_delta mode and always uses every pair: TUM's default mode
+/// (all or 10000 random pairs of any separation, mean printed) is a trap for drift numbers, and its
+/// random subsampling above 10000 pairs is not reproducible. Below 10000 pairs the numbers are TUM's.
+struct RpeOptions {
+  /// 1 second, as `evaluate_rpe.py --fixed_delta` (the drift per second the TUM benchmark recommends
+  /// for RGB-D, and what DynaSLAM's repository ran).
+  double delta = 1.0;
+  DeltaUnit delta_unit = DeltaUnit::Seconds;
+  double offset_s = 0.0;  ///< added to the estimate's stamps (evaluate_rpe.py --offset)
+  /// Fixed factor on the estimate's relative translations (evaluate_rpe.py --scale); set it to the
+  /// ATE Sim(3) scale to evaluate a monocular estimate.
+  double scale = 1.0;
+};
+
+/// One compared pair. Indices point into the caller's trajectories (not the sorted order).
+template <class T>
+struct RpePair {
+  std::uint32_t estimate_i = 0, estimate_j = 0;
+  std::uint32_t groundtruth_i = 0, groundtruth_j = 0;
+  T translation_m = T(0);
+  T rotation_deg = T(0);
+};
+
+template <class T>
+struct RpeResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  ErrorStatistics<T> translation_m;   ///< |t(E)|, metres
+  ErrorStatistics<T> rotation_deg;    ///< angle of R(E), degrees
+  std::size_t num_pairs = 0;          ///< "compared_pose_pairs"
+  std::size_t num_dropped_gap = 0;    ///< pairs dropped: a ground-truth stamp further than 2 x median GT interval
+  double max_gap_s = 0;               ///< that gap limit
+  std::vector<RpePair<T>> pairs;
+};
+
+/// evaluate_rpe.py GROUNDTRUTH ESTIMATE --fixed_delta --delta D --delta_unit U, every pair used.
+/// Both trajectories are first sorted by stamp (duplicates: last entry wins, non-finite stamps
+/// ignored). For each estimate pose i (sorted), j = the pose whose delta coordinate (frame index,
+/// stamp, distance or angle travelled) is closest to that of i plus delta; the pair is dropped when
+/// j is the LAST estimate pose (TUM's rule, so the final frame never pairs). Each estimate stamp
+/// takes the closest ground-truth stamp (not unique, no 0.02 s window); the pair is dropped when
+/// either stamp gap exceeds 2 x the median ground-truth stamp interval.
+/// Rotation angles: arccos(clamp((trace - 1) / 2)) in double as TUM for double input; for float input
+/// the atan2(|vee(R - R^T)| / 2, (trace - 1) / 2) form, since arccos near 1 amplifies float round-off
+/// of the rotation matrices (1e-7) into 5e-4 rad.
+template <class T>
+RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>& estimate,
+                          const RpeOptions& options = {});
+
+// ------------------------------------------------------------------------------------------------
+// Implementation
+// ------------------------------------------------------------------------------------------------
+namespace detail {
+
+/// evaluate_rpe.py find_closest_index, line for line (binary search remembering the best probe;
+/// its tie-breaking decides which of two equidistant stamps is taken, so it is ported, not rewritten).
+inline std::size_t find_closest_index(const std::vector<double>& list, double t) {
+  std::size_t beginning = 0;
+  double difference = std::abs(list[0] - t);
+  std::size_t best = 0;
+  std::size_t end = list.size();
+  while (beginning < end) {
+    const std::size_t middle = (end + beginning) / 2;
+    if (std::abs(list[middle] - t) < difference) {
+      difference = std::abs(list[middle] - t);
+      best = middle;
+    }
+    if (t == list[middle]) return middle;
+    if (list[middle] > t) {
+      end = middle;
+    } else {
+      beginning = middle + 1;
+    }
+  }
+  return best;
+}
+
+/// TUM compute_angle for double; the atan2 form for float input (see evaluate_rpe).
+template <class T>
+double relative_rotation_angle_rad(const Mat3<double>& R) {
+  if (std::is_same<T, double>::value) return rotation_angle(R);
+  const Vec3<double> w(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
+  return std::atan2(0.5 * w.norm(), 0.5 * (R.trace() - 1.0));
+}
+
+}  // namespace detail
+
+template <class T>
+RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>& estimate, const RpeOptions& options) {
+  RpeResult<T> result;
+  auto fail = [&result](Status status, const std::string& why) {
+    result.status = status;
+    result.reason = "rpe: " + why;
+    return result;
+  };
+  if (groundtruth.stamps.size() != groundtruth.poses.size() || estimate.stamps.size() != estimate.poses.size()) {
+    return fail(Status::InvalidInput, "a trajectory has different numbers of stamps and poses");
+  }
+  if (!(options.delta > 0.0) || !std::isfinite(options.delta) || !std::isfinite(options.offset_s) ||
+      !std::isfinite(options.scale)) {
+    return fail(Status::InvalidInput, "delta must be positive and finite, offset_s and scale finite");
+  }
+  std::vector<std::uint32_t> gt_order;
+  std::vector<std::uint32_t> est_order;
+  detail::sorted_unique_stamp_order(groundtruth.stamps.data(), groundtruth.size(), &gt_order);
+  detail::sorted_unique_stamp_order(estimate.stamps.data(), estimate.size(), &est_order);
+  if (gt_order.size() < 2 || est_order.size() < 2) {
+    return fail(Status::TooFewPoints, "need at least 2 distinct finite stamps in each trajectory, got " +
+                                          std::to_string(gt_order.size()) + " ground truth and " +
+                                          std::to_string(est_order.size()) + " estimate");
+  }
+  const std::size_t n_gt = gt_order.size();
+  const std::size_t n_est = est_order.size();
+  std::vector<double> stamps_gt(n_gt);
+  std::vector<double> stamps_est(n_est);
+  for (std::size_t k = 0; k < n_gt; ++k) stamps_gt[k] = groundtruth.stamps[gt_order[k]];
+  for (std::size_t k = 0; k < n_est; ++k) stamps_est[k] = estimate.stamps[est_order[k]];
+  const double offset = options.offset_s;
+
+  // TUM's overlap check: estimate stamps that round-trip est -> closest GT -> closest est.
+  {
+    std::vector<std::uint8_t> returned(n_est, 0);
+    std::size_t distinct = 0;
+    for (std::size_t k = 0; k < n_est; ++k) {
+      const double t_gt = stamps_gt[detail::find_closest_index(stamps_gt, stamps_est[k] + offset)];
+      const std::size_t back = detail::find_closest_index(stamps_est, t_gt - offset);
+      distinct += returned[back] == 0;
+      returned[back] = 1;
+    }
+    if (distinct < 2) {
+      return fail(Status::TooFewPoints, "the stamps of the two trajectories do not overlap (wrong files?)");
+    }
+  }
+
+  std::vector<Rigid3<double>> P(n_est);
+  std::vector<Rigid3<double>> Q(n_gt);
+  for (std::size_t k = 0; k < n_est; ++k) P[k] = estimate.poses[est_order[k]].template cast<double>();
+  for (std::size_t k = 0; k < n_gt; ++k) Q[k] = groundtruth.poses[gt_order[k]].template cast<double>();
+  if (!std::all_of(P.begin(), P.end(), [](const Rigid3<double>& p) { return p.all_finite(); }) ||
+      !std::all_of(Q.begin(), Q.end(), [](const Rigid3<double>& q) { return q.all_finite(); })) {
+    return fail(Status::NonFinite, "non-finite pose");
+  }
+
+  // The coordinate along which delta is measured (evaluate_rpe.py index_est).
+  std::vector<double> index(n_est);
+  switch (options.delta_unit) {
+    case DeltaUnit::Frames:
+      for (std::size_t k = 0; k < n_est; ++k) index[k] = static_cast<double>(k);
+      break;
+    case DeltaUnit::Seconds:
+      index = stamps_est;
+      break;
+    case DeltaUnit::Metres:
+    case DeltaUnit::Radians:
+    case DeltaUnit::Degrees: {
+      const double unit = options.delta_unit == DeltaUnit::Degrees ? Constants<double>::rad_to_deg() : 1.0;
+      double sum = 0.0;
+      index[0] = 0.0;
+      for (std::size_t k = 0; k + 1 < n_est; ++k) {
+        const Rigid3<double> motion = P[k + 1].inverse() * P[k];
+        sum += options.delta_unit == DeltaUnit::Metres ? motion.t.norm() : rotation_angle(motion.R) * unit;
+        index[k + 1] = sum;
+      }
+      break;
+    }
+  }
+
+  std::vector<double> gt_intervals(n_gt - 1);
+  for (std::size_t k = 0; k + 1 < n_gt; ++k) gt_intervals[k] = stamps_gt[k + 1] - stamps_gt[k];
+  const ErrorStatistics<double> interval_stats = compute_statistics(gt_intervals.data(), gt_intervals.size());
+  const double max_gap = 2.0 * interval_stats.median;
+  result.max_gap_s = max_gap;
+
+  result.pairs.reserve(n_est);
+  std::vector<T> trans;
+  std::vector<T> rot;
+  trans.reserve(n_est);
+  rot.reserve(n_est);
+  for (std::size_t i = 0; i < n_est; ++i) {
+    const std::size_t j = detail::find_closest_index(index, index[i] + options.delta);
+    if (j == n_est - 1) continue;
+    const double te_i = stamps_est[i] + offset;
+    const double te_j = stamps_est[j] + offset;
+    const std::size_t gi = detail::find_closest_index(stamps_gt, te_i);
+    const std::size_t gj = detail::find_closest_index(stamps_gt, te_j);
+    if (std::abs(stamps_gt[gi] - te_i) > max_gap || std::abs(stamps_gt[gj] - te_j) > max_gap) {
+      ++result.num_dropped_gap;
+      continue;
+    }
+    // ominus(scale(ominus(P_j, P_i)), ominus(Q_j, Q_i)) with ominus(a, b) = a^-1 b.
+    Rigid3<double> est_motion = P[j].inverse() * P[i];
+    est_motion.t *= options.scale;
+    const Rigid3<double> gt_motion = Q[gj].inverse() * Q[gi];
+    const Rigid3<double> error = est_motion.inverse() * gt_motion;
+    RpePair<T> pair;
+    pair.estimate_i = est_order[i];
+    pair.estimate_j = est_order[j];
+    pair.groundtruth_i = gt_order[gi];
+    pair.groundtruth_j = gt_order[gj];
+    pair.translation_m = static_cast<T>(error.t.norm());
+    pair.rotation_deg = static_cast<T>(detail::relative_rotation_angle_rad<T>(error.R) * Constants<double>::rad_to_deg());
+    trans.push_back(pair.translation_m);
+    rot.push_back(pair.rotation_deg);
+    result.pairs.push_back(pair);
+  }
+  result.num_pairs = result.pairs.size();
+  if (result.num_pairs < 2) {
+    return fail(Status::TooFewPoints, "only " + std::to_string(result.num_pairs) +
+                                          " pose pairs matched the ground truth (TUM needs 2); " +
+                                          std::to_string(result.num_dropped_gap) + " dropped by the " +
+                                          std::to_string(max_gap) + " s gap rule");
+  }
+  result.translation_m = compute_statistics(trans.data(), trans.size());
+  result.rotation_deg = compute_statistics(rot.data(), rot.size());
+  return result;
+}
+
+}  // namespace dyncull::eval
