@@ -1,0 +1,299 @@
+/// @file subbox_refine.hpp
+/// Sub-box refinement (seed 003 Algorithm 1): each detection box is split into 3 x 3 sub-boxes voted
+/// dynamic or static by the geometric labels inside them (ratio = dyn / (dyn + static) vs sigma1).
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/mask.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/labels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+
+/// Options of Algorithm 1. The paper gives no values for sigma1, sigma2 beyond "the majority"; the
+/// merge rule and the empty-sub-box rule are our choices (docs/parts/geometric-algorithms.md).
+template <class T>
+struct SubBoxOptions {
+  int grid = 3;                 ///< grid x grid sub-boxes per box (paper: 3; at most 8)
+  T sigma1 = T(0.5);            ///< dynamic sub-box when dyn / (dyn + static) >= sigma1
+  int sigma2 = 4;               ///< more than sigma2 dynamic sub-boxes (after merging) -> whole box dynamic
+  std::size_t min_points = 2;   ///< sub-boxes with fewer labelled points carry no evidence ("empty")
+  /// A static sub-box next to a dynamic one is merged into the dynamic set when it is empty or its
+  /// ratio is at least merge_ratio. The paper merges every neighbour (merge_ratio = 0); 0.2 keeps
+  /// sub-boxes whose points clearly agree on "static" (the legs of a person who only moves the arms).
+  T merge_ratio = T(0.2);
+  bool merge_8_neighbours = false;  ///< false: 4-neighbours (edge-sharing), true: 8 (corners too)
+  /// Features outside every box keep their geometric label (there is no semantic evidence against it);
+  /// false: they become static (trust only boxed objects).
+  bool keep_geometric_outside_boxes = true;
+  int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
+};
+
+/// Per-box vote. Cell (row, col) is cells[row * grid + col]; state 1 = dynamic.
+struct SubBoxVote {
+  bool whole_box = false;       ///< more than sigma2 dynamic sub-boxes: the whole box is dynamic
+  int num_dynamic_cells = 0;    ///< after merging (and after whole_box: grid*grid)
+  int num_merged_cells = 0;     ///< static or empty cells merged because they touch a dynamic one
+};
+
+template <class T>
+struct SubBoxResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  std::vector<FeatureLabel> labels;  ///< per feature: Static or Dynamic
+  std::vector<CullReason> reasons;   ///< SubBox inside a dynamic sub-box, Epipolar outside boxes, else None
+  std::vector<SubBoxVote> votes;     ///< per box
+  std::vector<std::uint8_t> cells;   ///< per box grid*grid dynamic flags, box-major
+  std::vector<std::uint32_t> dyn_count, static_count;  ///< per box grid*grid vote counts
+  std::size_t num_dynamic = 0, num_static = 0;
+  std::size_t num_rescued = 0;  ///< geometric Dynamic inside a box but in a static sub-box: made Static
+  std::size_t num_added = 0;    ///< geometric Static made Dynamic by a dynamic sub-box
+  std::size_t num_boxes = 0, num_whole_boxes = 0, num_invalid_boxes = 0;
+};
+
+namespace detail {
+template <class T> const Box<T>& subbox_as_box(const Box<T>& b) { return b; }
+template <class T> const Box<T>& subbox_as_box(const Detection<T>& d) { return d.box; }
+
+/// Cell of (x, y) in box b, or -1 when outside. Cells split the box evenly in continuous coordinates.
+template <class T>
+int subbox_cell(const Box<T>& b, int grid, T x, T y) {
+  if (!(x >= b.x0 && x <= b.x1 && y >= b.y0 && y <= b.y1)) return -1;
+  const T w = b.x1 - b.x0, h = b.y1 - b.y0;
+  int cx = w > T(0) ? static_cast<int>((x - b.x0) * T(grid) / w) : 0;
+  int cy = h > T(0) ? static_cast<int>((y - b.y0) * T(grid) / h) : 0;
+  cx = std::min(std::max(cx, 0), grid - 1);
+  cy = std::min(std::max(cy, 0), grid - 1);
+  return cy * grid + cx;
+}
+}  // namespace detail
+
+/// Runs Algorithm 1 on every box, writing into `out` (buffers reused across frames).
+/// points: the features; geometric: their geometric labels (Dynamic / Static; Candidate = unlabelled,
+/// not counted); boxes: container of Box<T> or Detection<T> (the boxes to refine, e.g. person boxes);
+/// in_object_mask: optional per-feature flag (object mask of 000 §3.3): a feature in a dynamic sub-box
+/// is Dynamic only if also in the object mask, as the paper keeps "the mask" inside dynamic sub-boxes.
+template <class T, class Points, class Boxes>
+void refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+                     const SubBoxOptions<T>& options, SubBoxResult<T>* out,
+                     const std::uint8_t* in_object_mask = nullptr) {
+  static_assert(is_point_container_v<Points>, "dyncull::refine_subboxes: points must hold points (see PointTraits)");
+  SubBoxResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(points.size());
+  const std::size_t nb = static_cast<std::size_t>(boxes.size());
+  const int g = options.grid;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  r.num_dynamic = r.num_static = r.num_rescued = r.num_added = 0;
+  r.num_boxes = nb;
+  r.num_whole_boxes = r.num_invalid_boxes = 0;
+  if (g < 1 || g > 8 || !(options.sigma1 >= T(0)) || options.sigma2 < 0) {
+    r.status = Status::InvalidInput;
+    r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0 and sigma2 >= 0 required";
+    r.votes.clear();
+    return;
+  }
+  const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  r.votes.assign(nb, SubBoxVote{});
+  r.cells.assign(nb * cells_per_box, 0);
+  r.dyn_count.assign(nb * cells_per_box, 0);
+  r.static_count.assign(nb * cells_per_box, 0);
+
+  // Votes: every labelled feature counts in every box containing it (boxes may overlap).
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Box<T>& box = detail::subbox_as_box(boxes[b]);
+    if (!box.valid()) {
+      ++r.num_invalid_boxes;
+      continue;
+    }
+    std::uint32_t* dc = r.dyn_count.data() + b * cells_per_box;
+    std::uint32_t* sc = r.static_count.data() + b * cells_per_box;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int c = detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
+      if (c < 0) continue;
+      if (geometric[i] == FeatureLabel::Dynamic) ++dc[c];
+      else if (geometric[i] == FeatureLabel::Static) ++sc[c];
+    }
+  }
+
+  // Cell states: 1 dynamic, 0 static with evidence, 2 empty (no evidence).
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!detail::subbox_as_box(boxes[b]).valid()) continue;
+    std::uint8_t* cells = r.cells.data() + b * cells_per_box;
+    const std::uint32_t* dc = r.dyn_count.data() + b * cells_per_box;
+    const std::uint32_t* sc = r.static_count.data() + b * cells_per_box;
+    std::uint8_t st[64];  // voted states; merging reads these, so it never chains
+    for (std::size_t c = 0; c < cells_per_box; ++c) {
+      const std::uint32_t total = dc[c] + sc[c];
+      if (total < options.min_points || total == 0) st[c] = 2;
+      else st[c] = T(dc[c]) >= options.sigma1 * T(total) ? 1 : 0;
+    }
+    // Merge (Algorithm 1 line 14) in one pass against the voted dynamic cells, so merging does not chain.
+    SubBoxVote& vote = r.votes[b];
+    for (int row = 0; row < g; ++row)
+      for (int col = 0; col < g; ++col) {
+        const std::size_t c = static_cast<std::size_t>(row * g + col);
+        if (st[c] == 1) {
+          cells[c] = 1;
+          continue;
+        }
+        bool touches = false;
+        for (int dr = -1; dr <= 1 && !touches; ++dr)
+          for (int dcol = -1; dcol <= 1 && !touches; ++dcol) {
+            if ((dr == 0 && dcol == 0) || (!options.merge_8_neighbours && dr != 0 && dcol != 0)) continue;
+            const int rr = row + dr, cc = col + dcol;
+            if (rr < 0 || cc < 0 || rr >= g || cc >= g) continue;
+            touches = st[static_cast<std::size_t>(rr * g + cc)] == 1;
+          }
+        const std::uint32_t total = dc[c] + sc[c];
+        const bool weak = st[c] == 2 || T(dc[c]) >= options.merge_ratio * T(total);
+        cells[c] = (touches && weak) ? 1 : 0;
+        vote.num_merged_cells += cells[c];
+      }
+    for (std::size_t c = 0; c < cells_per_box; ++c) vote.num_dynamic_cells += cells[c];
+    if (vote.num_dynamic_cells > options.sigma2) {
+      vote.whole_box = true;
+      vote.num_dynamic_cells = static_cast<int>(cells_per_box);
+      std::fill(cells, cells + cells_per_box, std::uint8_t(1));
+      ++r.num_whole_boxes;
+    }
+  }
+
+  // Features: dynamic inside any dynamic cell (and the object mask if given); static inside boxes otherwise.
+  for (std::size_t i = 0; i < n; ++i) {
+    const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
+    bool in_box = false, in_dynamic = false;
+    for (std::size_t b = 0; b < nb && !in_dynamic; ++b) {
+      const Box<T>& box = detail::subbox_as_box(boxes[b]);
+      if (!box.valid()) continue;
+      const int c = detail::subbox_cell(box, g, x, y);
+      if (c < 0) continue;
+      in_box = true;
+      in_dynamic = r.cells[b * cells_per_box + static_cast<std::size_t>(c)] != 0;
+    }
+    const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
+    if (!std::isfinite(x) || !std::isfinite(y)) {
+      r.labels[i] = FeatureLabel::Dynamic;  // never trust a non-finite feature as static
+      r.reasons[i] = CullReason::InvalidInput;
+    } else if (in_dynamic && (!in_object_mask || in_object_mask[i])) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      r.reasons[i] = CullReason::SubBox;
+      r.num_added += !geo_dyn;
+    } else if (in_box) {
+      r.num_rescued += geo_dyn;
+    } else if (geo_dyn && options.keep_geometric_outside_boxes) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      r.reasons[i] = CullReason::Epipolar;
+    }
+    r.num_dynamic += r.labels[i] == FeatureLabel::Dynamic;
+  }
+  r.num_static = n - r.num_dynamic;
+  if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
+}
+
+/// Convenience overload returning a fresh result.
+template <class T, class Points, class Boxes>
+SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+                                const SubBoxOptions<T>& options = {}, const std::uint8_t* in_object_mask = nullptr) {
+  SubBoxResult<T> r;
+  refine_subboxes(points, geometric, boxes, options, &r, in_object_mask);
+  return r;
+}
+
+/// Square (Chebyshev) binary dilation of `mask` inside `roi` by `radius` pixels, two separable passes
+/// with running counts: cost O(roi area), independent of the radius. `scratch` is reused.
+inline void dilate_square(MaskView mask, PixelRect roi, int radius, std::vector<std::uint16_t>* scratch) {
+  if (mask.empty() || radius <= 0) return;
+  roi.c0 = std::max(roi.c0, 0);
+  roi.r0 = std::max(roi.r0, 0);
+  roi.c1 = std::min(roi.c1, mask.width);
+  roi.r1 = std::min(roi.r1, mask.height);
+  if (roi.empty()) return;
+  const int w = roi.width(), h = roi.height();
+  scratch->assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
+  std::uint16_t* tmp = scratch->data();
+  // Horizontal: tmp = number of set pixels within [x - r, x + r] (saturating is unnecessary: <= 2r+1).
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* row = mask.row(roi.r0 + y) + roi.c0;
+    std::uint16_t* t = tmp + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    int count = 0;
+    for (int x = 0; x < std::min(radius, w); ++x) count += row[x] != 0;
+    for (int x = 0; x < w; ++x) {
+      if (x + radius < w) count += row[x + radius] != 0;
+      if (x - radius - 1 >= 0) count -= row[x - radius - 1] != 0;
+      t[x] = static_cast<std::uint16_t>(count > 0);
+    }
+  }
+  // Vertical, written back into the mask.
+  for (int x = 0; x < w; ++x) {
+    int count = 0;
+    for (int y = 0; y < std::min(radius, h); ++y) count += tmp[static_cast<std::size_t>(y) * w + x];
+    for (int y = 0; y < h; ++y) {
+      if (y + radius < h) count += tmp[static_cast<std::size_t>(y + radius) * w + x];
+      if (y - radius - 1 >= 0) count -= tmp[static_cast<std::size_t>(y - radius - 1) * w + x];
+      mask.row(roi.r0 + y)[roi.c0 + x] = static_cast<std::uint8_t>(count > 0 ? 255 : 0);
+    }
+  }
+}
+
+/// Rasterises the final mask of Algorithm 1 into `mask` (cleared first; must be the image size):
+/// the object mask (or the whole cell when object_mask is empty) inside every dynamic sub-box, then
+/// dilated by options.dilation_radius_px. Returns the number of set pixels.
+template <class T, class Boxes>
+std::size_t subbox_mask(const SubBoxResult<T>& result, const Boxes& boxes, const SubBoxOptions<T>& options,
+                        ConstMaskView object_mask, MaskView mask, std::vector<std::uint16_t>* scratch) {
+  if (mask.empty()) return 0;
+  for (int y = 0; y < mask.height; ++y) std::fill(mask.row(y), mask.row(y) + mask.width, std::uint8_t(0));
+  const int g = options.grid;
+  if (g < 1 || result.votes.size() != static_cast<std::size_t>(boxes.size())) return 0;
+  const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  PixelRect bound{mask.width, mask.height, 0, 0};
+  for (std::size_t b = 0; b < result.votes.size(); ++b) {
+    const Box<T>& box = detail::subbox_as_box(boxes[b]);
+    if (!box.valid()) continue;
+    const T cw = box.width() / T(g), ch = box.height() / T(g);
+    for (int c = 0; c < static_cast<int>(cells_per_box); ++c) {
+      if (!result.cells[b * cells_per_box + static_cast<std::size_t>(c)]) continue;
+      const int row = c / g, col = c % g;
+      const Box<T> cell{box.x0 + T(col) * cw, box.y0 + T(row) * ch, box.x0 + T(col + 1) * cw, box.y0 + T(row + 1) * ch};
+      const PixelRect pr = pixel_rect(cell, mask.width, mask.height);
+      if (pr.empty()) continue;
+      bound.c0 = std::min(bound.c0, pr.c0);
+      bound.r0 = std::min(bound.r0, pr.r0);
+      bound.c1 = std::max(bound.c1, pr.c1);
+      bound.r1 = std::max(bound.r1, pr.r1);
+      for (int y = pr.r0; y < pr.r1; ++y) {
+        std::uint8_t* out = mask.row(y);
+        if (object_mask.empty()) {
+          std::fill(out + pr.c0, out + pr.c1, std::uint8_t(255));
+        } else {
+          const std::uint8_t* in = object_mask.in_bounds(0, y) ? object_mask.row(y) : nullptr;
+          const int c1 = std::min(pr.c1, object_mask.width);
+          for (int x = pr.c0; in && x < c1; ++x) out[x] = in[x] ? std::uint8_t(255) : out[x];
+        }
+      }
+    }
+  }
+  if (bound.empty()) return 0;
+  const int rad = options.dilation_radius_px;
+  dilate_square(mask, PixelRect{bound.c0 - rad, bound.r0 - rad, bound.c1 + rad, bound.r1 + rad}, rad, scratch);
+  std::size_t set = 0;
+  for (int y = 0; y < mask.height; ++y)
+    for (int x = 0; x < mask.width; ++x) set += mask.row(y)[x] != 0;
+  return set;
+}
+
+}  // namespace dyncull

@@ -1,0 +1,205 @@
+// Tests of the 3x3 sub-box refinement (seed 003 Algorithm 1) with geometric labels of known error rates.
+#include "dyncull/culling/subbox_refine.hpp"
+
+#include "support/culling_scenes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace dyncull {
+namespace {
+
+using test::SceneConfig;
+using test::SceneKind;
+
+template <class T>
+class SubBoxTest : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(SubBoxTest, Scalars);
+
+// Geometric labels as an epipolar check would give them: truth with 8 % of static features flagged
+// (noise, epipolar-line errors) and 15 % of moving ones missed (motion along the epipolar line).
+template <class T>
+std::vector<FeatureLabel> noisy_geometric_labels(const test::CullingScene<T>& s, std::uint64_t seed = 3) {
+  Random rng(seed);
+  std::vector<FeatureLabel> g(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const bool flip = rng.uniform() < (s.truth_dynamic[i] ? 0.15 : 0.08);
+    g[i] = (s.truth_dynamic[i] != 0) != flip ? FeatureLabel::Dynamic : FeatureLabel::Static;
+  }
+  return g;
+}
+
+template <class T>
+std::vector<Detection<T>> person_boxes(const test::CullingScene<T>& s) {
+  std::vector<Detection<T>> out;
+  for (std::size_t b = 0; b < s.detections.size(); ++b)
+    if (s.detections[b].class_id == 0)
+      out.push_back(Detection<T>{s.detections[b].box.template cast<T>(), 0, T(s.detections[b].confidence)});
+  return out;
+}
+
+TYPED_TEST(SubBoxTest, SittingPersonKeepsStaticLegsAndCullsTheMovingUpperBody) {
+  using T = TypeParam;
+  SceneConfig config;
+  config.walking = false;
+  config.num_per_object = 200;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto geo = noisy_geometric_labels(s);
+  const auto boxes = person_boxes(s);
+  ASSERT_EQ(boxes.size(), 1u);
+  const auto r = refine_subboxes(s.keypoints, geo.data(), boxes, SubBoxOptions<T>{});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_FALSE(r.votes[0].whole_box);
+  // Top row dynamic, bottom two rows static (003 Figure 8: a seated person moving the upper body).
+  for (int c = 0; c < 9; ++c) EXPECT_EQ(r.cells[static_cast<std::size_t>(c)], c < 3 ? 1 : 0) << "cell " << c;
+  std::size_t legs = 0, legs_static = 0, upper = 0, upper_dyn = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] == SceneKind::SittingLower) {
+      ++legs;
+      legs_static += r.labels[i] == FeatureLabel::Static;
+    } else if (s.kind[i] == SceneKind::SittingUpper) {
+      ++upper;
+      upper_dyn += r.labels[i] == FeatureLabel::Dynamic;
+    }
+  }
+  ASSERT_GT(legs, 50u);
+  ASSERT_GT(upper, 20u);
+  // The top cell row reaches 5 % of the person height below the moving part: those leg features are
+  // culled with it, the rest (>= 90 %) must survive; every upper-body feature lies in the top row.
+  EXPECT_GE(double(legs_static), 0.9 * double(legs)) << legs_static << " of " << legs;
+  EXPECT_EQ(upper_dyn, upper);
+  EXPECT_GT(r.num_rescued, 0u);  // false epipolar flags on the legs were undone
+}
+
+TYPED_TEST(SubBoxTest, PaperMergeRuleCullsTheWholeSittingPerson) {
+  // Documents why merge_ratio defaults to 0.2: merging every static neighbour (the paper's literal
+  // rule) turns the middle row dynamic, 6 > sigma2 = 4 cells, and the whole person is culled.
+  using T = TypeParam;
+  SceneConfig config;
+  config.walking = false;
+  config.num_per_object = 200;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto geo = noisy_geometric_labels(s);
+  SubBoxOptions<T> paper;
+  paper.merge_ratio = T(0);
+  const auto r = refine_subboxes(s.keypoints, geo.data(), person_boxes(s), paper);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r.votes[0].whole_box);
+  EXPECT_EQ(r.votes[0].num_merged_cells, 3);
+}
+
+TYPED_TEST(SubBoxTest, WalkingPersonBecomesAWholeDynamicBox) {
+  using T = TypeParam;
+  SceneConfig config;
+  config.sitting = false;
+  config.tv = false;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto geo = noisy_geometric_labels(s);
+  const auto r = refine_subboxes(s.keypoints, geo.data(), person_boxes(s), SubBoxOptions<T>{});
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r.votes[0].whole_box);
+  EXPECT_EQ(r.num_whole_boxes, 1u);
+  std::size_t person = 0, person_dyn = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.kind[i] == SceneKind::WalkingPerson) {
+      ++person;
+      person_dyn += r.labels[i] == FeatureLabel::Dynamic;
+    }
+  EXPECT_EQ(person_dyn, person);  // the 15 % missed by geometry are recovered
+  EXPECT_GT(r.num_added, 0u);
+  // Outside boxes the geometric label stands (chair and the 8 % false flags on the room).
+  SubBoxOptions<T> only_boxes;
+  only_boxes.keep_geometric_outside_boxes = false;
+  const auto q = refine_subboxes(s.keypoints, geo.data(), person_boxes(s), only_boxes);
+  EXPECT_LT(q.num_dynamic, r.num_dynamic);
+}
+
+TYPED_TEST(SubBoxTest, EmptyAndInvalidBoxesAndObjectMask) {
+  using T = TypeParam;
+  const std::vector<Vec2<T>> pts{Vec2<T>(3, 3), Vec2<T>(5, 4), Vec2<T>(300, 300), Vec2<T>(305, 302),
+                                 Vec2<T>(Constants<T>::nan(), T(1))};
+  const std::vector<FeatureLabel> geo{FeatureLabel::Dynamic, FeatureLabel::Dynamic, FeatureLabel::Dynamic,
+                                      FeatureLabel::Static, FeatureLabel::Static};
+  std::vector<Box<T>> boxes{Box<T>{T(100), T(100), T(200), T(200)},                 // empty: no features
+                            Box<T>{T(0), T(0), T(29), T(29)},                       // both in cell 0
+                            Box<T>{Constants<T>::nan(), T(0), T(1), T(1)}};          // invalid
+  const auto r = refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<T>{});
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.num_invalid_boxes, 1u);
+  EXPECT_FALSE(r.reason.empty());
+  EXPECT_EQ(r.votes[0].num_dynamic_cells, 0);  // no evidence and no dynamic neighbour: static
+  // Box 1: cell 0 dynamic; its 4-neighbours 1 and 3 are empty and merged; 3 <= sigma2.
+  EXPECT_EQ(r.votes[1].num_dynamic_cells, 3);
+  EXPECT_EQ(r.votes[1].num_merged_cells, 2);
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(r.reasons[0], CullReason::SubBox);
+  EXPECT_EQ(r.labels[2], FeatureLabel::Dynamic);  // outside boxes: geometric label kept
+  EXPECT_EQ(r.reasons[2], CullReason::Epipolar);
+  EXPECT_EQ(r.labels[3], FeatureLabel::Static);
+  EXPECT_EQ(r.labels[4], FeatureLabel::Dynamic);  // non-finite: never trusted
+  // 8-neighbour merging also takes the diagonal cell 4.
+  SubBoxOptions<T> eight;
+  eight.merge_8_neighbours = true;
+  EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, eight).votes[1].num_dynamic_cells, 4);
+  // Object-mask flags: a feature in a dynamic cell but outside the object mask stays static.
+  const std::vector<std::uint8_t> in_mask{0, 1, 1, 1, 1};
+  const auto m = refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<T>{}, in_mask.data());
+  EXPECT_EQ(m.labels[0], FeatureLabel::Static);
+  EXPECT_EQ(m.labels[1], FeatureLabel::Dynamic);
+  // Invalid options.
+  SubBoxOptions<T> bad;
+  bad.grid = 0;
+  EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, bad).status, Status::InvalidInput);
+}
+
+TYPED_TEST(SubBoxTest, RasterMaskIsObjectMaskInDynamicCellsDilated) {
+  using T = TypeParam;
+  const int W = 120, H = 90;
+  // Two dynamic features in cell 0, static evidence in its 4-neighbours 1 and 3 and in cell 8.
+  const std::vector<Vec2<T>> pts{Vec2<T>(35, 35), Vec2<T>(36, 36), Vec2<T>(55, 35), Vec2<T>(56, 36),
+                                 Vec2<T>(35, 55), Vec2<T>(36, 56), Vec2<T>(85, 75), Vec2<T>(86, 76)};
+  const std::vector<FeatureLabel> geo{FeatureLabel::Dynamic, FeatureLabel::Dynamic, FeatureLabel::Static,
+                                      FeatureLabel::Static,  FeatureLabel::Static,  FeatureLabel::Static,
+                                      FeatureLabel::Static,  FeatureLabel::Static};
+  const std::vector<Box<T>> boxes{Box<T>{T(30), T(30), T(89.999), T(89)}};  // 3x3 cells of 20 px
+  SubBoxOptions<T> opt;
+  opt.merge_ratio = T(2);  // static neighbours with evidence are never merged: one dynamic cell
+  opt.dilation_radius_px = 3;
+  const auto r = refine_subboxes(pts, geo.data(), boxes, opt);
+  ASSERT_EQ(r.votes[0].num_dynamic_cells, 1);
+  Mask out(W, H);
+  std::vector<std::uint16_t> scratch;
+  // Whole cell: pixels 30..49 x 30..49 (20 x 20), dilated by 3 -> 26 x 26.
+  EXPECT_EQ(subbox_mask(r, boxes, opt, ConstMaskView{}, out.view(), &scratch), 26u * 26u);
+  EXPECT_TRUE(out.test(27, 27));
+  EXPECT_FALSE(out.test(26, 27));
+  EXPECT_FALSE(out.test(53, 40));
+  // Object mask: one pixel inside the cell -> a 7 x 7 square; pixels outside dynamic cells are dropped.
+  Mask object(W, H);
+  object.pixels[static_cast<std::size_t>(40 * W + 40)] = 1;
+  object.pixels[static_cast<std::size_t>(80 * W + 80)] = 1;
+  EXPECT_EQ(subbox_mask(r, boxes, opt, object.view(), out.view(), &scratch), 49u);
+}
+
+TEST(SubBoxDilation, MatchesBruteForce) {
+  const int W = 64, H = 48, R = 4;
+  Random rng(5);
+  Mask m(W, H);
+  for (auto& p : m.pixels) p = rng.uniform() < 0.01 ? 1 : 0;
+  Mask ref(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      bool any = false;
+      for (int dy = -R; dy <= R; ++dy)
+        for (int dx = -R; dx <= R; ++dx) any = any || m.test(x + dx, y + dy);
+      ref.pixels[static_cast<std::size_t>(y * W + x)] = any ? 255 : 0;
+    }
+  std::vector<std::uint16_t> scratch;
+  dilate_square(m.view(), PixelRect{0, 0, W, H}, R, &scratch);
+  EXPECT_EQ(m.pixels, ref.pixels);
+}
+
+}  // namespace
+}  // namespace dyncull
