@@ -1,0 +1,172 @@
+/// @file box_tracker.hpp
+/// Missed-detection compensation (Dynamic-VINS compensateMissedDetection): a box the detector
+/// misses is carried forward by its averaged centre velocity, grown by 10 px, and dropped after 2
+/// frames without a detection. All state lives in the BoxTracker object the caller owns.
+///
+/// API:
+///   BoxTracker<float> tracker(BoxTrackerOptions<float>{});
+///   BoxTrackerResult<float> r = tracker.update(detections, width, height);  // once per frame
+///   r.boxes: this frame's detections followed by the carried-forward boxes (r.carried[i] = 1).
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+
+template <class T>
+struct BoxTrackerOptions {
+  /// A detection continues a track when its IoU with the track's predicted box reaches this.
+  T min_iou = T(0.3);
+  /// Growth of a carried box per missed frame, on every side (Dynamic-VINS: 10 px).
+  T grow_px_per_frame = T(10);
+  /// A track is dropped after more than this many consecutive frames without a detection.
+  int max_missed_frames = 2;
+  /// Velocity average: v = (1 - a) v_old + a v_new (a = 1: last displacement only).
+  T velocity_smoothing = T(0.5);
+  /// Only detections of the track's class continue it.
+  bool same_class_only = true;
+};
+
+template <class T>
+struct TrackedBox {
+  std::int64_t id = -1;
+  Detection<T> detection;   ///< last detected box (or last prediction while missed)
+  Vec2<T> velocity = Vec2<T>::Zero();  ///< centre pixels per frame
+  Vec2<T> last_centre = Vec2<T>::Zero();  ///< centre of the last detected (not predicted) box
+  int missed = 0;           ///< consecutive frames without a detection
+  int hits = 0;             ///< frames with a detection
+};
+
+template <class T>
+struct BoxTrackerResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::vector<Detection<T>> boxes;      ///< detections (input order), then carried boxes
+  std::vector<std::uint8_t> carried;    ///< 1 for boxes carried forward (CullReason::TrackedBox)
+  std::vector<std::int64_t> track_id;   ///< track of each box
+  std::size_t num_matched = 0, num_new = 0, num_carried = 0, num_dropped = 0;
+};
+
+template <class T>
+class BoxTracker {
+ public:
+  explicit BoxTracker(const BoxTrackerOptions<T>& options = {}) : options_(options) {}
+
+  /// Feeds one frame's detections (already filtered, pixel boxes). Invalid boxes are ignored
+  /// (counted in `reason`); a bad image size fails with InvalidInput and leaves the state as is.
+  BoxTrackerResult<T> update(const std::vector<Detection<T>>& detections, int width, int height) {
+    BoxTrackerResult<T> r;
+    if (width <= 0 || height <= 0) {
+      r.status = Status::InvalidInput;
+      r.reason = "image size must be positive";
+      return r;
+    }
+    // Predicted boxes of the existing tracks.
+    std::vector<Box<T>> predicted(tracks_.size());
+    for (std::size_t t = 0; t < tracks_.size(); ++t) {
+      const Box<T>& b = tracks_[t].detection.box;
+      const Vec2<T>& v = tracks_[t].velocity;
+      predicted[t] = Box<T>{b.x0 + v.x(), b.y0 + v.y(), b.x1 + v.x(), b.y1 + v.y()};
+    }
+    // Greedy association by IoU, best pairs first (a handful of boxes: O(n^2 log n) is nothing).
+    struct Pair {
+      T iou;
+      std::size_t det, track;
+    };
+    std::vector<Pair> pairs;
+    std::size_t invalid = 0;
+    for (std::size_t d = 0; d < detections.size(); ++d) {
+      if (!detections[d].box.valid()) {
+        ++invalid;
+        continue;
+      }
+      for (std::size_t t = 0; t < tracks_.size(); ++t) {
+        if (options_.same_class_only && detections[d].class_id != tracks_[t].detection.class_id) continue;
+        const T o = iou(detections[d].box, predicted[t]);
+        if (o >= options_.min_iou) pairs.push_back(Pair{o, d, t});
+      }
+    }
+    std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+      return a.iou > b.iou || (a.iou == b.iou && (a.det < b.det || (a.det == b.det && a.track < b.track)));
+    });
+    std::vector<std::int64_t> det_track(detections.size(), -1);
+    std::vector<std::uint8_t> track_used(tracks_.size(), 0);
+    for (const Pair& p : pairs) {
+      if (det_track[p.det] >= 0 || track_used[p.track]) continue;
+      det_track[p.det] = static_cast<std::int64_t>(p.track);
+      track_used[p.track] = 1;
+    }
+
+    std::vector<TrackedBox<T>> next;
+    next.reserve(tracks_.size() + detections.size());
+    for (std::size_t d = 0; d < detections.size(); ++d) {
+      if (!detections[d].box.valid()) continue;
+      TrackedBox<T> tb;
+      if (det_track[d] >= 0) {
+        const TrackedBox<T>& old = tracks_[static_cast<std::size_t>(det_track[d])];
+        // Velocity from the last real detection, spread over the frames it was missed.
+        const Vec2<T> shift = (detections[d].box.centre() - old.last_centre) / T(old.missed + 1);
+        tb = old;
+        tb.velocity = (T(1) - options_.velocity_smoothing) * old.velocity + options_.velocity_smoothing * shift;
+        ++tb.hits;
+        ++r.num_matched;
+      } else {
+        tb.id = next_id_++;
+        tb.hits = 1;
+        ++r.num_new;
+      }
+      tb.detection = detections[d];
+      tb.last_centre = detections[d].box.centre();
+      tb.missed = 0;
+      r.boxes.push_back(detections[d]);
+      r.carried.push_back(0);
+      r.track_id.push_back(tb.id);
+      next.push_back(tb);
+    }
+    for (std::size_t t = 0; t < tracks_.size(); ++t) {
+      if (track_used[t]) continue;
+      TrackedBox<T> tb = tracks_[t];
+      ++tb.missed;
+      const Box<T> moved = predicted[t].padded(options_.grow_px_per_frame);
+      const bool outside = moved.x1 < T(0) || moved.y1 < T(0) || moved.x0 > T(width - 1) || moved.y0 > T(height - 1);
+      if (tb.missed > options_.max_missed_frames || outside || !moved.valid()) {
+        ++r.num_dropped;
+        continue;
+      }
+      // The unclipped box is kept for the next prediction; the output is clipped to the image.
+      tb.detection.box = moved;
+      Detection<T> out = tb.detection;
+      out.box = moved.clipped(width, height);
+      r.boxes.push_back(out);
+      r.carried.push_back(1);
+      r.track_id.push_back(tb.id);
+      ++r.num_carried;
+      next.push_back(tb);
+    }
+    tracks_.swap(next);
+    if (invalid) r.reason = std::to_string(invalid) + " invalid detection(s) ignored";
+    return r;
+  }
+
+  const std::vector<TrackedBox<T>>& tracks() const { return tracks_; }
+  void reset() {
+    tracks_.clear();
+    next_id_ = 0;
+  }
+
+ private:
+  BoxTrackerOptions<T> options_;
+  std::vector<TrackedBox<T>> tracks_;
+  std::int64_t next_id_ = 0;
+};
+
+}  // namespace dyncull

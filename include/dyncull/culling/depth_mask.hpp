@@ -1,0 +1,500 @@
+/// @file depth_mask.hpp
+/// Depth-threshold object mask inside a detection box (000 §3.3, eq. 1-2): d_max = max of the four
+/// corner depths, d_c = centre depth; if d_max - d_c > eps the mask is the box pixels with valid depth
+/// below d_c + eps. Plain rule exactly as published, plus a robust variant (patch statistics,
+/// histogram fallback, missing depth) and the Dynamic-VINS threshold form.
+///
+/// API (for the pipeline):
+///   DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>&, const Box<T>&, const DepthMaskOptions&, MaskView out = {});
+///   DepthMaskResult depth_mask(const DepthView<Raw>&, const Boxes& boxes /* Box<T> or Detection<T> */,
+///                              const Points& points, const DepthMaskOptions&, MaskView out = {});
+///   -> per-box info (thresholds, outcome, pixel counts) + per-point labels / reasons / box index.
+/// `out` (optional, same size as the depth image) is OR-ed with `mask_value` where the mask is set;
+/// the caller clears it once per frame. Point labels never need the raster.
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/depth.hpp"
+#include "dyncull/core/mask.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/culling/labels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace dyncull {
+
+/// Plain: 000 eq. 1-2 on single pixels (corner and integer centre pixels, raw units, strict
+/// inequalities); when the rule does not apply the mask is empty and features in the box are
+/// Candidates. Robust: patch estimates, missing-depth pixels masked, histogram fallback.
+enum class DepthMaskMode : std::uint8_t { Plain = 0, Robust = 1 };
+
+/// Seed000: threshold d_c + eps iff d_max - d_c > eps. DynamicVins (HITSZ-NRSL/Dynamic-VINS
+/// setSemanticMask): both valid: midpoint (d_c + d_max)/2 if d_max - d_c > eps, else d_c + eps;
+/// only the corner valid: d_max; neither valid: whole box.
+enum class DepthThresholdForm : std::uint8_t { Seed000 = 0, DynamicVins = 1 };
+
+/// What produced a box's mask.
+enum class DepthMaskOutcome : std::uint8_t {
+  RuleApplied = 0,    ///< threshold from the d_c / d_max rule
+  HistogramFallback,  ///< rule did not apply: foreground cluster of the box's depth histogram
+  WholeBox,           ///< too little depth to decide: every box pixel is masked (robust / Dynamic-VINS)
+  NotApplied,         ///< plain rule did not apply: empty mask, features are Candidates
+  EmptyBox,           ///< box invalid or outside the image
+};
+
+constexpr const char* to_string(DepthMaskOutcome o) noexcept {
+  switch (o) {
+    case DepthMaskOutcome::RuleApplied: return "rule applied";
+    case DepthMaskOutcome::HistogramFallback: return "histogram fallback";
+    case DepthMaskOutcome::WholeBox: return "whole box";
+    case DepthMaskOutcome::NotApplied: return "rule not applicable";
+    case DepthMaskOutcome::EmptyBox: return "empty box";
+  }
+  return "unknown";
+}
+
+struct DepthMaskOptions {
+  DepthMaskMode mode = DepthMaskMode::Robust;
+  DepthThresholdForm form = DepthThresholdForm::Seed000;
+  /// eps of 000 eq. 2 in metres (paper: empirical, 0.3-0.5 m indoors; 0.3 m fits TUM best).
+  double eps_m = 0.3;
+  /// eps of the Dynamic-VINS form (their 1000 mm).
+  double dynamic_vins_eps_m = 1.0;
+
+  // ---- robust mode ----
+  /// d_c = lower median of the valid depths in a (2r+1)^2 window at the centre (Kinect holes).
+  int centre_patch_radius_px = 2;
+  /// A corner without depth is replaced by the first valid depth walking diagonally inwards, at
+  /// most this many steps (< 0: half the box's shorter side). Covers the band without depth
+  /// along the image border.
+  int corner_search_px = -1;
+  /// Mask box pixels without a depth measurement too: inside a dynamic object's box an unknown
+  /// pixel cannot be trusted, and Kinect holes cluster at object boundaries.
+  bool mask_missing_depth = true;
+  /// Histogram fallback (rule not applicable): bins of this width from 0 to histogram_max_m.
+  double histogram_bin_m = 0.1;
+  double histogram_max_m = 12.0;
+  /// A bin is occupied when it holds at least this fraction of the box's valid pixels.
+  double histogram_occupied_fraction = 0.002;
+  /// The foreground cluster ends after this many consecutive unoccupied bins.
+  int histogram_max_gap_bins = 1;
+  /// ... and never reaches further than this behind d_c (depth extent of one object).
+  double max_object_depth_extent_m = 1.5;
+  /// Below this fraction of box pixels with depth the whole box is masked.
+  double min_valid_fraction = 0.05;
+
+  std::uint8_t mask_value = 255;
+};
+
+/// Per-box outcome. Depths in metres (0 = no measurement); threshold_m is exclusive.
+struct DepthMaskBoxInfo {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  PixelRect rect;  ///< the box's pixels (inclusive box -> [c0, c1) x [r0, r1))
+  DepthMaskOutcome outcome = DepthMaskOutcome::EmptyBox;
+  bool rule_applies = false;
+  double d_max_m = 0, d_c_m = 0, threshold_m = 0;
+  double threshold_raw = 0;   ///< exclusive threshold in the view's raw units (TUM: 13085 for 2.617 m)
+  bool masks_missing = false; ///< pixels without depth are part of this box's mask
+  std::size_t num_mask_pixels = 0;  ///< counted only when a raster was written
+  std::size_t num_valid_pixels = 0; ///< counted only in the histogram fallback
+};
+
+struct DepthMaskResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::vector<DepthMaskBoxInfo> boxes;
+  std::vector<FeatureLabel> labels;   ///< Dynamic in a mask, Candidate in a NotApplied box, else Static
+  std::vector<CullReason> reasons;
+  std::vector<std::int32_t> box_index;///< first box whose mask (or NotApplied box) holds the point, -1
+  std::size_t num_static = 0, num_candidate = 0, num_dynamic = 0;
+  std::size_t num_in_boxes = 0;       ///< points inside any box
+  std::size_t num_mask_pixels = 0;
+};
+
+namespace detail {
+
+/// Pixel predicate of one box in raw units: in = lo <= d < hi (valid range already folded in);
+/// missing pixels are in when `missing`; `all` masks the whole rect.
+struct DepthBand {
+  double lo = 1, hi = 0;
+  bool missing = false;
+  bool all = false;
+  bool none = true;
+};
+
+template <class Raw>
+struct RawRange {
+  double lo = 0, hi = 0;  ///< valid raw values: lo <= r <= hi
+};
+
+/// Valid raw range of a view, exact for integer raw (checked against DepthView::to_metres).
+template <class Raw>
+RawRange<Raw> valid_raw_range(const DepthView<Raw>& v) {
+  RawRange<Raw> r;
+  const double upm = static_cast<double>(v.units_per_metre);
+  if (std::is_integral<Raw>::value) {
+    const double top = static_cast<double>(std::numeric_limits<Raw>::max());
+    double lo = std::max(1.0, std::ceil(static_cast<double>(v.min_m) * upm));
+    double hi = std::min(top, std::floor(static_cast<double>(v.max_m) * upm));
+    // Float rounding in to_metres: nudge the integer bounds until they agree with it.
+    while (lo > 1 && v.to_metres(static_cast<Raw>(lo - 1)) > 0.f) lo -= 1;
+    while (lo <= hi && v.to_metres(static_cast<Raw>(lo)) <= 0.f) lo += 1;
+    while (hi < top && v.to_metres(static_cast<Raw>(hi + 1)) > 0.f) hi += 1;
+    while (hi >= lo && v.to_metres(static_cast<Raw>(hi)) <= 0.f) hi -= 1;
+    r.lo = lo;
+    r.hi = hi;
+  } else {
+    r.lo = std::max(static_cast<double>(v.min_m) * upm, std::numeric_limits<double>::min());
+    r.hi = static_cast<double>(v.max_m) * upm;
+  }
+  return r;
+}
+
+template <class Raw>
+bool raw_valid(Raw d, const RawRange<Raw>& range) {
+  const double x = static_cast<double>(d);
+  return x >= range.lo && x <= range.hi;  // NaN fails both
+}
+
+/// Lower median of the valid raw values in a (2r+1)^2 window (0 if none).
+template <class Raw>
+double patch_lower_median(const DepthView<Raw>& v, const RawRange<Raw>& range, int cu, int cv, int radius,
+                          const PixelRect& rect) {
+  radius = std::clamp(radius, 0, 7);
+  double buf[225];
+  int n = 0;
+  for (int y = std::max(cv - radius, rect.r0); y <= std::min(cv + radius, rect.r1 - 1); ++y)
+    for (int x = std::max(cu - radius, rect.c0); x <= std::min(cu + radius, rect.c1 - 1); ++x) {
+      const Raw d = v.raw(x, y);
+      if (raw_valid(d, range)) buf[n++] = static_cast<double>(d);
+    }
+  if (n == 0) return 0;
+  std::nth_element(buf, buf + (n - 1) / 2, buf + n);
+  return buf[(n - 1) / 2];
+}
+
+/// First valid raw depth walking from (u, v) by (du, dv) for at most `steps` steps (0 if none).
+template <class Raw>
+double walk_inwards(const DepthView<Raw>& v, const RawRange<Raw>& range, int u, int y, int du, int dv, int steps,
+                    const PixelRect& rect) {
+  for (int s = 0; s <= steps; ++s, u += du, y += dv) {
+    if (u < rect.c0 || u >= rect.c1 || y < rect.r0 || y >= rect.r1) break;
+    const Raw d = v.raw(u, y);
+    if (raw_valid(d, range)) return static_cast<double>(d);
+  }
+  return 0;
+}
+
+/// One pass over the rect: OR mask_value where the band holds; returns the number of set pixels.
+template <class Raw>
+std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rect,
+                           const DepthBand& band, std::uint8_t value, MaskView out) {
+  std::size_t count = 0;
+  const int c0 = rect.c0, c1 = rect.c1, r0 = rect.r0, r1 = rect.r1;
+  if (band.all || band.none) {
+    if (band.none) return 0;
+    for (int y = r0; y < r1; ++y) {
+      std::uint8_t* o = out.row(y);
+      for (int x = c0; x < c1; ++x) o[x] = static_cast<std::uint8_t>(o[x] | value);
+    }
+    return static_cast<std::size_t>(rect.area());
+  }
+  if constexpr (std::is_same<Raw, std::uint16_t>::value) {
+    // Single unsigned compares: d in [lo, hi) <=> (uint16)(d - lo) < hi - lo.
+    const auto lo = static_cast<std::uint16_t>(band.lo);
+    const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));
+    const auto vlo = static_cast<std::uint16_t>(range.lo);
+    const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);
+    const std::uint8_t miss_value = band.missing ? value : std::uint8_t(0);
+    for (int y = r0; y < r1; ++y) {
+      const std::uint16_t* d = v.row(y);
+      std::uint8_t* o = out.row(y);
+      unsigned row_count = 0;
+      for (int x = c0; x < c1; ++x) {
+        const bool in = static_cast<std::uint16_t>(d[x] - lo) < span;
+        const bool miss = static_cast<std::uint16_t>(d[x] - vlo) > vspan;
+        const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (miss ? miss_value : 0));
+        o[x] = static_cast<std::uint8_t>(o[x] | m);
+        row_count += m != 0;
+      }
+      count += row_count;
+    }
+  } else {
+    const Raw lo = static_cast<Raw>(band.lo), hi = static_cast<Raw>(band.hi);
+    const Raw vlo = static_cast<Raw>(range.lo), vhi = static_cast<Raw>(range.hi);
+    const std::uint8_t miss_value = band.missing ? value : std::uint8_t(0);
+    for (int y = r0; y < r1; ++y) {
+      const Raw* d = v.row(y);
+      std::uint8_t* o = out.row(y);
+      unsigned row_count = 0;
+      for (int x = c0; x < c1; ++x) {
+        const bool in = (unsigned(d[x] >= lo) & unsigned(d[x] < hi)) != 0;
+        const bool valid = (unsigned(d[x] >= vlo) & unsigned(d[x] <= vhi)) != 0;  // NaN: invalid
+        const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (valid ? 0 : miss_value));
+        o[x] = static_cast<std::uint8_t>(o[x] | m);
+        row_count += m != 0;
+      }
+      count += row_count;
+    }
+  }
+  return count;
+}
+
+template <class Raw>
+bool band_contains(const DepthView<Raw>& v, const RawRange<Raw>& range, const DepthBand& band, int u, int y) {
+  if (band.none) return false;
+  if (band.all) return true;
+  const Raw d = v.raw(u, y);
+  if (!raw_valid(d, range)) return band.missing;
+  const double x = static_cast<double>(d);
+  return x >= band.lo && x < band.hi;
+}
+
+/// Threshold and band of one box (no raster). Returns the info; `band` receives the predicate.
+template <class Raw, class T>
+DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>& box,
+                          const DepthMaskOptions& o, DepthBand* band) {
+  DepthMaskBoxInfo info;
+  *band = DepthBand{};
+  if (!box.valid()) {
+    info.status = Status::InvalidInput;
+    info.reason = "box is non-finite or inverted";
+    return info;
+  }
+  info.rect = pixel_rect(box, v.width, v.height);
+  if (info.rect.empty()) {
+    info.status = Status::Skipped;
+    info.reason = "box has no pixel inside the image";
+    return info;
+  }
+  const PixelRect& rc = info.rect;
+  const double upm = static_cast<double>(v.units_per_metre);
+  const int x0 = rc.c0, y0 = rc.r0, x1 = rc.c1 - 1, y1 = rc.r1 - 1;
+  const int cu = (x0 + x1) / 2, cv = (y0 + y1) / 2;  // integer centre, as 000's reference code
+  const bool robust = o.mode == DepthMaskMode::Robust;
+
+  double corner[4], dc;
+  if (robust) {
+    const int steps = o.corner_search_px >= 0 ? o.corner_search_px : std::min(rc.width(), rc.height()) / 2;
+    corner[0] = walk_inwards(v, range, x0, y0, 1, 1, steps, rc);
+    corner[1] = walk_inwards(v, range, x1, y0, -1, 1, steps, rc);
+    corner[2] = walk_inwards(v, range, x0, y1, 1, -1, steps, rc);
+    corner[3] = walk_inwards(v, range, x1, y1, -1, -1, steps, rc);
+    dc = patch_lower_median(v, range, cu, cv, o.centre_patch_radius_px, rc);
+  } else {
+    const int cx[4] = {x0, x1, x0, x1}, cy[4] = {y0, y0, y1, y1};
+    for (int k = 0; k < 4; ++k) {
+      const Raw d = v.raw(cx[k], cy[k]);
+      corner[k] = raw_valid(d, range) ? static_cast<double>(d) : 0.0;  // "0 counts as 0"
+    }
+    const Raw d = v.raw(cu, cv);
+    dc = raw_valid(d, range) ? static_cast<double>(d) : 0.0;
+  }
+  const double dmax = std::max(std::max(corner[0], corner[1]), std::max(corner[2], corner[3]));
+  info.d_max_m = dmax / upm;
+  info.d_c_m = dc / upm;
+  const bool integral = std::is_integral<Raw>::value;
+  auto eps_raw = [&](double eps_m) { return integral ? std::round(eps_m * upm) : eps_m * upm; };
+  band->missing = robust && o.mask_missing_depth;
+  band->lo = range.lo;
+
+  auto set_threshold = [&](double thr_raw, DepthMaskOutcome outcome) {
+    info.outcome = outcome;
+    info.threshold_raw = thr_raw;
+    info.threshold_m = thr_raw / upm;
+    band->none = false;
+    band->hi = std::min(thr_raw, range.hi + (integral ? 1.0 : 0.0));
+    if (!integral && thr_raw > range.hi) band->hi = std::nextafter(range.hi, std::numeric_limits<double>::max());
+    if (integral) band->hi = std::ceil(band->hi);
+  };
+  auto whole_box = [&]() {
+    info.outcome = DepthMaskOutcome::WholeBox;
+    band->none = false;
+    band->all = true;
+  };
+
+  if (o.form == DepthThresholdForm::DynamicVins) {
+    const double e = eps_raw(o.dynamic_vins_eps_m);
+    info.rule_applies = true;
+    if (dc > 0 && dmax > 0) set_threshold(dmax - dc > e ? (dmax + dc) / 2 : dc + e, DepthMaskOutcome::RuleApplied);
+    else if (dmax > 0) set_threshold(dmax, DepthMaskOutcome::RuleApplied);
+    else if (dc > 0) set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
+    else whole_box();
+    info.masks_missing = band->missing || band->all;
+    return info;
+  }
+
+  const double e = eps_raw(o.eps_m);
+  info.rule_applies = dc > 0 && dmax - dc > e;
+  if (info.rule_applies) {
+    set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
+  } else if (!robust) {
+    info.outcome = DepthMaskOutcome::NotApplied;
+    info.reason = "rule does not apply (d_max - d_c <= eps)";
+  } else {
+    // Histogram fallback: the foreground cluster that holds d_c (or the nearest big cluster).
+    const double bin_raw = std::max(o.histogram_bin_m, 1e-3) * upm;
+    const int nb = std::max(1, static_cast<int>(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3))));
+    std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb), 0u);
+    std::size_t valid = 0;
+    const double inv_bin = 1.0 / bin_raw;
+    for (int y = rc.r0; y < rc.r1; ++y) {
+      const Raw* d = v.row(y);
+      for (int x = rc.c0; x < rc.c1; ++x) {
+        if (!raw_valid(d[x], range)) continue;
+        const int b = std::min(nb - 1, static_cast<int>(static_cast<double>(d[x]) * inv_bin));
+        ++hist[static_cast<std::size_t>(b)];
+        ++valid;
+      }
+    }
+    info.num_valid_pixels = valid;
+    if (static_cast<double>(valid) < o.min_valid_fraction * static_cast<double>(rc.area()) || valid == 0) {
+      whole_box();
+      info.reason = "too few pixels with depth: whole box";
+    } else {
+      const auto occupied = static_cast<std::uint32_t>(
+          std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));
+      int start = -1;
+      if (dc > 0) {
+        start = std::min(nb - 1, static_cast<int>(dc * inv_bin));
+      } else {
+        // No centre depth: the nearest bin holding 5 % of the valid pixels seeds the cluster.
+        const auto seed = static_cast<std::uint32_t>(std::max(1.0, 0.05 * static_cast<double>(valid)));
+        for (int b = 0; b < nb && start < 0; ++b)
+          if (hist[static_cast<std::size_t>(b)] >= seed) start = b;
+        if (start < 0) start = 0;
+      }
+      const double seed_raw = dc > 0 ? dc : (start + 0.5) * bin_raw;
+      const int last_allowed =
+          std::min(nb - 1, static_cast<int>((seed_raw + o.max_object_depth_extent_m * upm) * inv_bin));
+      int end = start, gap = 0;
+      for (int b = start + 1; b <= last_allowed; ++b) {
+        if (hist[static_cast<std::size_t>(b)] >= occupied) {
+          end = b;
+          gap = 0;
+        } else if (++gap > o.histogram_max_gap_bins) {
+          break;
+        }
+      }
+      set_threshold((end + 1) * bin_raw, DepthMaskOutcome::HistogramFallback);
+      if (info.d_c_m == 0) info.d_c_m = seed_raw / upm;
+    }
+  }
+  info.masks_missing = band->missing || band->all;
+  return info;
+}
+
+template <class T> const Box<T>& as_box(const Box<T>& b) { return b; }
+template <class T> const Box<T>& as_box(const Detection<T>& d) { return d.box; }
+
+}  // namespace detail
+
+/// Mask of one box; writes into `out` when it is non-empty and the depth image's size.
+template <class Raw, class T>
+DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, const DepthMaskOptions& options,
+                                MaskView out = {}) {
+  DepthMaskBoxInfo info;
+  if (depth.empty()) {
+    info.status = Status::Skipped;
+    info.reason = "no depth image";
+    return info;
+  }
+  if (!out.empty() && (out.width != depth.width || out.height != depth.height)) {
+    info.status = Status::InvalidInput;
+    info.reason = "mask size differs from the depth image";
+    return info;
+  }
+  const auto range = detail::valid_raw_range(depth);
+  detail::DepthBand band;
+  info = detail::plan_box(depth, range, box, options, &band);
+  if (info.ok() && !out.empty())
+    info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, band, options.mask_value, out);
+  return info;
+}
+
+/// Masks every box and labels every point: Dynamic (DepthMask) when the point's pixel (rounded)
+/// is in a box's mask, Candidate when it lies in a box whose plain rule did not apply, else Static.
+/// Non-finite points are Dynamic (InvalidInput). Bad boxes are reported per box; the call fails
+/// only when the depth image is missing (Skipped) or the mask has the wrong size (InvalidInput).
+template <class Raw, class Boxes, class Points>
+DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& points,
+                           const DepthMaskOptions& options, MaskView out = {}) {
+  static_assert(is_point_container_v<Points>, "depth_mask: points must be a container of points");
+  DepthMaskResult r;
+  const std::size_t n = points.size();
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  r.box_index.assign(n, -1);
+  if (depth.empty()) {
+    r.status = Status::Skipped;
+    r.reason = "no depth image";
+    return r;
+  }
+  if (!out.empty() && (out.width != depth.width || out.height != depth.height)) {
+    r.status = Status::InvalidInput;
+    r.reason = "mask size differs from the depth image";
+    return r;
+  }
+  const auto range = detail::valid_raw_range(depth);
+  std::vector<detail::DepthBand> bands(boxes.size());
+  r.boxes.reserve(boxes.size());
+  std::size_t bad = 0;
+  for (std::size_t b = 0; b < boxes.size(); ++b) {
+    r.boxes.push_back(detail::plan_box(depth, range, detail::as_box(boxes[b]), options, &bands[b]));
+    DepthMaskBoxInfo& info = r.boxes.back();
+    if (!info.ok()) ++bad;
+    else if (!out.empty()) {
+      info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, bands[b], options.mask_value, out);
+      r.num_mask_pixels += info.num_mask_pixels;
+    }
+  }
+  if (bad) r.reason = std::to_string(bad) + " of " + std::to_string(boxes.size()) + " boxes skipped";
+
+  for (std::size_t i = 0; i < n; ++i) {
+    using S = typename PointTraits<container_point_t<Points>>::Scalar;
+    const S px = point_x(points[i]), py = point_y(points[i]);
+    if (!std::isfinite(static_cast<double>(px)) || !std::isfinite(static_cast<double>(py))) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      r.reasons[i] = CullReason::InvalidInput;
+      ++r.num_dynamic;
+      continue;
+    }
+    const long lu = std::lround(static_cast<double>(px)), lv = std::lround(static_cast<double>(py));
+    bool inside_any = false;
+    for (std::size_t b = 0; b < r.boxes.size(); ++b) {
+      const DepthMaskBoxInfo& info = r.boxes[b];
+      if (!info.ok() || lu < info.rect.c0 || lu >= info.rect.c1 || lv < info.rect.r0 || lv >= info.rect.r1) continue;
+      inside_any = true;
+      if (info.outcome == DepthMaskOutcome::NotApplied) {
+        if (r.labels[i] == FeatureLabel::Static) {
+          r.labels[i] = FeatureLabel::Candidate;
+          r.reasons[i] = CullReason::DepthMask;
+          r.box_index[i] = static_cast<std::int32_t>(b);
+        }
+      } else if (detail::band_contains(depth, range, bands[b], static_cast<int>(lu), static_cast<int>(lv))) {
+        r.labels[i] = FeatureLabel::Dynamic;
+        r.reasons[i] = CullReason::DepthMask;
+        r.box_index[i] = static_cast<std::int32_t>(b);
+        break;
+      }
+    }
+    r.num_in_boxes += inside_any;
+    r.num_dynamic += r.labels[i] == FeatureLabel::Dynamic;
+    r.num_candidate += r.labels[i] == FeatureLabel::Candidate;
+  }
+  r.num_static = n - r.num_dynamic - r.num_candidate;
+  return r;
+}
+
+}  // namespace dyncull

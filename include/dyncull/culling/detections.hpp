@@ -1,0 +1,299 @@
+/// @file detections.hpp
+/// Detector output -> pixel boxes: YOLO normalised (cx, cy, w, h) to corners X1 = (x - w/2) W,
+/// X2 = (x + w/2) W, Y1 = (y - h/2) H, Y2 = (y + h/2) H (001 eq. 1-2, 004 eq. 1), undoing a letterbox.
+///
+/// API:
+///   Box<T> yolo_to_pixel_box(const YoloBox<T>&, int width, int height, const Letterbox<T>& = {});
+///   DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>&, int w, int h, const DetectionOptions<T>&);
+///   DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& pixel_boxes, int w, int h, const DetectionOptions<T>&);
+///   YoloParseResult<T> parse_yolo_lines(const std::string& text);   // "class cx cy w h [conf]" per line
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/status.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+
+/// One raw YOLO output: normalised centre and size in [0, 1] of the network input.
+template <class T>
+struct YoloBox {
+  int class_id = -1;
+  T cx = T(0), cy = T(0), w = T(0), h = T(0);
+  T confidence = T(1);
+};
+
+/// How the image was fitted into the network input. With `input_width <= 0` the normalised
+/// coordinates refer to the image itself (plain resize, or labels files). Otherwise they refer to
+/// an input_width x input_height tensor in which the image was scaled by `scale` and offset by
+/// (pad_x, pad_y) pixels (YOLOv5 letterbox: scale = min(in_w / W, in_h / H), pad = half the rest).
+template <class T>
+struct Letterbox {
+  int input_width = 0;
+  int input_height = 0;
+  T scale = T(1);
+  T pad_x = T(0);
+  T pad_y = T(0);
+
+  /// The centred letterbox YOLOv5/v8 use for an image of width x height.
+  static Letterbox centred(int image_width, int image_height, int in_w, int in_h) {
+    Letterbox lb;
+    lb.input_width = in_w;
+    lb.input_height = in_h;
+    if (image_width <= 0 || image_height <= 0) return lb;
+    const T sx = T(in_w) / T(image_width), sy = T(in_h) / T(image_height);
+    lb.scale = sx < sy ? sx : sy;
+    lb.pad_x = (T(in_w) - lb.scale * T(image_width)) / T(2);
+    lb.pad_y = (T(in_h) - lb.scale * T(image_height)) / T(2);
+    return lb;
+  }
+};
+
+/// Why a detection was dropped.
+enum class BoxRejection : std::uint8_t { None = 0, NonFinite, NonPositiveSize, OutsideImage, LowConfidence, BadClass };
+
+constexpr const char* to_string(BoxRejection r) noexcept {
+  switch (r) {
+    case BoxRejection::None: return "kept";
+    case BoxRejection::NonFinite: return "non-finite coordinates";
+    case BoxRejection::NonPositiveSize: return "width or height <= 0";
+    case BoxRejection::OutsideImage: return "entirely outside the image";
+    case BoxRejection::LowConfidence: return "confidence below the class threshold";
+    case BoxRejection::BadClass: return "negative class id";
+  }
+  return "unknown";
+}
+
+template <class T>
+struct DetectionOptions {
+  /// Grow every kept box by this many pixels on each side before clipping (Crowd-SLAM / CDS-SLAM
+  /// use 5 px: detector boxes are tight and limbs stick out).
+  T box_padding_px = T(5);
+  /// Minimum confidence for classes without their own entry.
+  T min_confidence = T(0.4);
+  /// Person (COCO id 0) threshold: lower, because a missed person costs more than a false one
+  /// (SG-SLAM: 0.1 for person vs 0.985 for other classes).
+  T min_confidence_person = T(0.25);
+  int person_class_id = 0;
+  /// Per-class thresholds indexed by class id; entries < 0 (or ids past the end) use the above.
+  std::vector<T> class_min_confidence;
+  Letterbox<T> letterbox;
+
+  T threshold_for(int class_id) const {
+    if (class_id >= 0 && static_cast<std::size_t>(class_id) < class_min_confidence.size() &&
+        class_min_confidence[static_cast<std::size_t>(class_id)] >= T(0))
+      return class_min_confidence[static_cast<std::size_t>(class_id)];
+    return class_id == person_class_id ? min_confidence_person : min_confidence;
+  }
+};
+
+template <class T>
+struct DetectionsResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::vector<Detection<T>> detections;     ///< kept boxes, padded and clipped to [0, W-1] x [0, H-1]
+  std::vector<int> source_index;            ///< input index of each kept box
+  std::vector<BoxRejection> rejections;     ///< one per input (None = kept)
+  std::size_t num_input = 0, num_kept = 0, num_invalid = 0, num_outside = 0, num_low_confidence = 0;
+};
+
+/// Unclipped pixel corners of a YOLO box (no padding, no validity checks).
+template <class T>
+Box<T> yolo_to_pixel_box(const YoloBox<T>& b, int width, int height, const Letterbox<T>& lb = {}) {
+  const bool boxed = lb.input_width > 0 && lb.input_height > 0 && lb.scale > T(0);
+  const T sx = boxed ? T(lb.input_width) : T(width);
+  const T sy = boxed ? T(lb.input_height) : T(height);
+  Box<T> out{(b.cx - b.w / T(2)) * sx, (b.cy - b.h / T(2)) * sy, (b.cx + b.w / T(2)) * sx, (b.cy + b.h / T(2)) * sy};
+  if (boxed) {
+    out = Box<T>{(out.x0 - lb.pad_x) / lb.scale, (out.y0 - lb.pad_y) / lb.scale, (out.x1 - lb.pad_x) / lb.scale,
+                 (out.y1 - lb.pad_y) / lb.scale};
+  }
+  return out;
+}
+
+namespace detail {
+template <class T>
+BoxRejection check_and_finish_box(Box<T>* box, T confidence, int class_id, int width, int height,
+                                  const DetectionOptions<T>& o) {
+  if (class_id < 0) return BoxRejection::BadClass;
+  if (!box->finite() || !std::isfinite(confidence)) return BoxRejection::NonFinite;
+  if (!(box->x1 > box->x0) || !(box->y1 > box->y0)) return BoxRejection::NonPositiveSize;
+  if (box->x1 < T(0) || box->y1 < T(0) || box->x0 > T(width - 1) || box->y0 > T(height - 1))
+    return BoxRejection::OutsideImage;
+  if (confidence < o.threshold_for(class_id)) return BoxRejection::LowConfidence;
+  const T pad = std::isfinite(o.box_padding_px) ? o.box_padding_px : T(0);
+  *box = box->padded(pad).clipped(width, height);
+  return BoxRejection::None;
+}
+
+template <class T>
+void tally(DetectionsResult<T>* r, BoxRejection why) {
+  r->rejections.push_back(why);
+  if (why == BoxRejection::None) ++r->num_kept;
+  else if (why == BoxRejection::OutsideImage) ++r->num_outside;
+  else if (why == BoxRejection::LowConfidence) ++r->num_low_confidence;
+  else ++r->num_invalid;
+}
+
+template <class T>
+void finish(DetectionsResult<T>* r, int width, int height) {
+  if (width <= 0 || height <= 0) {
+    r->status = Status::InvalidInput;
+    r->reason = "image size must be positive";
+    return;
+  }
+  if (r->num_kept < r->num_input) {
+    r->reason = std::to_string(r->num_input - r->num_kept) + " of " + std::to_string(r->num_input) +
+                " boxes rejected (" + std::to_string(r->num_invalid) + " invalid, " + std::to_string(r->num_outside) +
+                " outside, " + std::to_string(r->num_low_confidence) + " low confidence)";
+  }
+}
+}  // namespace detail
+
+/// Converts, filters, pads and clips YOLO boxes. Rejected boxes do not make the call fail: status
+/// stays Ok and `reason` / `rejections` say what was dropped. InvalidInput only for a bad image size.
+template <class T>
+DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>& boxes, int width, int height,
+                                            const DetectionOptions<T>& options = {}) {
+  DetectionsResult<T> r;
+  r.num_input = boxes.size();
+  if (width <= 0 || height <= 0) {
+    detail::finish(&r, width, height);
+    return r;
+  }
+  r.rejections.reserve(boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const YoloBox<T>& b = boxes[i];
+    Box<T> px = yolo_to_pixel_box(b, width, height, options.letterbox);
+    // w, h are tested on the normalised input too: a NaN/negative size must not survive the letterbox.
+    BoxRejection why = !(std::isfinite(b.cx) && std::isfinite(b.cy) && std::isfinite(b.w) && std::isfinite(b.h))
+                           ? BoxRejection::NonFinite
+                           : (!(b.w > T(0)) || !(b.h > T(0)) ? BoxRejection::NonPositiveSize : BoxRejection::None);
+    if (why == BoxRejection::None) why = detail::check_and_finish_box(&px, b.confidence, b.class_id, width, height, options);
+    detail::tally(&r, why);
+    if (why == BoxRejection::None) {
+      r.detections.push_back(Detection<T>{px, b.class_id, b.confidence});
+      r.source_index.push_back(static_cast<int>(i));
+    }
+  }
+  detail::finish(&r, width, height);
+  return r;
+}
+
+/// Same checks, padding and clipping for boxes already in pixels (e.g. after the detector's own
+/// post-processing).
+template <class T>
+DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, int width, int height,
+                                      const DetectionOptions<T>& options = {}) {
+  DetectionsResult<T> r;
+  r.num_input = boxes.size();
+  if (width <= 0 || height <= 0) {
+    detail::finish(&r, width, height);
+    return r;
+  }
+  r.rejections.reserve(boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    Box<T> px = boxes[i].box;
+    const BoxRejection why =
+        detail::check_and_finish_box(&px, boxes[i].confidence, boxes[i].class_id, width, height, options);
+    detail::tally(&r, why);
+    if (why == BoxRejection::None) {
+      r.detections.push_back(Detection<T>{px, boxes[i].class_id, boxes[i].confidence});
+      r.source_index.push_back(static_cast<int>(i));
+    }
+  }
+  detail::finish(&r, width, height);
+  return r;
+}
+
+/// One unparseable line of a YOLO text file (1-based line number).
+struct YoloParseError {
+  int line = 0;
+  std::string message;
+};
+
+template <class T>
+struct YoloParseResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::vector<YoloBox<T>> boxes;  ///< every line that parsed, in file order
+  std::vector<int> line_of_box;   ///< 1-based line number of each box
+  std::vector<YoloParseError> errors;
+};
+
+/// Parses YOLO text ("class cx cy w h [conf]" per line; blank lines and '#' comments skipped).
+/// Bad lines are skipped and listed; status is ParseError when any line failed (the good boxes
+/// are still returned), with the first failing line in `reason`. Validity of the numbers
+/// (w > 0, finite) is left to convert_yolo_detections, which reports it per box.
+template <class T>
+YoloParseResult<T> parse_yolo_lines(const std::string& text) {
+  YoloParseResult<T> r;
+  std::size_t pos = 0;
+  int line_no = 0;
+  while (pos <= text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(pos, end - pos);
+    ++line_no;
+    pos = end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') {
+      if (end == text.size()) break;
+      continue;
+    }
+    double v[6];
+    int n = 0;
+    const char* p = line.c_str();
+    bool bad = false;
+    while (true) {
+      while (*p == ' ' || *p == '\t') ++p;
+      if (*p == '\0') break;
+      if (n == 6) {
+        bad = true;
+        break;
+      }
+      char* q = nullptr;
+      v[n] = std::strtod(p, &q);
+      if (q == p || (*q != '\0' && *q != ' ' && *q != '\t')) {
+        bad = true;
+        break;
+      }
+      ++n;
+      p = q;
+    }
+    if (bad || n < 5) {
+      r.errors.push_back(YoloParseError{line_no, bad ? "expected numbers: class cx cy w h [conf]"
+                                                     : "expected 5 or 6 fields, got " + std::to_string(n)});
+    } else if (v[0] != std::floor(v[0]) || v[0] < 0 || v[0] > 1e6) {
+      r.errors.push_back(YoloParseError{line_no, "class id must be a non-negative integer"});
+    } else {
+      YoloBox<T> b;
+      b.class_id = static_cast<int>(v[0]);
+      b.cx = T(v[1]);
+      b.cy = T(v[2]);
+      b.w = T(v[3]);
+      b.h = T(v[4]);
+      b.confidence = n == 6 ? T(v[5]) : T(1);
+      r.boxes.push_back(b);
+      r.line_of_box.push_back(line_no);
+    }
+    if (end == text.size()) break;
+  }
+  if (!r.errors.empty()) {
+    r.status = Status::ParseError;
+    r.reason = "line " + std::to_string(r.errors.front().line) + ": " + r.errors.front().message + " (" +
+               std::to_string(r.errors.size()) + " bad line(s))";
+  }
+  return r;
+}
+
+}  // namespace dyncull

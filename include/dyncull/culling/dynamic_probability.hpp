@@ -1,0 +1,288 @@
+/// @file dynamic_probability.hpp
+/// Per-feature dynamic probability (000 §3.4, eq. 3-5, Algorithm 1): P = a1 S + a2 M + a3 K, dynamic
+/// iff P >= threshold. S from the motion level, M from LK flow against the static features' flow
+/// (eq. 4-5, adaptive threshold defined here), K from a caller-owned per-track state store.
+///
+/// API (for the pipeline):
+///   TrackStateStore store;                       // owned by the front end, carried between frames
+///   DynamicProbabilityResult<T> r = dynamic_probability(prev_pts, curr_pts, levels, options,
+///                                                        EgoMotion<T>{}, &store, &track_ids);
+///   levels[i]: MotionLevel of the mask/box holding feature i (Ignore = in no mask: reference set).
+///   r.labels / r.reasons / r.probability / r.moving, r.motion_threshold_px, r.reference_flow.
+#pragma once
+
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/motion_levels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace dyncull {
+
+/// How a feature's flow is compared with the camera's own motion.
+enum class FlowModel : std::uint8_t {
+  MeanFlow = 0,     ///< 000 eq. 4-5: |flow - reference flow| (right for small rotation, shallow scenes)
+  Fundamental = 1,  ///< ego-motion compensated: distance of p_curr to the epipolar line F p_prev (003 eq. 3)
+  Homography = 2,   ///< ego-motion compensated for pure rotation / planar scenes: |p_curr - H p_prev|
+};
+
+/// Where K of eq. 3 comes from. Algorithm 1 step 9 re-runs "steps 5-8" (the flow test) on the
+/// matched feature of the last frame, so K = that feature's previous M (default): not self-
+/// sustaining. The text's reading (K = last frame's final decision) is offered; with it a person
+/// that was dynamic once stays dynamic whenever a1 + a3 >= threshold.
+enum class TemporalSource : std::uint8_t { PreviousMotion = 0, PreviousDecision = 1 };
+
+/// Camera-motion model for the ego-motion-compensated variants (x_curr ~ matrix x_prev).
+template <class T>
+struct EgoMotion {
+  FlowModel model = FlowModel::MeanFlow;
+  Mat3<T> matrix = Mat3<T>::Identity();  ///< F (x_curr^T F x_prev = 0) or H (x_curr ~ H x_prev)
+};
+
+template <class T>
+struct DynamicProbabilityOptions {
+  /// Weights (a1 + a2 + a3 = 1) and threshold. Chosen so that, with S in {1, 0.5, 0}:
+  ///   high (person):  still -> 0.4 static;   moving (M) -> >= 0.8 dynamic;  moved last frame only (K) -> 0.6 dynamic
+  ///   medium (chair): still -> 0.2 static;   moving -> >= 0.6 dynamic;      K only -> 0.4 static
+  ///   low (tv):       M only -> 0.4 static;  K only -> 0.2 static;          M and K (two frames) -> 0.6 dynamic
+  /// Every combination is at least 0.05 from the threshold, so rounding never decides.
+  T weight_semantic = T(0.4);
+  T weight_motion = T(0.4);
+  T weight_temporal = T(0.2);
+  T threshold = T(0.55);
+
+  /// Adaptive threshold t of eq. 5 (the paper never defines it): over the reference features'
+  /// residuals r, t = max(min_motion_threshold_px, median(r) + mad_scale * 1.4826 * MAD(r)):
+  /// the spread of the background's own flow (LK noise, parallax) plus a floor in pixels.
+  T min_motion_threshold_px = T(1.5);
+  T mad_scale = T(3);
+  /// Reference flow (U, V): component-wise median of the reference features (true), or their
+  /// mean as eq. 4 (false; a few mislabelled movers drag the mean).
+  bool median_reference = true;
+  /// Fewer reference features than this: all features form the reference (most of a frame is
+  /// static), and t = fallback_motion_threshold_px.
+  std::size_t min_reference_features = 8;
+  T fallback_motion_threshold_px = T(3);
+  TemporalSource temporal_source = TemporalSource::PreviousMotion;
+  /// Reference features are those with these levels (in no mask, or in a low-level mask).
+  bool low_level_in_reference = true;
+};
+
+/// Per-track memory for K: the last flow result and decision of each track id. Owned by the
+/// caller; call begin_frame() once per frame so stale tracks age out.
+class TrackStateStore {
+ public:
+  struct State {
+    std::uint8_t moving = 0;   ///< M of the last frame the track was seen
+    std::uint8_t dynamic = 0;  ///< final decision of that frame
+    std::uint64_t frame = 0;   ///< frame counter when last updated
+  };
+
+  explicit TrackStateStore(std::uint64_t max_age_frames = 1) : max_age_(max_age_frames) {}
+
+  /// Advances the frame counter and forgets tracks unseen for more than max_age frames.
+  void begin_frame() {
+    ++frame_;
+    for (auto it = states_.begin(); it != states_.end();) {
+      if (frame_ - it->second.frame > max_age_) it = states_.erase(it);
+      else ++it;
+    }
+  }
+  /// State of a track seen in an earlier frame, or nullptr (K = 0 for unmatched features).
+  const State* find(std::int64_t track_id) const {
+    const auto it = states_.find(track_id);
+    return (it == states_.end() || it->second.frame >= frame_) ? nullptr : &it->second;
+  }
+  void update(std::int64_t track_id, bool moving, bool dynamic) {
+    states_[track_id] = State{static_cast<std::uint8_t>(moving), static_cast<std::uint8_t>(dynamic), frame_};
+  }
+  std::size_t size() const { return states_.size(); }
+  std::uint64_t frame() const { return frame_; }
+  void clear() {
+    states_.clear();
+    frame_ = 0;
+  }
+
+ private:
+  std::unordered_map<std::int64_t, State> states_;
+  std::uint64_t frame_ = 0;
+  std::uint64_t max_age_ = 1;
+};
+
+template <class T>
+struct DynamicProbabilityResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::vector<FeatureLabel> labels;  ///< Dynamic iff in a mask (level != Ignore) and P >= threshold
+  std::vector<CullReason> reasons;   ///< Probability for the dynamic ones
+  std::vector<T> probability;        ///< P of eq. 3 (0 for features in no mask)
+  std::vector<T> residual_px;        ///< flow residual against the camera-motion model (NaN: no flow)
+  std::vector<std::uint8_t> moving;  ///< M of eq. 5, for every feature
+  std::vector<std::uint8_t> temporal;///< K used for every feature
+  Vec2<T> reference_flow = Vec2<T>::Zero();  ///< (U, V) of eq. 4 (MeanFlow model)
+  T motion_threshold_px = T(0);      ///< t of eq. 5 as used
+  std::size_t num_reference = 0;
+  bool used_fallback = false;        ///< too few reference features: all features were the reference
+  std::size_t num_masked = 0, num_dynamic = 0, num_no_flow = 0;
+};
+
+namespace detail {
+template <class T>
+T median_in_place(std::vector<T>& v) {
+  if (v.empty()) return T(0);
+  const std::size_t mid = (v.size() - 1) / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  return v[mid];
+}
+}  // namespace detail
+
+/// Dynamic probability of every feature. prev_points[i] -> curr_points[i] is feature i's LK flow
+/// (non-finite = lost track: M = 0). `levels` has one entry per feature. `track_ids` (optional, one
+/// per feature, negative = untracked) with `store` gives K and is updated with this frame's M and
+/// decisions (call store->begin_frame() before each frame).
+template <class T, class Prev, class Curr>
+DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const Curr& curr_points,
+                                                const std::vector<MotionLevel>& levels,
+                                                const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego = {},
+                                                TrackStateStore* store = nullptr,
+                                                const std::vector<std::int64_t>* track_ids = nullptr) {
+  static_assert(is_point_container_v<Prev> && is_point_container_v<Curr>,
+                "dynamic_probability: points must be containers of points");
+  DynamicProbabilityResult<T> r;
+  const std::size_t n = curr_points.size();
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  r.probability.assign(n, T(0));
+  r.residual_px.assign(n, Constants<T>::nan());
+  r.moving.assign(n, 0);
+  r.temporal.assign(n, 0);
+  if (prev_points.size() != n || levels.size() != n || (track_ids && track_ids->size() != n)) {
+    r.status = Status::InvalidInput;
+    r.reason = "prev_points, curr_points, levels (and track_ids) must have the same size";
+    return r;
+  }
+  const T wsum = o.weight_semantic + o.weight_motion + o.weight_temporal;
+  if (!(std::abs(wsum - T(1)) < T(1e-3)) || o.weight_semantic < T(0) || o.weight_motion < T(0) ||
+      o.weight_temporal < T(0) || !std::isfinite(o.threshold)) {
+    r.status = Status::InvalidInput;
+    r.reason = "weights must be non-negative and sum to 1, threshold finite";
+    return r;
+  }
+  if (!ego.matrix.allFinite()) {
+    r.status = Status::NonFinite;
+    r.reason = "ego-motion matrix is not finite";
+    return r;
+  }
+  auto is_reference = [&](MotionLevel l) {
+    return l == MotionLevel::Ignore || (o.low_level_in_reference && l == MotionLevel::Low);
+  };
+
+  // Residual of each feature against the camera-motion model (MeanFlow: the raw flow for now).
+  std::vector<Vec2<T>> flow(n, Vec2<T>::Zero());
+  std::vector<std::uint8_t> has_flow(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2<T> p1 = to_vec2<T>(prev_points[i]), p2 = to_vec2<T>(curr_points[i]);
+    if (!p1.allFinite() || !p2.allFinite()) continue;
+    has_flow[i] = 1;
+    flow[i] = p2 - p1;
+    if (ego.model == FlowModel::Fundamental) {
+      const Vec3<T> l = ego.matrix * Vec3<T>(p1.x(), p1.y(), T(1));
+      const T norm = std::sqrt(l.x() * l.x() + l.y() * l.y());
+      r.residual_px[i] = norm > T(0) ? std::abs(l.x() * p2.x() + l.y() * p2.y() + l.z()) / norm : T(0);
+    } else if (ego.model == FlowModel::Homography) {
+      const Vec3<T> q = ego.matrix * Vec3<T>(p1.x(), p1.y(), T(1));
+      r.residual_px[i] = std::abs(q.z()) > Constants<T>::small()
+                             ? (Vec2<T>(q.x() / q.z(), q.y() / q.z()) - p2).norm()
+                             : std::numeric_limits<T>::infinity();
+    }
+  }
+  std::vector<std::size_t> ref;
+  ref.reserve(n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (has_flow[i] && is_reference(levels[i])) ref.push_back(i);
+  if (ref.size() < o.min_reference_features) {
+    r.used_fallback = true;
+    ref.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (has_flow[i]) ref.push_back(i);
+  }
+  r.num_reference = ref.size();
+
+  if (ego.model == FlowModel::MeanFlow && !ref.empty()) {
+    std::vector<T> u, v;
+    u.reserve(ref.size());
+    v.reserve(ref.size());
+    for (std::size_t i : ref) {
+      u.push_back(flow[i].x());
+      v.push_back(flow[i].y());
+    }
+    if (o.median_reference) {
+      r.reference_flow = Vec2<T>(detail::median_in_place(u), detail::median_in_place(v));
+    } else {
+      Vec2<T> s = Vec2<T>::Zero();
+      for (std::size_t i : ref) s += flow[i];
+      r.reference_flow = s / T(ref.size());
+    }
+  }
+  if (ego.model == FlowModel::MeanFlow)
+    for (std::size_t i = 0; i < n; ++i)
+      if (has_flow[i]) r.residual_px[i] = (flow[i] - r.reference_flow).norm();
+
+  // Adaptive t: robust spread of the reference features' own residuals, with a floor.
+  if (r.used_fallback || ref.empty()) {
+    r.motion_threshold_px = o.fallback_motion_threshold_px;
+  } else {
+    std::vector<T> res;
+    res.reserve(ref.size());
+    for (std::size_t i : ref) res.push_back(r.residual_px[i]);
+    const T med = detail::median_in_place(res);
+    for (T& x : res) x = std::abs(x - med);
+    const T mad = detail::median_in_place(res);
+    const T t = med + o.mad_scale * T(1.4826) * mad;
+    r.motion_threshold_px = std::isfinite(t) ? std::max(o.min_motion_threshold_px, t) : o.min_motion_threshold_px;
+  }
+  if (r.used_fallback) {
+    r.reason = "only " + std::to_string(r.num_reference) + " features with flow as reference (fewer than " +
+               std::to_string(o.min_reference_features) + " outside masks): fallback threshold used";
+  }
+
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!has_flow[i]) ++r.num_no_flow;
+    const bool m = has_flow[i] && r.residual_px[i] > r.motion_threshold_px;
+    r.moving[i] = static_cast<std::uint8_t>(m);
+    bool k = false;
+    const bool tracked = store && track_ids && (*track_ids)[i] >= 0;
+    if (tracked) {
+      if (const TrackStateStore::State* s = store->find((*track_ids)[i]))
+        k = o.temporal_source == TemporalSource::PreviousMotion ? s->moving != 0 : s->dynamic != 0;
+    }
+    r.temporal[i] = static_cast<std::uint8_t>(k);
+    bool dynamic = false;
+    if (levels[i] != MotionLevel::Ignore) {
+      ++r.num_masked;
+      const T p = o.weight_semantic * motion_level_score<T>(levels[i]) + o.weight_motion * T(m) +
+                  o.weight_temporal * T(k);
+      r.probability[i] = p;
+      dynamic = p >= o.threshold;
+      if (dynamic) {
+        r.labels[i] = FeatureLabel::Dynamic;
+        r.reasons[i] = CullReason::Probability;
+        ++r.num_dynamic;
+      }
+    }
+    if (tracked) store->update((*track_ids)[i], m, dynamic);
+  }
+  return r;
+}
+
+}  // namespace dyncull
