@@ -1,0 +1,31 @@
+// dyncull_eval: TUM-exact ATE / RPE of an estimated trajectory against ground truth.
+//   dyncull_eval GROUNDTRUTH ESTIMATE [--rpe] [--delta N] [--delta-unit frames|seconds] [--scale]
+//                [--max-difference S] [--json]
+// The logic lives in dyncull/eval/report.hpp (tested there); this file only wires it to stdio.
+#include "dyncull/eval/report.hpp"
+
+#include <cstdio>
+#include <string>
+
+int main(int argc, char** argv) {
+  using namespace dyncull::eval;
+  const std::string program = argc > 0 ? argv[0] : "dyncull_eval";
+  const ParseArgsResult parsed = parse_eval_args(argc, argv);
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "%s: %s\n\n%s", program.c_str(), parsed.reason.c_str(), eval_usage(program).c_str());
+    return 2;
+  }
+  if (parsed.args.help) {
+    std::fputs(eval_usage(program).c_str(), stdout);
+    return 0;
+  }
+  const EvalReport report = run_eval(parsed.args);
+  if (!report.ok()) {
+    std::fprintf(stderr, "%s: %s\n", program.c_str(), report.reason.c_str());
+    if (parsed.args.json) std::fputs(format_report_json(report).c_str(), stdout);
+    return 1;
+  }
+  const std::string text = parsed.args.json ? format_report_json(report) : format_report_text(report);
+  std::fputs(text.c_str(), stdout);
+  return 0;
+}
