@@ -79,7 +79,9 @@ PnpScene<T> make_pnp_scene(std::uint64_t seed, int n, double noise_px = 0.0, dou
 template <class T>
 double rotation_error_deg(const Rigid3<T>& a, const Rigid3<T>& b) {
   const Mat3<double> d = a.R.template cast<double>().transpose() * b.R.template cast<double>();
-  return rotation_angle(d) * 180.0 / 3.14159265358979323846;
+  // Through the quaternion (atan2), not acos of the trace: acos loses half the digits near 0.
+  const Eigen::Quaterniond q(d);
+  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())) * 180.0 / 3.14159265358979323846;
 }
 template <class T>
 double translation_error(const Rigid3<T>& a, const Rigid3<T>& b) {
