@@ -176,23 +176,23 @@ struct Normal2 {
 };
 
 template <class T>
+using ConstArrayMap = Eigen::Map<const Eigen::Array<T, Eigen::Dynamic, 1>>;
+
+template <class T>
 inline Normal2<T> accumulate_normal(const BisectorLines<T>& lines, RobustLoss loss, T k, const Vec2<T>& x_rel) {
   Normal2<T> n;
-  const std::size_t m = lines.size();
-  const T* nx = lines.nx.data();
-  const T* ny = lines.ny.data();
-  const T* e = lines.e.data();
+  const Eigen::Index m = static_cast<Eigen::Index>(lines.size());
+  const ConstArrayMap<T> nx(lines.nx.data(), m), ny(lines.ny.data(), m), e(lines.e.data(), m);
   if (loss == RobustLoss::None) {
-    for (std::size_t i = 0; i < m; ++i) {
-      n.a += nx[i] * nx[i];
-      n.b += nx[i] * ny[i];
-      n.c += ny[i] * ny[i];
-      n.ra += nx[i] * e[i];
-      n.rb += ny[i] * e[i];
-    }
+    // Eigen reductions are vectorised (a scalar loop is not: it may not reorder the sums).
+    n.a = nx.square().sum();
+    n.b = (nx * ny).sum();
+    n.c = ny.square().sum();
+    n.ra = (nx * e).sum();
+    n.rb = (ny * e).sum();
     return n;
   }
-  for (std::size_t i = 0; i < m; ++i) {
+  for (Eigen::Index i = 0; i < m; ++i) {
     const T r = nx[i] * x_rel.x() + ny[i] * x_rel.y() - e[i];
     const T w = robust_weight(loss, r, k);
     n.a += w * nx[i] * nx[i];
@@ -275,20 +275,16 @@ template <class T>
 T bisector_cost(const BisectorLines<T>& lines, const Vec2<T>& centre, RobustLoss loss, T loss_scale_px,
                 Vec2<T>* gradient) {
   const Vec2<T> x = centre - lines.origin;
-  const std::size_t m = lines.size();
-  const T* nx = lines.nx.data();
-  const T* ny = lines.ny.data();
-  const T* e = lines.e.data();
+  const Eigen::Index m = static_cast<Eigen::Index>(lines.size());
+  const detail::ConstArrayMap<T> nx(lines.nx.data(), m), ny(lines.ny.data(), m), e(lines.e.data(), m);
   T f = T(0), gx = T(0), gy = T(0);
   if (loss == RobustLoss::None) {
-    for (std::size_t i = 0; i < m; ++i) {
-      const T r = nx[i] * x.x() + ny[i] * x.y() - e[i];
-      f += r * r;
-      gx += r * nx[i];
-      gy += r * ny[i];
-    }
+    const auto r = nx * x.x() + ny * x.y() - e;  // signed distances (eq. 5 with |n| = 1), lazily evaluated
+    f = r.square().sum();
+    gx = (r * nx).sum();
+    gy = (r * ny).sum();
   } else {
-    for (std::size_t i = 0; i < m; ++i) {
+    for (Eigen::Index i = 0; i < m; ++i) {
       const T r = nx[i] * x.x() + ny[i] * x.y() - e[i];
       const T wr = detail::robust_weight(loss, r, loss_scale_px) * r;
       f += detail::robust_rho(loss, r, loss_scale_px);
