@@ -1,0 +1,322 @@
+/// @file frontend.hpp
+/// RGB-D visual odometry front end of the dynamic_vo demo: ORB corners spread over a grid, pyramidal
+/// LK tracking frame to frame, 3-D points from the keyframe's depth (002 eq. 5-6), PnP-RANSAC on the
+/// features the culling kept (002 §2), motion-only refinement on the inliers, constant-velocity fallback.
+#pragma once
+
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/geometry/pnp.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+namespace vo {
+
+/// Front-end settings. Defaults follow ORB-SLAM2's RGB-D front end where it has one.
+struct FrontEndOptions {
+  int max_features = 800;             ///< features per keyframe (tracked + newly detected)
+  int grid_cols = 8, grid_rows = 6;   ///< detection grid: spreads the budget over the image
+  int fast_threshold = 12;            ///< ORB's FAST threshold (OpenCV default 20 finds too few on flat walls)
+  int min_feature_distance_px = 10;   ///< new corners keep this far from tracked ones
+  int border_px = 12;                 ///< no features this close to the edge (Kinect depth band, LK window)
+  float min_depth_m = 0.4f;           ///< TUM sensor's reliable range
+  float max_depth_m = 8.f;
+  float max_depth_step_ratio = 0.05f; ///< reject corners on depth edges: 3x3 spread above this fraction
+  int lk_window_px = 21;              ///< LK window and pyramid depth (PRIOR_ART: 21 px, 3-5 levels)
+  int lk_levels = 3;
+  double pnp_threshold_px = 2.0;      ///< reprojection inlier threshold of PnP-RANSAC
+  int min_pnp_inliers = 15;           ///< ORB-SLAM2 loses reference tracking below 15 matches
+  int keyframe_min_inliers = 120;     ///< new keyframe when fewer inliers remain ...
+  double keyframe_min_tracked_ratio = 0.5;  ///< ... or fewer tracks than this share of the keyframe's ...
+  double keyframe_max_translation_m = 0.2;  ///< ... or the camera moved this far from the keyframe ...
+  double keyframe_max_rotation_deg = 15.0;  ///< ... or turned this much.
+  std::uint64_t seed = 7;             ///< PnP-RANSAC seed (deterministic runs)
+};
+
+/// One input frame; the views must stay valid during process calls.
+struct FrameInput {
+  double timestamp = 0;
+  cv::Mat gray;     ///< CV_8UC1
+  cv::Mat depth_m;  ///< CV_32FC1 metres, 0 = no measurement
+};
+
+/// Per-frame outcome, for progress and statistics.
+struct FrameStats {
+  Status status = Status::Ok;  ///< Ok when PnP gave the pose; Skipped on the first frame; else the fallback's reason
+  std::string reason;
+  std::size_t tracks = 0;      ///< features tracked into this frame
+  std::size_t kept = 0;        ///< of them, kept by the culling and used for PnP
+  std::size_t inliers = 0;     ///< PnP inliers
+  bool keyframe = false;       ///< this frame became a keyframe
+  bool fallback = false;       ///< pose from the constant-velocity prior (PnP failed)
+};
+
+/// The tracked features of the current frame, structure of arrays (all the same length).
+struct Tracks {
+  std::vector<std::uint32_t> ids;          ///< stable per feature, for per-track culling state
+  std::vector<cv::Point2f> prev_px;        ///< position in the previous frame
+  std::vector<cv::Point2f> cur_px;         ///< position in the current frame
+  std::vector<Vec3<double>> world;         ///< 3-D point from its keyframe's depth, world frame
+  std::vector<std::uint8_t> pnp_inlier;    ///< set by estimate()
+
+  std::size_t size() const { return ids.size(); }
+  void clear() {
+    ids.clear();
+    prev_px.clear();
+    cur_px.clear();
+    world.clear();
+    pnp_inlier.clear();
+  }
+};
+
+/// Frame-to-keyframe RGB-D odometry. Call track(frame), cull tracks(), then estimate(keep).
+class FrontEnd {
+ public:
+  FrontEnd(const PinholeCamera<double>& camera, const FrontEndOptions& options = {})
+      : camera_(camera), options_(options) {
+    orb_ = cv::ORB::create(options_.max_features * 2, 1.2f, 4, 19, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                           options_.fast_threshold);
+  }
+
+  /// Tracks the features of the previous frame into `frame` (LK). On the first frame there is
+  /// nothing to track: tracks() is empty and estimate() makes the frame the first keyframe.
+  void track(const FrameInput& frame) {
+    frame_ = frame;
+    if (prev_gray_.empty() || tracks_.size() == 0) {
+      tracks_.clear();
+      return;
+    }
+    // The previous frame's positions become prev_px; LK writes the new ones.
+    tracks_.prev_px.swap(tracks_.cur_px);
+    std::vector<std::uint8_t> status;
+    std::vector<float> err;
+    cv::calcOpticalFlowPyrLK(prev_gray_, frame.gray, tracks_.prev_px, tracks_.cur_px, status, err,
+                             cv::Size(options_.lk_window_px, options_.lk_window_px), options_.lk_levels,
+                             cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03));
+    const float b = static_cast<float>(options_.border_px) * 0.5f;
+    const float umax = static_cast<float>(frame.gray.cols) - 1.f - b, vmax = static_cast<float>(frame.gray.rows) - 1.f - b;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      const cv::Point2f p = tracks_.cur_px[i];
+      if (!status[i] || !(p.x >= b && p.y >= b && p.x <= umax && p.y <= vmax)) continue;
+      tracks_.ids[n] = tracks_.ids[i];
+      tracks_.prev_px[n] = tracks_.prev_px[i];
+      tracks_.cur_px[n] = p;
+      tracks_.world[n] = tracks_.world[i];
+      ++n;
+    }
+    tracks_.ids.resize(n);
+    tracks_.prev_px.resize(n);
+    tracks_.cur_px.resize(n);
+    tracks_.world.resize(n);
+    tracks_.pnp_inlier.assign(n, 0);
+  }
+
+  const Tracks& tracks() const { return tracks_; }
+
+  /// Pose given to the first frame (default identity: the world is the first camera).
+  void set_initial_pose(const Rigid3<double>& world_from_cam) {
+    if (!initialised_) initial_world_from_cam_ = world_from_cam;
+  }
+
+  /// Pose of the current frame from the tracks with keep[i] != 0 (keep.size() == tracks().size()),
+  /// then keyframe management. Returns what happened; pose() is always set (fallback: prior).
+  FrameStats estimate(const std::vector<std::uint8_t>& keep) {
+    FrameStats stats;
+    stats.tracks = tracks_.size();
+    if (!initialised_) {
+      world_from_cam_ = initial_world_from_cam_;
+      velocity_ = Rigid3<double>::identity();
+      stats.status = Status::Skipped;
+      stats.reason = "first frame";
+      make_keyframe(stats);
+      initialised_ = true;
+      finish_frame();
+      return stats;
+    }
+
+    // Constant-velocity prior: the last inter-frame motion repeated (cam_from_world of this frame).
+    const Rigid3<double> prior_world_from_cam = world_from_cam_ * velocity_;
+    world_pts_.clear();
+    pixels_.clear();
+    index_.clear();
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      if (i < keep.size() && !keep[i]) continue;
+      world_pts_.push_back(tracks_.world[i]);
+      pixels_.emplace_back(static_cast<double>(tracks_.cur_px[i].x), static_cast<double>(tracks_.cur_px[i].y));
+      index_.push_back(i);
+    }
+    stats.kept = index_.size();
+
+    Rigid3<double> world_from_cam = prior_world_from_cam;
+    bool ok = false;
+    if (index_.size() >= static_cast<std::size_t>(options_.min_pnp_inliers)) {
+      PnpOptions<double> pnp;
+      pnp.ransac.max_residual = options_.pnp_threshold_px;
+      pnp.ransac.confidence = 0.999;
+      pnp.ransac.max_iterations = 1000;
+      pnp.ransac.seed = options_.seed + frame_count_;
+      pnp.refine = true;
+      pnp.refinement.huber = true;  // motion-only refinement robust to the outliers RANSAC let through
+      const PnpResult<double> r = solve_pnp_ransac(world_pts_, pixels_, camera_, pnp);
+      if (r.ok() && r.num_inliers >= static_cast<std::size_t>(options_.min_pnp_inliers) &&
+          r.cam_from_world.all_finite()) {
+        ok = true;
+        world_from_cam = r.cam_from_world.inverse();
+        stats.inliers = r.num_inliers;
+        for (std::size_t k = 0; k < index_.size(); ++k) tracks_.pnp_inlier[index_[k]] = r.inlier_mask[k];
+      } else {
+        stats.status = r.ok() ? Status::TooFewPoints : r.status;
+        stats.reason = r.ok() ? "PnP inliers below minimum" : r.reason;
+      }
+    } else {
+      stats.status = Status::TooFewPoints;
+      stats.reason = "too few kept tracks for PnP";
+    }
+    if (!ok) stats.fallback = true;
+
+    velocity_ = world_from_cam_.inverse() * world_from_cam;
+    world_from_cam_ = world_from_cam;
+
+    const Rigid3<double> kf_from_cam = keyframe_world_from_cam_.inverse() * world_from_cam_;
+    const bool far = kf_from_cam.t.norm() > options_.keyframe_max_translation_m ||
+                     rotation_angle(kf_from_cam.R) * Constants<double>::rad_to_deg() > options_.keyframe_max_rotation_deg;
+    const bool weak = stats.inliers < static_cast<std::size_t>(options_.keyframe_min_inliers) ||
+                      static_cast<double>(tracks_.size()) < options_.keyframe_min_tracked_ratio * keyframe_size_;
+    if (far || weak) make_keyframe(stats);
+    finish_frame();
+    return stats;
+  }
+
+  /// Estimated pose of the current frame (world = first frame's camera).
+  const Rigid3<double>& world_from_cam() const { return world_from_cam_; }
+  const PinholeCamera<double>& camera() const { return camera_; }
+  const FrontEndOptions& options() const { return options_; }
+
+ private:
+  /// Metric depth at a corner, or 0 when missing, out of range or on a depth edge.
+  float usable_depth(float u, float v) const {
+    const int x = static_cast<int>(std::lround(u)), y = static_cast<int>(std::lround(v));
+    const cv::Mat& d = frame_.depth_m;
+    if (x < 1 || y < 1 || x >= d.cols - 1 || y >= d.rows - 1) return 0.f;
+    const float z = d.at<float>(y, x);
+    if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) return 0.f;
+    // Points on an occlusion edge back-project half on the object, half on the background.
+    for (int dy = -1; dy <= 1; ++dy) {
+      const float* row = d.ptr<float>(y + dy);
+      for (int dx = -1; dx <= 1; ++dx) {
+        const float zz = row[x + dx];
+        if (!(zz > 0.f) || std::abs(zz - z) > options_.max_depth_step_ratio * z) return 0.f;
+      }
+    }
+    return z;
+  }
+
+  /// The current frame becomes the keyframe: its PnP inliers are re-anchored on its own depth
+  /// (fresh 3-D points stop drift from old depth), the rest of the budget is new ORB corners.
+  void make_keyframe(FrameStats& stats) {
+    stats.keyframe = true;
+    keyframe_world_from_cam_ = world_from_cam_;
+    std::size_t n = 0;
+    const bool have_inliers = stats.inliers > 0;
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      if (have_inliers && !tracks_.pnp_inlier[i]) continue;
+      if (!have_inliers) continue;  // after a PnP failure no track is trusted
+      const cv::Point2f p = tracks_.cur_px[i];
+      const float z = usable_depth(p.x, p.y);
+      if (z <= 0.f) continue;
+      tracks_.ids[n] = tracks_.ids[i];
+      tracks_.cur_px[n] = p;
+      tracks_.world[n] = world_from_cam_.apply(camera_.backproject(Vec2<double>(p.x, p.y), static_cast<double>(z)));
+      ++n;
+    }
+    tracks_.ids.resize(n);
+    tracks_.cur_px.resize(n);
+    tracks_.world.resize(n);
+
+    const int budget = options_.max_features - static_cast<int>(n);
+    if (budget > 0) detect_new(budget);
+    tracks_.prev_px = tracks_.cur_px;
+    tracks_.pnp_inlier.assign(tracks_.size(), 0);
+    keyframe_size_ = static_cast<double>(tracks_.size());
+  }
+
+  /// ORB corners away from existing tracks, the best few per grid cell.
+  void detect_new(int budget) {
+    const cv::Mat& gray = frame_.gray;
+    mask_.create(gray.size(), CV_8UC1);
+    mask_.setTo(0);
+    const int b = options_.border_px;
+    mask_(cv::Rect(b, b, gray.cols - 2 * b, gray.rows - 2 * b)).setTo(255);
+    for (const cv::Point2f& p : tracks_.cur_px)
+      cv::circle(mask_, cv::Point(cvRound(p.x), cvRound(p.y)), options_.min_feature_distance_px, cv::Scalar(0), -1);
+    keypoints_.clear();
+    orb_->detect(gray, keypoints_, mask_);
+
+    const int cells = options_.grid_cols * options_.grid_rows;
+    const int per_cell = std::max(1, (budget + cells - 1) / cells);
+    cell_points_.assign(static_cast<std::size_t>(cells), {});
+    for (const cv::KeyPoint& k : keypoints_) {
+      const int c = std::min(options_.grid_cols - 1, static_cast<int>(k.pt.x * options_.grid_cols / gray.cols));
+      const int r = std::min(options_.grid_rows - 1, static_cast<int>(k.pt.y * options_.grid_rows / gray.rows));
+      cell_points_[static_cast<std::size_t>(r * options_.grid_cols + c)].push_back(k);
+    }
+    int added = 0;
+    for (auto& cell : cell_points_) {
+      std::sort(cell.begin(), cell.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b2) { return a.response > b2.response; });
+      int in_cell = 0;
+      for (const cv::KeyPoint& k : cell) {
+        if (in_cell >= per_cell || added >= budget) break;
+        // ORB detects on a pyramid: two keypoints can share a pixel; the mask check drops the second.
+        const int x = cvRound(k.pt.x), y = cvRound(k.pt.y);
+        if (mask_.at<std::uint8_t>(y, x) == 0) continue;
+        const float z = usable_depth(k.pt.x, k.pt.y);
+        if (z <= 0.f) continue;
+        cv::circle(mask_, cv::Point(x, y), options_.min_feature_distance_px / 2, cv::Scalar(0), -1);
+        tracks_.ids.push_back(next_id_++);
+        tracks_.cur_px.push_back(k.pt);
+        tracks_.world.push_back(
+            world_from_cam_.apply(camera_.backproject(Vec2<double>(k.pt.x, k.pt.y), static_cast<double>(z))));
+        ++in_cell;
+        ++added;
+      }
+    }
+  }
+
+  void finish_frame() {
+    frame_.gray.copyTo(prev_gray_);
+    ++frame_count_;
+  }
+
+  PinholeCamera<double> camera_;
+  FrontEndOptions options_;
+  cv::Ptr<cv::ORB> orb_;
+  FrameInput frame_;
+  cv::Mat prev_gray_, mask_;
+  Tracks tracks_;
+  bool initialised_ = false;
+  Rigid3<double> world_from_cam_, velocity_, keyframe_world_from_cam_, initial_world_from_cam_;
+  double keyframe_size_ = 0;
+  std::uint32_t next_id_ = 1;
+  std::uint64_t frame_count_ = 0;
+  // Scratch buffers reused frame to frame.
+  std::vector<Vec3<double>> world_pts_;
+  std::vector<Vec2<double>> pixels_;
+  std::vector<std::size_t> index_;
+  std::vector<cv::KeyPoint> keypoints_;
+  std::vector<std::vector<cv::KeyPoint>> cell_points_;
+};
+
+}  // namespace vo
+}  // namespace dyncull

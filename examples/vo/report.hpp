@@ -1,0 +1,182 @@
+/// @file report.hpp
+/// Outputs of the dynamic_vo demo: per-feature label counts against the sim's per-pixel motion truth
+/// (precision / recall of the dynamic labels, 000 eq. 6-7 style tables), a top-view trajectory plot
+/// and frames with kept / culled features drawn (PNG through OpenCV).
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+namespace vo {
+
+/// Confusion counts of "culled" against "moving" truth, plus the static features inside boxes.
+struct LabelCounts {
+  std::size_t true_positive = 0;   ///< culled and moving
+  std::size_t false_positive = 0;  ///< culled but static
+  std::size_t false_negative = 0;  ///< kept but moving
+  std::size_t true_negative = 0;   ///< kept and static
+  std::size_t static_in_box = 0;       ///< static features inside any detection box ...
+  std::size_t static_in_box_kept = 0;  ///< ... and how many of them were kept
+
+  double precision() const {
+    const std::size_t d = true_positive + false_positive;
+    return d ? static_cast<double>(true_positive) / static_cast<double>(d) : std::numeric_limits<double>::quiet_NaN();
+  }
+  double recall() const {
+    const std::size_t d = true_positive + false_negative;
+    return d ? static_cast<double>(true_positive) / static_cast<double>(d) : std::numeric_limits<double>::quiet_NaN();
+  }
+  double static_in_box_kept_ratio() const {
+    return static_in_box ? static_cast<double>(static_in_box_kept) / static_cast<double>(static_in_box)
+                         : std::numeric_limits<double>::quiet_NaN();
+  }
+  LabelCounts& operator+=(const LabelCounts& o) {
+    true_positive += o.true_positive;
+    false_positive += o.false_positive;
+    false_negative += o.false_negative;
+    true_negative += o.true_negative;
+    static_in_box += o.static_in_box;
+    static_in_box_kept += o.static_in_box_kept;
+    return *this;
+  }
+};
+
+/// Adds one frame's features: `moving` is the per-pixel truth (CV_8UC1, non-zero = moving),
+/// keep[i] == 0 means culled. Features outside the image are not counted.
+inline void count_labels(const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep,
+                         const cv::Mat& moving, const std::vector<Detection<float>>& detections, LabelCounts* out) {
+  if (moving.empty() || moving.type() != CV_8UC1) return;
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
+    if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
+    const bool is_moving = moving.at<std::uint8_t>(v, u) != 0;
+    const bool culled = i < keep.size() && keep[i] == 0;
+    if (culled && is_moving) ++out->true_positive;
+    if (culled && !is_moving) ++out->false_positive;
+    if (!culled && is_moving) ++out->false_negative;
+    if (!culled && !is_moving) ++out->true_negative;
+    if (is_moving) continue;
+    bool in_box = false;
+    for (const Detection<float>& d : detections) in_box = in_box || d.box.contains(px[i].x, px[i].y);
+    if (in_box) {
+      ++out->static_in_box;
+      if (!culled) ++out->static_in_box_kept;
+    }
+  }
+}
+
+/// A distinct colour per strategy (BGR), ground truth is black.
+inline cv::Scalar strategy_colour(std::size_t i) {
+  static const std::array<cv::Scalar, 8> colours = {cv::Scalar(40, 40, 220),  cv::Scalar(40, 160, 40),
+                                                    cv::Scalar(220, 120, 30), cv::Scalar(180, 50, 180),
+                                                    cv::Scalar(30, 160, 220), cv::Scalar(140, 140, 40),
+                                                    cv::Scalar(90, 90, 90),   cv::Scalar(200, 60, 120)};
+  return colours[i % colours.size()];
+}
+
+/// Writes a top view of the ground truth and the (aligned) estimates. The two world axes with the
+/// largest ground-truth extent span the plot, so it reads as x-y or x-z as the motion dictates.
+inline bool plot_trajectories(const std::string& path, const std::string& title,
+                              const std::vector<Vec3<double>>& truth, const std::vector<std::string>& names,
+                              const std::vector<std::vector<Vec3<double>>>& estimates) {
+  const int size = 720, margin = 60, legend = 24 * static_cast<int>(names.size() + 1);
+  cv::Mat img(size + legend, size, CV_8UC3, cv::Scalar(255, 255, 255));
+  Vec3<double> lo = Vec3<double>::Constant(1e300), hi = Vec3<double>::Constant(-1e300);
+  auto grow = [&](const std::vector<Vec3<double>>& pts) {
+    for (const auto& p : pts) {
+      if (!p.allFinite()) continue;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  };
+  grow(truth);
+  Vec3<double> extent = hi - lo;
+  if (!extent.allFinite()) extent.setZero();
+  int a = 0, b = 1;
+  {
+    std::array<int, 3> axes = {0, 1, 2};
+    std::sort(axes.begin(), axes.end(), [&](int i, int j) { return extent[i] > extent[j]; });
+    a = std::min(axes[0], axes[1]);
+    b = std::max(axes[0], axes[1]);
+  }
+  for (const auto& e : estimates) grow(e);
+  if (!(lo.allFinite() && hi.allFinite())) return false;
+  const double span = std::max({hi[a] - lo[a], hi[b] - lo[b], 0.05});
+  const double scale = (size - 2 * margin) / span;
+  const double ca = 0.5 * (lo[a] + hi[a]), cb = 0.5 * (lo[b] + hi[b]);
+  auto to_px = [&](const Vec3<double>& p) {
+    return cv::Point(static_cast<int>(std::lround(size / 2 + (p[a] - ca) * scale)),
+                     static_cast<int>(std::lround(size / 2 - (p[b] - cb) * scale)));
+  };
+  auto draw = [&](const std::vector<Vec3<double>>& pts, const cv::Scalar& colour, int thickness) {
+    for (std::size_t i = 1; i < pts.size(); ++i) {
+      if (!pts[i - 1].allFinite() || !pts[i].allFinite()) continue;
+      cv::line(img, to_px(pts[i - 1]), to_px(pts[i]), colour, thickness, cv::LINE_AA);
+    }
+  };
+  for (std::size_t i = 0; i < estimates.size(); ++i) draw(estimates[i], strategy_colour(i), 1);
+  draw(truth, cv::Scalar(0, 0, 0), 2);
+
+  const char* axis_name = "xyz";
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s  (top view: %c right, %c up; %.2f m across)", title.c_str(), axis_name[a],
+                axis_name[b], span);
+  cv::putText(img, buf, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  int y = size + 16;
+  cv::line(img, cv::Point(10, y - 4), cv::Point(40, y - 4), cv::Scalar(0, 0, 0), 2);
+  cv::putText(img, "ground truth", cv::Point(50, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    y += 24;
+    cv::line(img, cv::Point(10, y - 4), cv::Point(40, y - 4), strategy_colour(i), 2);
+    cv::putText(img, names[i], cv::Point(50, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  return cv::imwrite(path, img);
+}
+
+/// Draws detection boxes, kept features (green) and culled features (red) on a copy of `bgr`.
+/// With truth, culled static features are drawn as red crosses and kept moving ones as yellow rings.
+inline bool draw_features(const std::string& path, const cv::Mat& bgr, const std::string& caption,
+                          const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep,
+                          const std::vector<Detection<float>>& detections, const cv::Mat& moving) {
+  cv::Mat img = bgr.clone();
+  for (const Detection<float>& d : detections) {
+    cv::rectangle(img, cv::Point(cvRound(d.box.x0), cvRound(d.box.y0)), cv::Point(cvRound(d.box.x1), cvRound(d.box.y1)),
+                  cv::Scalar(255, 160, 0), 2);
+    cv::putText(img, "class " + std::to_string(d.class_id), cv::Point(cvRound(d.box.x0) + 3, cvRound(d.box.y0) + 14),
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 160, 0), 1, cv::LINE_AA);
+  }
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    const bool culled = i < keep.size() && keep[i] == 0;
+    const int u = cvRound(px[i].x), v = cvRound(px[i].y);
+    const bool truth = !moving.empty();
+    const bool is_moving = truth && u >= 0 && v >= 0 && u < moving.cols && v < moving.rows && moving.at<std::uint8_t>(v, u);
+    const cv::Point c(u, v);
+    if (!culled && truth && is_moving) {
+      cv::circle(img, c, 5, cv::Scalar(0, 230, 255), 2, cv::LINE_AA);
+    } else if (culled && truth && !is_moving) {
+      cv::drawMarker(img, c, cv::Scalar(0, 0, 255), cv::MARKER_CROSS, 8, 2);
+    } else {
+      cv::circle(img, c, 3, culled ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 200, 0), -1, cv::LINE_AA);
+    }
+  }
+  cv::rectangle(img, cv::Point(0, 0), cv::Point(img.cols, 22), cv::Scalar(0, 0, 0), -1);
+  cv::putText(img, caption, cv::Point(6, 16), cv::FONT_HERSHEY_SIMPLEX, 0.48, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  return cv::imwrite(path, img);
+}
+
+}  // namespace vo
+}  // namespace dyncull

@@ -1,0 +1,280 @@
+/// @file runner.hpp
+/// Runs the dynamic_vo front end over one sequence with several culling strategies in lockstep (each
+/// frame is loaded once and fed to one front end per strategy), then evaluates ATE (000 eq. 6-7,
+/// TUM evaluate_ate.py through dyncull::eval) and the improvement (m - n) / m (002 eq. 7).
+#pragma once
+
+#include "dyncull/eval/ate.hpp"
+#include "dyncull/eval/statistics.hpp"
+#include "dyncull/eval/trajectory.hpp"
+
+#include "culling.hpp"
+#include "frontend.hpp"
+#include "report.hpp"
+#include "sources.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+namespace vo {
+
+struct RunnerOptions {
+  std::string out_dir = "dynamic_vo_out";
+  int max_frames = 300;
+  int progress_every = 50;       ///< progress line every this many frames
+  int frames_to_draw = 3;        ///< frames with kept/culled features written as PNG (0: none)
+  bool write_outputs = true;     ///< PNGs and TUM trajectory files (tests turn this off)
+  bool print_progress = true;
+  FrontEndOptions front_end;
+};
+
+/// Everything measured for one strategy on one sequence.
+struct StrategyRun {
+  StrategySpec spec;
+  eval::Trajectory<double> estimate;
+  LabelCounts labels;
+  double cull_ms = 0, front_end_ms = 0;  ///< totals over the frames
+  std::size_t frames = 0, fallbacks = 0, keyframes = 0, tracks = 0, kept = 0, inliers = 0;
+  // Evaluation.
+  bool has_ate = false;
+  double ate_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  std::size_t ate_pairs = 0;
+  std::string ate_note;                  ///< how the ATE was computed when not the standard way
+  std::vector<Vec3<double>> aligned_positions;
+
+  double cull_ms_per_frame() const { return frames ? cull_ms / static_cast<double>(frames) : 0.0; }
+  double front_end_ms_per_frame() const { return frames ? front_end_ms / static_cast<double>(frames) : 0.0; }
+};
+
+struct SequenceReport {
+  std::string name;
+  bool has_label_truth = false;
+  eval::Trajectory<double> truth;  ///< per frame when the source has it (sim)
+  std::string truth_note;
+  std::vector<StrategyRun> runs;
+  std::vector<std::string> files;  ///< PNG / trajectory files written
+};
+
+namespace detail {
+inline double ms_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace detail
+
+/// Runs every strategy over the first max_frames frames of `source`. Returns false (with `error`)
+/// only when a frame cannot be loaded.
+template <class Source>
+bool run_sequence(const std::string& name, Source& source, const std::vector<StrategySpec>& specs,
+                  const RunnerOptions& options, SequenceReport* report, std::string* error) {
+  report->name = name;
+  report->has_label_truth = source.has_truth_labels();
+  const int n = std::min(source.size(), options.max_frames);
+  if (n < 2) {
+    *error = name + ": fewer than 2 frames";
+    return false;
+  }
+  const PinholeCamera<double> camera = source.camera();
+  std::vector<FrontEnd> front_ends;
+  std::vector<Culler> cullers;
+  report->runs.clear();
+  for (const StrategySpec& s : specs) {
+    front_ends.emplace_back(camera, options.front_end);
+    cullers.emplace_back(s, camera);
+    report->runs.emplace_back();
+    report->runs.back().spec = s;
+    report->runs.back().estimate.reserve(static_cast<std::size_t>(n));
+  }
+  // Frames drawn with the recommended strategy (or the last one given) at 1/4, 1/2, 3/4 of the run.
+  std::size_t draw_strategy = specs.size() - 1;
+  for (std::size_t k = 0; k < specs.size(); ++k)
+    if (specs[k].recommended) draw_strategy = k;
+  std::vector<int> draw_at;
+  for (int k = 1; k <= options.frames_to_draw; ++k) draw_at.push_back(n * k / (options.frames_to_draw + 1));
+
+  SequenceFrame frame;
+  FrameInput input;
+  std::vector<std::uint8_t> keep;
+  if (options.print_progress) std::printf("[%s] %d frames, %zu strategies\n", name.c_str(), n, specs.size());
+  for (int i = 0; i < n; ++i) {
+    if (!source.load(i, &frame, error)) return false;
+    if (frame.has_truth_pose) report->truth.push_back(frame.timestamp, frame.truth_world_from_cam);
+    input.timestamp = frame.timestamp;
+    input.gray = frame.gray;
+    input.depth_m = frame.depth_m;
+    const bool draw = options.write_outputs && std::find(draw_at.begin(), draw_at.end(), i) != draw_at.end();
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      FrontEnd& fe = front_ends[k];
+      StrategyRun& run = report->runs[k];
+      // The sim's truth fixes the start so trajectories and truth share a frame before alignment.
+      if (i == 0 && frame.has_truth_pose) fe.set_initial_pose(frame.truth_world_from_cam);
+      const auto t0 = std::chrono::steady_clock::now();
+      fe.track(input);
+      const double track_ms = detail::ms_since(t0);
+      const auto t1 = std::chrono::steady_clock::now();
+      cullers[k].cull(frame, fe.tracks(), fe.world_from_cam(), &keep);
+      run.cull_ms += detail::ms_since(t1);
+      const auto t2 = std::chrono::steady_clock::now();
+      const FrameStats st = fe.estimate(keep);
+      run.front_end_ms += track_ms + detail::ms_since(t2);
+      cullers[k].after_pose(frame, fe.tracks(), fe.world_from_cam(), st.keyframe);
+
+      run.estimate.push_back(frame.timestamp, fe.world_from_cam());
+      ++run.frames;
+      run.fallbacks += (st.fallback && i > 0) ? 1 : 0;
+      run.keyframes += st.keyframe ? 1 : 0;
+      run.tracks += st.tracks;
+      run.kept += st.kept;
+      run.inliers += st.inliers;
+      if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
+      if (draw && k == draw_strategy && fe.tracks().size() > 0) {
+        source.load_colour(&frame);
+        char file[64];
+        std::snprintf(file, sizeof file, "/%s_frame%04d.png", name.c_str(), i);
+        std::ostringstream cap;
+        cap << name << " frame " << i << ", " << specs[k].name << ": " << st.kept << " kept of " << st.tracks
+            << " (green kept, red culled" << (frame.moving.empty() ? "" : "; red x: culled static, yellow ring: kept moving")
+            << ")";
+        if (draw_features(options.out_dir + file, frame.bgr, cap.str(), fe.tracks().cur_px, keep, frame.detections,
+                          frame.moving))
+          report->files.push_back(options.out_dir + file);
+      }
+      if (options.print_progress && ((i + 1) % options.progress_every == 0 || i + 1 == n)) {
+        std::printf("[%s] frame %4d/%d  %-20s tracks %4zu kept %4zu inliers %4zu%s\n", name.c_str(), i + 1, n,
+                    specs[k].name.c_str(), st.tracks, st.kept, st.inliers, st.fallback ? "  (constant-velocity fallback)" : "");
+      }
+    }
+    if (options.print_progress && ((i + 1) % options.progress_every == 0 || i + 1 == n)) std::fflush(stdout);
+  }
+  return true;
+}
+
+/// ATE of every run against `truth`. The standard TUM way (associate, SE(3) alignment, RMSE); when
+/// the truth does not move (static camera: the alignment is undefined) the estimate is compared
+/// unaligned, in the truth frame it was started in, and the run's ate_note says so.
+inline void evaluate(const eval::Trajectory<double>& truth, SequenceReport* report, const RunnerOptions& options) {
+  for (StrategyRun& run : report->runs) {
+    const eval::AteResult<double> ate = eval::evaluate_ate(truth, run.estimate);
+    run.aligned_positions.clear();
+    if (ate.ok()) {
+      run.has_ate = true;
+      run.ate_rmse_m = ate.error_m.rmse;
+      run.ate_pairs = ate.num_pairs;
+      for (const auto& p : run.estimate.poses) run.aligned_positions.push_back(ate.groundtruth_from_estimate.apply(p.t));
+    } else if (ate.status == Status::Degenerate) {
+      const eval::AssociationResult m = eval::associate(truth.stamps, run.estimate.stamps);
+      std::vector<double> err;
+      for (std::size_t j = 0; j < m.size(); ++j)
+        err.push_back((truth.poses[m.first[j]].t - run.estimate.poses[m.second[j]].t).norm());
+      const eval::ErrorStatistics<double> s = eval::compute_statistics(err.data(), err.size());
+      if (s.ok()) {
+        run.has_ate = true;
+        run.ate_rmse_m = s.rmse;
+        run.ate_pairs = s.count;
+        run.ate_note = "unaligned (truth does not move: " + ate.reason + ")";
+        for (const auto& p : run.estimate.poses) run.aligned_positions.push_back(p.t);
+      } else {
+        run.ate_note = s.reason;
+      }
+    } else {
+      run.ate_note = ate.reason;
+    }
+    if (options.write_outputs) {
+      const std::string file = options.out_dir + "/" + report->name + "_" + run.spec.name + ".txt";
+      if (eval::write_tum_trajectory(file, run.estimate).ok()) report->files.push_back(file);
+    }
+  }
+  if (!options.write_outputs) return;
+  std::vector<Vec3<double>> truth_xyz;
+  for (const auto& p : truth.poses) truth_xyz.push_back(p.t);
+  std::vector<std::string> names;
+  std::vector<std::vector<Vec3<double>>> est;
+  for (const StrategyRun& run : report->runs) {
+    names.push_back(run.spec.name);
+    est.push_back(run.aligned_positions);
+  }
+  const std::string png = options.out_dir + "/" + report->name + "_trajectories.png";
+  if (plot_trajectories(png, report->name + ": ground truth vs estimates (aligned)", truth_xyz, names, est))
+    report->files.push_back(png);
+}
+
+/// Sim: the truth recorded frame by frame.
+inline void evaluate_against_recorded_truth(SequenceReport* report, const RunnerOptions& options) {
+  const eval::Trajectory<double> truth = report->truth;
+  evaluate(truth, report, options);
+}
+
+/// TUM: groundtruth.txt beside the images. Returns false when it is missing or unreadable.
+inline bool evaluate_against_file(const std::string& path, SequenceReport* report, const RunnerOptions& options) {
+  const eval::TrajectoryReadResult<double> gt = eval::read_tum_trajectory<double>(path);
+  if (!gt.ok()) {
+    report->truth_note = gt.reason;
+    for (StrategyRun& run : report->runs) {
+      if (!options.write_outputs) continue;
+      const std::string file = options.out_dir + "/" + report->name + "_" + run.spec.name + ".txt";
+      if (eval::write_tum_trajectory(file, run.estimate).ok()) report->files.push_back(file);
+    }
+    return false;
+  }
+  report->truth = gt.trajectory;
+  evaluate(gt.trajectory, report, options);
+  return true;
+}
+
+inline std::string fmt(double v, const char* f = "%.3f") {
+  if (!std::isfinite(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+/// The papers' table: ATE RMSE per sequence and strategy, improvement over no culling, labels, time.
+inline std::string format_table(const std::vector<SequenceReport>& reports, const std::string& command, double seconds) {
+  std::ostringstream o;
+  o << "| sequence | strategy | ATE RMSE (m) | improvement (m-n)/m | dyn. precision | dyn. recall | static in boxes kept "
+       "| culling ms/frame | front end ms/frame | cull / front end | fallbacks | keyframes |\n";
+  o << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const SequenceReport& r : reports) {
+    double reference = std::numeric_limits<double>::quiet_NaN();
+    for (const StrategyRun& run : r.runs)
+      if (!run.spec.culls && run.has_ate) reference = run.ate_rmse_m;
+    for (const StrategyRun& run : r.runs) {
+      const double improvement =
+          run.spec.culls && run.has_ate && reference > 0 ? (reference - run.ate_rmse_m) / reference
+                                                         : std::numeric_limits<double>::quiet_NaN();
+      const bool labels = r.has_label_truth && run.spec.culls;
+      o << "| " << r.name << " | " << run.spec.name << (run.spec.recommended ? " (default)" : "") << " | "
+        << (run.has_ate ? fmt(run.ate_rmse_m, "%.4f") : "-") << " | " << fmt(improvement * 100.0, "%.1f %%") << " | "
+        << (labels ? fmt(run.labels.precision()) : "-") << " | " << (labels ? fmt(run.labels.recall()) : "-") << " | "
+        << (labels ? fmt(run.labels.static_in_box_kept_ratio()) : "-") << " | " << fmt(run.cull_ms_per_frame(), "%.3f")
+        << " | " << fmt(run.front_end_ms_per_frame(), "%.2f") << " | "
+        << (run.spec.culls ? fmt(run.cull_ms_per_frame() / run.front_end_ms_per_frame(), "%.3f") : "-") << " | "
+        << run.fallbacks << " | " << run.keyframes << " |\n";
+    }
+  }
+  o << "\nATE: TUM evaluate_ate.py semantics (association 0.02 s, SE(3) alignment, RMSE of position errors).";
+  for (const SequenceReport& r : reports) {
+    for (const StrategyRun& run : r.runs) {
+      if (!run.ate_note.empty()) {
+        o << "\n- " << r.name << " / " << run.spec.name << ": " << run.ate_note;
+        break;
+      }
+    }
+    if (!r.truth_note.empty()) o << "\n- " << r.name << ": " << r.truth_note;
+  }
+  o << "\nPrecision/recall: culled features against the per-pixel 'moving' truth at each tracked feature, all frames;"
+       " 'static in boxes kept': share of truly static features inside detection boxes that were kept.\n";
+  o << "Times: wall clock per frame on this machine (culling = the preset's pipeline call; front end = LK tracking,"
+       " PnP-RANSAC with refinement, keyframe ORB detection).\n";
+  o << "\nCommand: `" << command << "` (" << fmt(seconds, "%.0f") << " s)\n";
+  return o.str();
+}
+
+}  // namespace vo
+}  // namespace dyncull

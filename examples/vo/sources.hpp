@@ -1,0 +1,278 @@
+/// @file sources.hpp
+/// Frame sources of the dynamic_vo demo: the synthetic dynamic scene rendered in memory
+/// (dyncull::sim::Scene, with per-pixel "moving" truth) and TUM RGB-D directories (rgb.txt,
+/// depth.txt, depth x 5000, optional groundtruth.txt, optional YOLO detections per frame).
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/detections.hpp"
+#include "dyncull/sim/scene.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+namespace vo {
+
+/// One frame as the demo consumes it. Mats may be headers over the source's buffers: valid until
+/// the next load() on the same source.
+struct SequenceFrame {
+  double timestamp = 0;
+  cv::Mat gray;     ///< CV_8UC1
+  cv::Mat depth_m;  ///< CV_32FC1 metres, 0 = no measurement
+  cv::Mat moving;   ///< CV_8UC1, 1 where the surface moves; empty when there is no truth
+  std::vector<Detection<float>> detections;
+  bool has_truth_pose = false;
+  Rigid3<double> truth_world_from_cam;
+  /// BGR image for drawing (only filled by load_colour()).
+  cv::Mat bgr;
+};
+
+/// Synthetic walking sequence rendered on demand (deterministic for its options).
+class SimSource {
+ public:
+  explicit SimSource(const sim::SceneOptions& options) : scene_(options) {}
+  int size() const { return scene_.num_frames(); }
+  PinholeCamera<double> camera() const { return scene_.camera(); }
+  bool has_detections() const { return true; }
+  bool has_truth_labels() const { return true; }
+
+  bool load(int index, SequenceFrame* out, std::string* error) {
+    scene_.render(index, &data_);
+    if (!data_.ok()) {
+      if (error) *error = "sim frame " + std::to_string(index) + ": " + data_.reason;
+      return false;
+    }
+    const int w = data_.width, h = data_.height;
+    if (w <= 0 || h <= 0 || data_.gray.size() != static_cast<std::size_t>(w) * h ||
+        data_.depth_m.size() != static_cast<std::size_t>(w) * h) {
+      if (error) *error = "sim frame " + std::to_string(index) + " has inconsistent buffers";
+      return false;
+    }
+    out->timestamp = data_.timestamp;
+    out->gray = cv::Mat(h, w, CV_8UC1, data_.gray.data());
+    out->depth_m = cv::Mat(h, w, CV_32FC1, data_.depth_m.data());
+    out->moving = data_.moving.size() == data_.gray.size() ? cv::Mat(h, w, CV_8UC1, data_.moving.data()) : cv::Mat();
+    out->detections = data_.detections;
+    out->has_truth_pose = true;
+    out->truth_world_from_cam = data_.world_from_cam;
+    out->bgr.release();
+    return true;
+  }
+  void load_colour(SequenceFrame* out) const {
+    if (data_.rgb.size() != static_cast<std::size_t>(data_.width) * data_.height * 3) {
+      cv::cvtColor(out->gray, out->bgr, cv::COLOR_GRAY2BGR);
+      return;
+    }
+    cv::Mat rgb(data_.height, data_.width, CV_8UC3, const_cast<std::uint8_t*>(data_.rgb.data()));
+    cv::cvtColor(rgb, out->bgr, cv::COLOR_RGB2BGR);
+  }
+
+ private:
+  sim::Scene scene_;
+  sim::FrameData data_;
+};
+
+namespace detail {
+
+struct StampedFile {
+  double timestamp = 0;
+  std::string path;
+};
+
+/// TUM list file: "timestamp filename" per line, '#' comments.
+inline bool read_tum_list(const std::string& file, std::vector<StampedFile>* out, std::string* error) {
+  std::ifstream in(file);
+  if (!in) {
+    *error = "cannot open " + file;
+    return false;
+  }
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    StampedFile f;
+    if (!(ss >> f.timestamp >> f.path)) {
+      *error = file + ":" + std::to_string(line_no) + ": expected 'timestamp filename'";
+      return false;
+    }
+    out->push_back(f);
+  }
+  return true;
+}
+
+/// File name without directory and extension: rgb/1341846313.592026.png -> 1341846313.592026.
+inline std::string stem(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = name.find_last_of('.');
+  return dot == std::string::npos ? name : name.substr(0, dot);
+}
+
+/// YOLO text ("class cx cy w h [conf]" normalised per line) -> pixel detections through
+/// dyncull's conversion (001 eq. 1-2) and filter. Returns the number of unparseable lines.
+inline std::size_t yolo_text_to_detections(const std::string& text, int width, int height,
+                                           std::vector<Detection<float>>* out) {
+  const YoloParseResult<float> parsed = parse_yolo_lines<float>(text);
+  const DetectionsResult<float> boxes = convert_yolo_detections<float>(parsed.boxes, width, height);
+  out->insert(out->end(), boxes.detections.begin(), boxes.detections.end());
+  return parsed.errors.size();
+}
+
+}  // namespace detail
+
+/// A TUM RGB-D sequence directory. Depth is associated to each RGB image by nearest timestamp
+/// (max 0.02 s, as the TUM associate.py); RGB images without a depth partner are dropped.
+class TumSource {
+ public:
+  /// `detections` is empty (none), a directory of YOLO label files named after the RGB image
+  /// (<stem>.txt, "class cx cy w h [conf]" normalised per line), or one text file whose lines are
+  /// "<rgb timestamp or stem> class cx cy w h [conf]".
+  bool open(const std::string& dir, const std::string& detections, const PinholeCamera<double>& camera,
+            std::string* error) {
+    dir_ = dir;
+    camera_ = camera;
+    std::vector<detail::StampedFile> rgb, depth;
+    if (!detail::read_tum_list(dir + "/rgb.txt", &rgb, error)) return false;
+    if (!detail::read_tum_list(dir + "/depth.txt", &depth, error)) return false;
+    if (rgb.empty() || depth.empty()) {
+      *error = dir + ": rgb.txt or depth.txt lists no images";
+      return false;
+    }
+    std::sort(depth.begin(), depth.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
+    for (const auto& r : rgb) {
+      auto it = std::lower_bound(depth.begin(), depth.end(), r.timestamp,
+                                 [](const detail::StampedFile& d, double t) { return d.timestamp < t; });
+      const detail::StampedFile* best = nullptr;
+      double best_dt = 0.02;
+      for (auto c : {it, it == depth.begin() ? it : it - 1}) {
+        if (c == depth.end()) continue;
+        const double dt = std::abs(c->timestamp - r.timestamp);
+        if (dt <= best_dt) {
+          best_dt = dt;
+          best = &*c;
+        }
+      }
+      if (best) frames_.push_back({r, *best});
+    }
+    if (frames_.empty()) {
+      *error = dir + ": no RGB image has a depth image within 0.02 s";
+      return false;
+    }
+    has_detections_ = false;
+    if (!detections.empty()) {
+      if (!load_detections(detections, error)) return false;
+      has_detections_ = true;
+    }
+    return true;
+  }
+
+  int size() const { return static_cast<int>(frames_.size()); }
+  PinholeCamera<double> camera() const { return camera_; }
+  bool has_detections() const { return has_detections_; }
+  bool has_truth_labels() const { return false; }
+  /// Detection lines skipped as unparseable so far (reported by the demo).
+  std::size_t bad_detection_lines() const { return bad_detection_lines_; }
+
+  bool load(int index, SequenceFrame* out, std::string* error) {
+    const Pair& p = frames_[static_cast<std::size_t>(index)];
+    bgr_ = cv::imread(dir_ + "/" + p.rgb.path, cv::IMREAD_COLOR);
+    const cv::Mat raw = cv::imread(dir_ + "/" + p.depth.path, cv::IMREAD_ANYDEPTH);
+    if (bgr_.empty() || raw.empty() || raw.type() != CV_16UC1 || raw.size() != bgr_.size()) {
+      *error = "cannot read " + p.rgb.path + " / " + p.depth.path + " (need 8-bit colour and 16-bit depth of equal size)";
+      return false;
+    }
+    cv::cvtColor(bgr_, gray_, cv::COLOR_BGR2GRAY);
+    raw.convertTo(depth_, CV_32FC1, 1.0 / 5000.0);  // TUM: 5000 units per metre, 0 stays 0
+    out->timestamp = p.rgb.timestamp;
+    out->gray = gray_;
+    out->depth_m = depth_;
+    out->moving.release();
+    out->detections.clear();
+    if (has_detections_) {
+      auto it = detections_.find(detail::stem(p.rgb.path));
+      if (it != detections_.end()) out->detections = it->second;
+      if (!detection_dir_.empty()) load_detection_file(detection_dir_ + "/" + detail::stem(p.rgb.path) + ".txt",
+                                                       &out->detections);
+    }
+    out->has_truth_pose = false;
+    out->bgr.release();
+    return true;
+  }
+  void load_colour(SequenceFrame* out) const { out->bgr = bgr_; }
+
+ private:
+  struct Pair {
+    detail::StampedFile rgb, depth;
+  };
+
+  bool load_detections(const std::string& path, std::string* error) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+      detection_dir_ = path;
+      return true;
+    }
+    std::ifstream in(path);
+    if (!in) {
+      *error = "cannot open detections " + path;
+      return false;
+    }
+    // One file for the sequence: the first field keys the RGB image, the rest is a YOLO line.
+    std::map<std::string, std::string> text;
+    std::string line;
+    while (std::getline(in, line)) {
+      const std::size_t first = line.find_first_not_of(" \t");
+      if (first == std::string::npos || line[first] == '#') continue;
+      const std::size_t split = line.find_first_of(" \t", first);
+      if (split == std::string::npos) continue;
+      text[line.substr(first, split - first)] += line.substr(split) + "\n";
+    }
+    for (const auto& [key, lines] : text) {
+      bad_detection_lines_ += detail::yolo_text_to_detections(lines, camera_.width, camera_.height, &detections_[key]);
+    }
+    return true;
+  }
+
+  void load_detection_file(const std::string& file, std::vector<Detection<float>>* out) {
+    std::ifstream in(file);
+    if (!in) return;  // YOLO writes no file for an image without detections
+    std::stringstream ss;
+    ss << in.rdbuf();
+    bad_detection_lines_ += detail::yolo_text_to_detections(ss.str(), camera_.width, camera_.height, out);
+  }
+
+  std::string dir_, detection_dir_;
+  PinholeCamera<double> camera_;
+  std::vector<Pair> frames_;
+  std::map<std::string, std::vector<Detection<float>>> detections_;
+  bool has_detections_ = false;
+  std::size_t bad_detection_lines_ = 0;
+  cv::Mat bgr_, gray_, depth_;
+};
+
+/// TUM intrinsics by sequence name (freiburg1/2/3), fr3 otherwise (TUM's published values).
+inline PinholeCamera<double> tum_camera_for(const std::string& dir) {
+  if (dir.find("freiburg1") != std::string::npos || dir.find("fr1") != std::string::npos)
+    return PinholeCamera<double>{517.3, 516.5, 318.6, 255.3, 640, 480};
+  if (dir.find("freiburg2") != std::string::npos || dir.find("fr2") != std::string::npos)
+    return PinholeCamera<double>{520.9, 521.0, 325.1, 249.7, 640, 480};
+  return PinholeCamera<double>::tum_fr3();
+}
+
+}  // namespace vo
+}  // namespace dyncull
