@@ -18,6 +18,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -53,6 +55,10 @@ struct BoxRuleResult {
 };
 
 namespace detail {
+/// Scalar of a container of Detection<T>.
+template <class Dets>
+using detection_scalar_t = std::decay_t<decltype(std::declval<const Dets&>()[std::size_t{0}].box.x0)>;
+
 /// Boxes of one level as structure-of-arrays, so the point loop is branch-free and vectorises.
 template <class T>
 struct BoxSoA {
@@ -88,7 +94,7 @@ void points_in_boxes(const T* xs, const T* ys, std::size_t n, const BoxSoA<T>& b
 
 /// Applies the box rule to every point. Boxes of Ignore-level classes take no part; invalid
 /// (non-finite or inverted) boxes are skipped and counted in `reason`.
-template <class T, class Points, class Dets>
+template <class Points, class Dets, class T = detail::detection_scalar_t<Dets>>
 BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, const MotionLevelTable& levels,
                                 const BoxRuleOptions<T>& options = {}) {
   static_assert(is_point_container_v<Points>, "apply_box_rule: points must be a container of points");

@@ -1,0 +1,164 @@
+#include "dyncull/culling/box_rule.hpp"
+#include "dyncull/core/random.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <vector>
+
+#ifdef DYNCULL_HAS_OPENCV
+#include <opencv2/core.hpp>
+#endif
+
+namespace {
+using namespace dyncull;
+
+template <class T>
+class BoxRule : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(BoxRule, Scalars);
+
+constexpr int kPerson = 0, kChair = 56, kTv = 62;
+
+template <class T>
+std::vector<Vec2<T>> grid_in(const Box<T>& b, int nx, int ny) {
+  std::vector<Vec2<T>> pts;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      pts.emplace_back(b.x0 + (b.x1 - b.x0) * (T(i) + T(0.5)) / T(nx), b.y0 + (b.y1 - b.y0) * (T(j) + T(0.5)) / T(ny));
+  return pts;
+}
+
+TYPED_TEST(BoxRule, WalkingPersonDynamicTvOverrideChairCandidate) {
+  using T = TypeParam;
+  const Box<T> person{T(100), T(50), T(220), T(400)};
+  const Box<T> tv{T(200), T(100), T(330), T(200)};  // overlaps the person's right edge
+  const Box<T> chair{T(400), T(250), T(500), T(420)};
+  const std::vector<Detection<T>> dets = {{person, kPerson, T(0.9)}, {tv, kTv, T(0.9)}, {chair, kChair, T(0.9)}};
+  const std::vector<Vec2<T>> pts = {
+      {T(150), T(300)},  // person only -> dynamic
+      {T(210), T(150)},  // person and tv -> static (low-level override)
+      {T(300), T(150)},  // tv only -> static
+      {T(450), T(300)},  // chair -> candidate
+      {T(600), T(20)},   // background -> static
+      {T(100), T(50)},   // exactly on the person's corner: boxes are inclusive -> dynamic
+  };
+  const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80(), BoxRuleOptions<T>{});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const std::vector<FeatureLabel> want = {FeatureLabel::Dynamic, FeatureLabel::Static,    FeatureLabel::Static,
+                                          FeatureLabel::Candidate, FeatureLabel::Static, FeatureLabel::Dynamic};
+  EXPECT_EQ(r.labels, want);
+  EXPECT_EQ(r.reasons[0], CullReason::HighLevelBox);
+  EXPECT_EQ(r.reasons[1], CullReason::LowLevelOverride);
+  EXPECT_EQ(r.reasons[2], CullReason::None);
+  EXPECT_EQ(r.reasons[3], CullReason::MediumLevelBox);
+  EXPECT_EQ(r.box_index[0], 0);
+  EXPECT_EQ(r.box_index[3], 2);
+  EXPECT_EQ(r.box_index[4], -1);
+  EXPECT_EQ(r.num_dynamic, 2u);
+  EXPECT_EQ(r.num_candidate, 1u);
+  EXPECT_EQ(r.num_static, 3u);
+  EXPECT_EQ(r.num_low_override, 1u);
+  EXPECT_EQ(r.num_high_boxes, 1u);
+  EXPECT_EQ(r.num_medium_boxes, 1u);
+  EXPECT_EQ(r.num_low_boxes, 1u);
+}
+
+TYPED_TEST(BoxRule, OptionsChangeTheOutcomeAsDocumented) {
+  using T = TypeParam;
+  const std::vector<Detection<T>> dets = {{Box<T>{T(0), T(0), T(100), T(100)}, kPerson, T(1)},
+                                          {Box<T>{T(90), T(0), T(200), T(100)}, kTv, T(1)},
+                                          {Box<T>{T(300), T(0), T(400), T(100)}, kChair, T(1)}};
+  const std::vector<Vec2<T>> pts = {{T(50), T(50)}, {T(93), T(50)}, {T(350), T(50)}};
+  BoxRuleOptions<T> o;
+  o.high_as_candidate = true;   // 001 §III.D: everything boxed goes to geometry
+  o.medium_as_candidate = false;
+  o.low_shrink_px = T(5);       // the tv box no longer shelters x = 93
+  const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80(), o);
+  EXPECT_EQ(r.labels[0], FeatureLabel::Candidate);
+  EXPECT_EQ(r.labels[1], FeatureLabel::Candidate);
+  EXPECT_EQ(r.labels[2], FeatureLabel::Static);
+}
+
+TYPED_TEST(BoxRule, EmptyInvalidAndIgnoredBoxes) {
+  using T = TypeParam;
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  const std::vector<Vec2<T>> pts = {{T(10), T(10)}, {nan, T(5)}, {T(5), std::numeric_limits<T>::infinity()}};
+  // No boxes at all: everything static except the non-finite points.
+  const BoxRuleResult<T> none = apply_box_rule(pts, std::vector<Detection<T>>{}, MotionLevelTable::coco80());
+  EXPECT_EQ(none.labels[0], FeatureLabel::Static);
+  EXPECT_EQ(none.labels[1], FeatureLabel::Dynamic);
+  EXPECT_EQ(none.reasons[1], CullReason::InvalidInput);
+  EXPECT_EQ(none.num_non_finite, 2u);
+  // NaN box skipped with a reason, inverted box skipped, unknown class ignored, zero-area box is a point.
+  const std::vector<Detection<T>> dets = {{Box<T>{nan, T(0), T(20), T(20)}, kPerson, T(1)},
+                                          {Box<T>{T(20), T(20), T(0), T(0)}, kPerson, T(1)},
+                                          {Box<T>{T(0), T(0), T(20), T(20)}, 500, T(1)},
+                                          {Box<T>{T(10), T(10), T(10), T(10)}, kPerson, T(1)}};
+  const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80());
+  EXPECT_TRUE(r.ok());
+  EXPECT_NE(r.reason.find("2 invalid"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);  // on the degenerate box
+  EXPECT_EQ(r.box_index[0], 3);
+  // No points.
+  const BoxRuleResult<T> empty = apply_box_rule(std::vector<Vec2<T>>{}, dets, MotionLevelTable::coco80());
+  EXPECT_TRUE(empty.ok());
+  EXPECT_TRUE(empty.labels.empty());
+}
+
+TYPED_TEST(BoxRule, AllDynamicFrame) {
+  using T = TypeParam;
+  const Box<T> full{T(0), T(0), T(639), T(479)};
+  const std::vector<Vec2<T>> pts = grid_in(full, 40, 25);
+  const BoxRuleResult<T> r = apply_box_rule(pts, std::vector<Detection<T>>{{full, kPerson, T(1)}},
+                                            MotionLevelTable::coco80());
+  EXPECT_EQ(r.num_dynamic, pts.size());
+  EXPECT_EQ(r.num_static, 0u);
+}
+
+// Oracle: the branch-free SoA kernel against the plain per-point rule with Box::contains.
+TYPED_TEST(BoxRule, MatchesScalarOracleOnRandomScenes) {
+  using T = TypeParam;
+  Random rng(7);
+  const MotionLevelTable table = MotionLevelTable::coco80();
+  const int classes[] = {kPerson, kChair, kTv, 16 /*dog*/, 73 /*book*/};
+  for (int scene = 0; scene < 20; ++scene) {
+    std::vector<Detection<T>> dets;
+    for (int b = 0; b < 6; ++b) {
+      const T x = T(rng.uniform(0, 560)), y = T(rng.uniform(0, 400));
+      dets.push_back({Box<T>{x, y, x + T(rng.uniform(10, 200)), y + T(rng.uniform(10, 200))}, classes[rng.index(5)], T(1)});
+    }
+    std::vector<Vec2<T>> pts(1000);
+    for (auto& p : pts) p = Vec2<T>(T(rng.uniform(0, 640)), T(rng.uniform(0, 480)));
+    const BoxRuleResult<T> r = apply_box_rule(pts, dets, table);
+    std::size_t agree = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      bool high = false, medium = false, low = false;
+      for (const auto& d : dets) {
+        if (!d.box.contains(pts[i].x(), pts[i].y())) continue;
+        const MotionLevel l = table.level(d.class_id);
+        high |= l == MotionLevel::High;
+        medium |= l == MotionLevel::Medium;
+        low |= l == MotionLevel::Low;
+      }
+      const FeatureLabel want = low ? FeatureLabel::Static
+                                    : (high ? FeatureLabel::Dynamic : (medium ? FeatureLabel::Candidate : FeatureLabel::Static));
+      agree += r.labels[i] == want;
+    }
+    // Precision and recall against the oracle must both be 1: any disagreement is a kernel bug.
+    EXPECT_EQ(agree, pts.size()) << "scene " << scene;
+  }
+}
+
+#ifdef DYNCULL_HAS_OPENCV
+TEST(BoxRuleOpenCV, KeyPointsAndPoint2fWithoutCopies) {
+  const std::vector<Detection<float>> dets = {{Box<float>{10, 10, 50, 50}, kPerson, 1.f}};
+  std::vector<cv::KeyPoint> kps = {cv::KeyPoint(20.f, 20.f, 7.f), cv::KeyPoint(80.f, 20.f, 7.f)};
+  const auto r = apply_box_rule(kps, dets, MotionLevelTable::coco80(), BoxRuleOptions<float>{});
+  EXPECT_EQ(r.labels, (std::vector<FeatureLabel>{FeatureLabel::Dynamic, FeatureLabel::Static}));
+  std::vector<cv::Point2f> p2 = {{20.f, 20.f}, {80.f, 20.f}};
+  const auto r2 = apply_box_rule(p2, dets, MotionLevelTable::coco80(), BoxRuleOptions<float>{});
+  EXPECT_EQ(r2.labels, r.labels);
+}
+#endif
+}  // namespace
