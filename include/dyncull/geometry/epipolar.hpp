@@ -1,0 +1,235 @@
+/// @file epipolar.hpp
+/// Epipolar lines and distances for a fundamental matrix F (x2^T F x1 = 0): seed 003 eq. 3 point-to-line
+/// distance D = |p2^T F p1| / sqrt(X^2 + Y^2), (X, Y, Z) = F p1; symmetric (HZ eq. 11.10) and Sampson (HZ eq. 11.9).
+#pragma once
+
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace dyncull {
+
+// ---------------------------------------------------------------------------------------------------------
+// Single correspondence. p1 in image 1, p2 in image 2, pixels; any point type with PointTraits.
+// ---------------------------------------------------------------------------------------------------------
+
+/// Epipolar line l2 = F p1 in image 2 as (a, b, c) with a x + b y + c = 0 (not normalised).
+template <class T, class P1>
+Vec3<T> epipolar_line(const Mat3<T>& F, const P1& p1) {
+  return F * Vec3<T>(point_x<T>(p1), point_y<T>(p1), T(1));
+}
+
+/// Epipolar line l1 = F^T p2 in image 1.
+template <class T, class P2>
+Vec3<T> epipolar_line_in_first(const Mat3<T>& F, const P2& p2) {
+  return F.transpose() * Vec3<T>(point_x<T>(p2), point_y<T>(p2), T(1));
+}
+
+/// Seed 003 eq. 3: distance in pixels of p2 to the line F p1. NaN when the line is undefined
+/// (p1 at the epipole, X = Y = 0) or the input is not finite.
+template <class T, class P1, class P2>
+T epipolar_distance(const Mat3<T>& F, const P1& p1, const P2& p2) {
+  using std::abs;
+  using std::sqrt;
+  const Vec3<T> l = epipolar_line(F, p1);
+  const T num = point_x<T>(p2) * l[0] + point_y<T>(p2) * l[1] + l[2];
+  const T norm_sq = l[0] * l[0] + l[1] * l[1];
+  if (!(norm_sq > T(0))) return Constants<T>::nan();
+  return abs(num) / sqrt(norm_sq);
+}
+
+/// Symmetric epipolar distance, squared: d(p2, F p1)^2 + d(p1, F^T p2)^2 (HZ eq. 11.10), px^2.
+template <class T, class P1, class P2>
+T symmetric_epipolar_distance_sq(const Mat3<T>& F, const P1& p1, const P2& p2) {
+  const Vec3<T> l2 = epipolar_line(F, p1);
+  const Vec3<T> l1 = epipolar_line_in_first(F, p2);
+  const T num = point_x<T>(p2) * l2[0] + point_y<T>(p2) * l2[1] + l2[2];
+  const T n2 = l2[0] * l2[0] + l2[1] * l2[1];
+  const T n1 = l1[0] * l1[0] + l1[1] * l1[1];
+  if (!(n1 > T(0)) || !(n2 > T(0))) return Constants<T>::nan();
+  return num * num * (T(1) / n1 + T(1) / n2);
+}
+
+/// Sampson distance, squared: (p2^T F p1)^2 / ((F p1)_1^2 + (F p1)_2^2 + (F^T p2)_1^2 + (F^T p2)_2^2)
+/// (HZ eq. 11.9), px^2: the first-order geometric reprojection error of the correspondence.
+template <class T, class P1, class P2>
+T sampson_distance_sq(const Mat3<T>& F, const P1& p1, const P2& p2) {
+  const Vec3<T> l2 = epipolar_line(F, p1);
+  const Vec3<T> l1 = epipolar_line_in_first(F, p2);
+  const T num = point_x<T>(p2) * l2[0] + point_y<T>(p2) * l2[1] + l2[2];
+  const T den = l2[0] * l2[0] + l2[1] * l2[1] + l1[0] * l1[0] + l1[1] * l1[1];
+  if (!(den > T(0))) return Constants<T>::nan();
+  return num * num / den;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Structure-of-arrays kernels (contiguous x1, y1, x2, y2). Eigen array expressions so that they vectorise
+// at -O2 too (g++ 12 auto-vectorises nothing at -O2). Used by the batch API and the F-RANSAC estimator.
+// ---------------------------------------------------------------------------------------------------------
+namespace detail {
+template <class T> using ArrayMap = Eigen::Map<Eigen::Array<T, Eigen::Dynamic, 1>>;
+template <class T> using ConstArrayMap = Eigen::Map<const Eigen::Array<T, Eigen::Dynamic, 1>>;
+}  // namespace detail
+
+/// Which distance a batch call writes.
+enum class EpipolarDistance : std::uint8_t {
+  PointToLine,       ///< seed 003 eq. 3, px (one-sided, in image 2)
+  PointToLineSq,     ///< its square, px^2
+  SymmetricSq,       ///< HZ eq. 11.10, px^2
+  SampsonSq,         ///< HZ eq. 11.9, px^2
+};
+
+/// Distances for n correspondences stored as contiguous arrays; `out` holds n values.
+/// Where the relevant line norm is zero the value is NaN or +inf (undefined line).
+template <class T>
+void epipolar_distances_soa(const Mat3<T>& F, const T* x1, const T* y1, const T* x2, const T* y2, std::size_t n,
+                            T* out, EpipolarDistance kind = EpipolarDistance::PointToLine) {
+  if (n == 0) return;
+  const auto N = static_cast<Eigen::Index>(n);
+  const detail::ConstArrayMap<T> u1(x1, N), v1(y1, N), u2(x2, N), v2(y2, N);
+  detail::ArrayMap<T> o(out, N);
+  // l2 = F p1 (X, Y, Z); the residual p2^T F p1 = x2 X + y2 Y + Z.
+  const auto X = F(0, 0) * u1 + F(0, 1) * v1 + F(0, 2);
+  const auto Y = F(1, 0) * u1 + F(1, 1) * v1 + F(1, 2);
+  const auto Z = F(2, 0) * u1 + F(2, 1) * v1 + F(2, 2);
+  const auto num = u2 * X + v2 * Y + Z;
+  switch (kind) {
+    case EpipolarDistance::PointToLine:
+      o = num.abs() / (X.square() + Y.square()).sqrt();
+      break;
+    case EpipolarDistance::PointToLineSq:
+      o = num.square() / (X.square() + Y.square());
+      break;
+    case EpipolarDistance::SymmetricSq: {
+      const auto A = F(0, 0) * u2 + F(1, 0) * v2 + F(2, 0);  // (F^T p2)_1
+      const auto B = F(0, 1) * u2 + F(1, 1) * v2 + F(2, 1);  // (F^T p2)_2
+      o = num.square() * ((X.square() + Y.square()).inverse() + (A.square() + B.square()).inverse());
+      break;
+    }
+    case EpipolarDistance::SampsonSq: {
+      const auto A = F(0, 0) * u2 + F(1, 0) * v2 + F(2, 0);
+      const auto B = F(0, 1) * u2 + F(1, 1) * v2 + F(2, 1);
+      o = num.square() / (X.square() + Y.square() + A.square() + B.square());
+      break;
+    }
+  }
+}
+
+/// Labels without sqrt or division: out[i] = 1 when the seed 003 eq. 3 distance exceeds `threshold_px`,
+/// i.e. (p2^T F p1)^2 > t^2 (X^2 + Y^2). Non-finite values give 0 (no evidence of motion). Returns the count of 1s.
+template <class T>
+std::size_t label_epipolar_soa(const Mat3<T>& F, const T* x1, const T* y1, const T* x2, const T* y2, std::size_t n,
+                               T threshold_px, std::uint8_t* out) {
+  constexpr std::size_t kBlock = 256;
+  alignas(32) T lhs[kBlock];
+  alignas(32) T rhs[kBlock];
+  const T t2 = threshold_px * threshold_px;
+  std::size_t count = 0;
+  for (std::size_t begin = 0; begin < n; begin += kBlock) {
+    const std::size_t len = n - begin < kBlock ? n - begin : kBlock;
+    const auto N = static_cast<Eigen::Index>(len);
+    const detail::ConstArrayMap<T> u1(x1 + begin, N), v1(y1 + begin, N), u2(x2 + begin, N), v2(y2 + begin, N);
+    const auto X = F(0, 0) * u1 + F(0, 1) * v1 + F(0, 2);
+    const auto Y = F(1, 0) * u1 + F(1, 1) * v1 + F(1, 2);
+    const auto Z = F(2, 0) * u1 + F(2, 1) * v1 + F(2, 2);
+    detail::ArrayMap<T>(lhs, N) = (u2 * X + v2 * Y + Z).square();
+    detail::ArrayMap<T>(rhs, N) = t2 * (X.square() + Y.square());
+    // Local pointer copies: the uint8 store must not alias the bound (PERFORMANCE.md).
+    std::uint8_t* dst = out + begin;
+    for (std::size_t i = 0; i < len; ++i) {
+      const std::uint8_t v = static_cast<std::uint8_t>(lhs[i] > rhs[i]);
+      dst[i] = v;
+      count += v;
+    }
+  }
+  return count;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Batch over the caller's point containers (std::vector<cv::Point2f>, std::vector<Vec2<T>>, keypoints ...).
+// Points are copied in blocks of 256 into stack arrays, then the SoA kernels run: no heap allocation.
+// ---------------------------------------------------------------------------------------------------------
+namespace detail {
+template <class T, class C1, class C2, class Fn>
+Status for_each_soa_block(const C1& points1, const C2& points2, Fn&& fn) {
+  static_assert(is_point_container_v<C1> && is_point_container_v<C2>,
+                "dyncull: point containers need size(), operator[] and points with PointTraits");
+  const std::size_t n = points1.size();
+  if (points2.size() != n) return Status::InvalidInput;
+  constexpr std::size_t kBlock = 256;
+  alignas(32) T x1[kBlock];
+  alignas(32) T y1[kBlock];
+  alignas(32) T x2[kBlock];
+  alignas(32) T y2[kBlock];
+  for (std::size_t begin = 0; begin < n; begin += kBlock) {
+    const std::size_t len = n - begin < kBlock ? n - begin : kBlock;
+    for (std::size_t i = 0; i < len; ++i) {
+      const auto& a = points1[begin + i];
+      const auto& b = points2[begin + i];
+      x1[i] = point_x<T>(a);
+      y1[i] = point_y<T>(a);
+      x2[i] = point_x<T>(b);
+      y2[i] = point_y<T>(b);
+    }
+    fn(begin, len, x1, y1, x2, y2);
+  }
+  return Status::Ok;
+}
+}  // namespace detail
+
+/// Batch distances of `kind` for corresponding containers; `out` must hold points1.size() values.
+/// Returns InvalidInput (writing nothing) when the sizes differ.
+template <class T, class C1, class C2>
+Status epipolar_distances(const Mat3<T>& F, const C1& points1, const C2& points2, T* out,
+                          EpipolarDistance kind = EpipolarDistance::PointToLine) {
+  return detail::for_each_soa_block<T>(
+      points1, points2,
+      [&](std::size_t begin, std::size_t len, const T* x1, const T* y1, const T* x2, const T* y2) {
+        epipolar_distances_soa(F, x1, y1, x2, y2, len, out + begin, kind);
+      });
+}
+
+/// As above, resizing `out` to points1.size().
+template <class T, class C1, class C2>
+Status epipolar_distances(const Mat3<T>& F, const C1& points1, const C2& points2, std::vector<T>* out,
+                          EpipolarDistance kind = EpipolarDistance::PointToLine) {
+  if (points1.size() != points2.size()) return Status::InvalidInput;
+  out->resize(points1.size());
+  return epipolar_distances(F, points1, points2, out->data(), kind);
+}
+
+/// Sampson distances squared (px^2) for corresponding containers.
+template <class T, class C1, class C2>
+Status sampson_distances_sq(const Mat3<T>& F, const C1& points1, const C2& points2, std::vector<T>* out) {
+  return epipolar_distances(F, points1, points2, out, EpipolarDistance::SampsonSq);
+}
+
+/// Symmetric epipolar distances squared (px^2) for corresponding containers.
+template <class T, class C1, class C2>
+Status symmetric_epipolar_distances_sq(const Mat3<T>& F, const C1& points1, const C2& points2,
+                                       std::vector<T>* out) {
+  return epipolar_distances(F, points1, points2, out, EpipolarDistance::SymmetricSq);
+}
+
+/// Thresholded labels (1 = seed 003 eq. 3 distance above `threshold_px`) for corresponding containers,
+/// without sqrt or division. `labels` holds points1.size() bytes; `count` (optional) receives the number of 1s.
+template <class T, class C1, class C2>
+Status label_epipolar(const Mat3<T>& F, const C1& points1, const C2& points2, T threshold_px, std::uint8_t* labels,
+                      std::size_t* count = nullptr) {
+  std::size_t total = 0;
+  const Status s = detail::for_each_soa_block<T>(
+      points1, points2,
+      [&](std::size_t begin, std::size_t len, const T* x1, const T* y1, const T* x2, const T* y2) {
+        total += label_epipolar_soa(F, x1, y1, x2, y2, len, threshold_px, labels + begin);
+      });
+  if (count) *count = total;
+  return s;
+}
+
+}  // namespace dyncull
