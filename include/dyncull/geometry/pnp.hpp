@@ -35,6 +35,9 @@ struct PoseRefinementOptions {
   T step_tolerance = T(1e-10);      ///< stop when |delta (rad, world units)| falls below this
   T cost_tolerance = T(1e-12);      ///< stop when the relative cost decrease falls below this
   T initial_damping = T(1e-4);      ///< LM lambda, relative to the diagonal of J^T J
+  /// Levenberg-Marquardt with a cost check per step; false runs plain Gauss-Newton steps (cheaper:
+  /// one pass per iteration) for callers that score the result themselves, as RANSAC's LO does.
+  bool check_cost = true;
 };
 
 template <class T>
@@ -234,7 +237,14 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
 
   std::size_t used = 0;
   double sq = 0;
-  double cost = cost_at(R, t, &used, &sq);
+  // Gauss-Newton mode skips the initial cost pass; the in-front count is checked in the first pass.
+  double cost = o.check_cost ? cost_at(R, t, &used, &sq) : 0.0;
+  if (!o.check_cost) {
+    for (std::size_t j = 0; j < count && used < 3; ++j) {
+      const std::size_t i = idx ? idx[j] : j;
+      used += (R.row(2).dot(Vec3<double>(d.X[i], d.Y[i], d.Z[i])) + t(2)) > 0;
+    }
+  }
   res.initial_cost = cost;
   if (used < 3) {
     res.status = Status::TooFewPoints;
@@ -261,23 +271,27 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
         if (s > k2) w = k / std::sqrt(s);  // IRLS weight rho'(s) of Huber
       }
       // d(pixel)/d(p_cam), then p_cam' = exp(omega) p_cam + v: d p/d omega = -[p]x, d p/d v = I.
-      Eigen::Matrix<double, 2, 6> J;
       const double a = fx * iz, b = fy * iz;
-      J(0, 3) = a;
-      J(0, 4) = 0;
-      J(0, 5) = -a * xn;
-      J(1, 3) = 0;
-      J(1, 4) = b;
-      J(1, 5) = -b * yn;
-      // columns 0-2: J_p * (-[p]x)
-      J(0, 0) = J(0, 5) * p(1);
-      J(0, 1) = a * p(2) - J(0, 5) * p(0);
-      J(0, 2) = -a * p(1);
-      J(1, 0) = -b * p(2) + J(1, 5) * p(1);
-      J(1, 1) = -J(1, 5) * p(0);
-      J(1, 2) = b * p(0);
-      H.noalias() += w * J.transpose() * J;
-      g.noalias() += w * J.transpose() * Eigen::Vector2d(du, dv);
+      const double j05 = -a * xn, j15 = -b * yn;
+      const double j0[6] = {j05 * p(1), a * p(2) - j05 * p(0), -a * p(1), a, 0.0, j05};
+      const double j1[6] = {-b * p(2) + j15 * p(1), -j15 * p(0), b * p(0), 0.0, b, j15};
+      // Upper triangle only (21 entries): the symmetric rank-2 update is the inner loop's cost.
+      for (int r = 0; r < 6; ++r) {
+        const double w0 = w * j0[r], w1 = w * j1[r];
+        for (int c = r; c < 6; ++c) H(r, c) += w0 * j0[c] + w1 * j1[c];
+        g(r) += w0 * du + w1 * dv;
+      }
+    }
+    H.template triangularView<Eigen::StrictlyLower>() = H.transpose();
+    if (!o.check_cost) {
+      // Plain Gauss-Newton (RANSAC's local optimisation scores the result itself).
+      const Eigen::Matrix<double, 6, 1> delta = -H.ldlt().solve(g);
+      if (!delta.allFinite()) break;
+      const Mat3<double> dR = so3_exp(delta.head<3>());
+      R = dR * R;
+      t = dR * t + delta.tail<3>();
+      if (delta.norm() < static_cast<double>(o.step_tolerance)) break;
+      continue;
     }
     bool accepted = false;
     Eigen::Matrix<double, 6, 1> delta;
@@ -311,6 +325,7 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
     }
     if (!accepted || delta.norm() < static_cast<double>(o.step_tolerance)) break;
   }
+  if (!o.check_cost) cost = cost_at(R, t, &used, &sq);
   // Re-orthonormalise: exp() products drift by ~1e-16 per step only, but keep R exactly in SO(3).
   Eigen::JacobiSVD<Mat3<double>> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
   R = svd.matrixU() * svd.matrixV().transpose();
@@ -484,7 +499,8 @@ class PnpEstimator {
   static constexpr int kMaxModels = 4;
 
   explicit PnpEstimator(const PnpData<T>& data) : d_(data) {
-    refit_options_.max_iterations = 3;  // LO refits start from a good pose: a few LM steps converge
+    refit_options_.max_iterations = 2;  // LO refits start from a good pose: two GN steps converge
+    refit_options_.check_cost = false;
   }
   std::size_t num_data() const { return d_.size(); }
 
