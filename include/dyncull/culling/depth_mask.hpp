@@ -155,7 +155,9 @@ RawRange<Raw> valid_raw_range(const DepthView<Raw>& v) {
     r.lo = lo;
     r.hi = hi;
   } else {
-    r.lo = std::max(static_cast<double>(v.min_m) * upm, std::numeric_limits<double>::min());
+    // Smallest positive Raw, so that 0 stays "no measurement" after the cast back to Raw.
+    r.lo = std::max(static_cast<double>(v.min_m) * upm,
+                    static_cast<double>(std::numeric_limits<Raw>::denorm_min()));
     r.hi = static_cast<double>(v.max_m) * upm;
   }
   return r;

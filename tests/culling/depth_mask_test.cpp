@@ -1,0 +1,297 @@
+// Synthetic depth scenes with known truth: a person (near) in front of a wall (far) inside a box.
+#include "dyncull/culling/depth_mask.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace {
+using namespace dyncull;
+
+constexpr int W = 160, H = 120;
+
+// Raw uint16 (5000 per metre) or float metres, one template for both.
+template <class Raw>
+struct Scene {
+  std::vector<Raw> depth = std::vector<Raw>(W * H);
+  std::vector<std::uint8_t> truth = std::vector<std::uint8_t>(W * H, 0);
+  static Raw raw(double m) {
+    if constexpr (std::is_integral<Raw>::value) return static_cast<Raw>(std::lround(m * 5000.0));
+    else return static_cast<Raw>(m);
+  }
+  DepthView<Raw> view(float min_m = 0.f, float max_m = 1e30f) const {
+    return DepthView<Raw>{depth.data(), W, H, 0, std::is_integral<Raw>::value ? 5000.f : 1.f, min_m, max_m};
+  }
+  void fill(double m) {
+    for (auto& d : depth) d = raw(m);
+  }
+  // An upright ellipse "person" at depth m.
+  void person(double cx, double cy, double rx, double ry, double m) {
+    for (int v = 0; v < H; ++v)
+      for (int u = 0; u < W; ++u) {
+        const double a = (u - cx) / rx, b = (v - cy) / ry;
+        if (a * a + b * b <= 1.0) {
+          depth[v * W + u] = raw(m);
+          truth[v * W + u] = 1;
+        }
+      }
+  }
+  void hole(int u0, int v0, int u1, int v1) {
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) depth[v * W + u] = Raw(0);
+  }
+};
+
+template <class Raw>
+class DepthMask : public ::testing::Test {};
+using Raws = ::testing::Types<std::uint16_t, float>;
+TYPED_TEST_SUITE(DepthMask, Raws);
+
+// Pixel agreement with the truth inside the box.
+template <class Raw>
+double box_iou(const Scene<Raw>& s, const Mask& m, const Box<double>& b) {
+  const PixelRect r = pixel_rect(b, W, H);
+  long tp = 0, fp = 0, fn = 0;
+  for (int v = r.r0; v < r.r1; ++v)
+    for (int u = r.c0; u < r.c1; ++u) {
+      const bool gt = s.truth[v * W + u] != 0, p = m.test(u, v);
+      tp += gt && p;
+      fp += !gt && p;
+      fn += gt && !p;
+    }
+  return double(tp) / double(tp + fp + fn);
+}
+
+TYPED_TEST(DepthMask, PlainRuleSeparatesPersonFromWall) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(80, 60, 20, 40, 1.5);
+  const Box<double> box{55, 15, 105, 105};
+  DepthMaskOptions o;
+  o.mode = DepthMaskMode::Plain;
+  Mask m(W, H);
+  const DepthMaskBoxInfo info = depth_mask_box(s.view(), box, o, m.view());
+  ASSERT_TRUE(info.ok()) << info.reason;
+  EXPECT_TRUE(info.rule_applies);
+  EXPECT_NEAR(info.d_max_m, 4.0, 1e-6);
+  EXPECT_NEAR(info.d_c_m, 1.5, 1e-6);
+  EXPECT_NEAR(info.threshold_m, 1.8, 1e-6);
+  EXPECT_DOUBLE_EQ(box_iou(s, m, box), 1.0);
+  // Nothing outside the box is touched.
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u)
+      if (!box.contains(u, v)) {
+        ASSERT_FALSE(m.test(u, v)) << u << "," << v;
+      }
+}
+
+TYPED_TEST(DepthMask, PointLabelsAgreeWithTheRaster) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(80, 60, 20, 40, 1.5);
+  const std::vector<Box<double>> boxes = {{55, 15, 105, 105}};
+  std::vector<Vec2<float>> pts;
+  for (int v = 0; v < H; v += 3)
+    for (int u = 0; u < W; u += 3) pts.emplace_back(float(u) + 0.3f, float(v) - 0.2f);
+  pts.emplace_back(std::numeric_limits<float>::quiet_NaN(), 1.f);
+  for (DepthMaskMode mode : {DepthMaskMode::Plain, DepthMaskMode::Robust}) {
+    DepthMaskOptions o;
+    o.mode = mode;
+    Mask m(W, H);
+    const DepthMaskResult r = depth_mask(s.view(), boxes, pts, o, m.view());
+    ASSERT_TRUE(r.ok()) << r.reason;
+    std::size_t dynamic = 0, truth_dynamic = 0;
+    for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+      const int u = int(std::lround(pts[i].x())), v = int(std::lround(pts[i].y()));
+      const bool in_mask = m.test(u, v);
+      EXPECT_EQ(r.labels[i] == FeatureLabel::Dynamic, in_mask) << u << "," << v;
+      dynamic += r.labels[i] == FeatureLabel::Dynamic;
+      truth_dynamic += s.truth[v * W + u] != 0;
+      if (in_mask) {
+        EXPECT_EQ(r.reasons[i], CullReason::DepthMask);
+      }
+    }
+    // Exact scene: the labels equal the truth (precision = recall = 1).
+    EXPECT_EQ(dynamic, truth_dynamic);
+    EXPECT_EQ(r.labels.back(), FeatureLabel::Dynamic);
+    EXPECT_EQ(r.reasons.back(), CullReason::InvalidInput);
+    EXPECT_EQ(r.num_dynamic, truth_dynamic + 1);
+    EXPECT_EQ(r.num_mask_pixels, m.count());
+  }
+  // Labels need no raster: same labels with an empty MaskView.
+  const DepthMaskResult a = depth_mask(s.view(), boxes, pts, DepthMaskOptions{});
+  Mask m(W, H);
+  const DepthMaskResult b = depth_mask(s.view(), boxes, pts, DepthMaskOptions{}, m.view());
+  EXPECT_EQ(a.labels, b.labels);
+}
+
+TYPED_TEST(DepthMask, RuleNotApplicablePlainGivesCandidatesRobustFallsBackToHistogram) {
+  using Raw = TypeParam;
+  // The box is tight on the person: all four corners are on the person too (d_max - d_c = 0).
+  Scene<Raw> s;
+  s.fill(4.0);
+  for (int v = 20; v <= 100; ++v)
+    for (int u = 60; u <= 100; ++u) {
+      s.depth[v * W + u] = Scene<Raw>::raw(1.5 + 0.002 * (v - 20));  // a slightly tilted body
+      s.truth[v * W + u] = 1;
+    }
+  for (int v = 40; v <= 80; ++v)  // wall visible between the arms
+    for (int u = 62; u <= 66; ++u) {
+      s.depth[v * W + u] = Scene<Raw>::raw(4.0);
+      s.truth[v * W + u] = 0;
+    }
+  const Box<double> box{60, 20, 100, 100};
+  DepthMaskOptions o;
+  o.mode = DepthMaskMode::Plain;
+  Mask m(W, H);
+  const std::vector<Vec2<double>> pts = {{80, 60}, {64, 60}, {130, 60}};
+  const DepthMaskResult plain = depth_mask(s.view(), std::vector<Box<double>>{box}, pts, o, m.view());
+  ASSERT_EQ(plain.boxes.size(), 1u);
+  EXPECT_EQ(plain.boxes[0].outcome, DepthMaskOutcome::NotApplied);
+  EXPECT_FALSE(plain.boxes[0].reason.empty());
+  EXPECT_EQ(m.count(), 0u);
+  EXPECT_EQ(plain.labels[0], FeatureLabel::Candidate);
+  EXPECT_EQ(plain.labels[1], FeatureLabel::Candidate);
+  EXPECT_EQ(plain.labels[2], FeatureLabel::Static);
+
+  o.mode = DepthMaskMode::Robust;
+  m.reset(W, H);
+  const DepthMaskResult robust = depth_mask(s.view(), std::vector<Box<double>>{box}, pts, o, m.view());
+  EXPECT_EQ(robust.boxes[0].outcome, DepthMaskOutcome::HistogramFallback);
+  EXPECT_GT(robust.boxes[0].threshold_m, 1.66);  // the whole body (1.5 .. 1.66 m) ...
+  EXPECT_LT(robust.boxes[0].threshold_m, 3.0);   // ... but not the wall
+  EXPECT_DOUBLE_EQ(box_iou(s, m, box), 1.0);
+  EXPECT_EQ(robust.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(robust.labels[1], FeatureLabel::Static);
+}
+
+TYPED_TEST(DepthMask, HolesAtCentreAndCornersAreBridgedByTheRobustMode) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(139, 59, 15, 40, 1.5);      // a person at the right image edge
+  s.hole(138, 58, 140, 60);            // Kinect hole on the centre pixel
+  s.hole(0, 0, W - 1, 3);              // band without depth along the top edge
+  s.hole(W - 4, 0, W - 1, H - 1);      // ... and the right edge
+  const Box<double> box{W - 41, 0, W - 1, H - 1};  // integer centre (139, 59)
+  DepthMaskOptions o;
+  o.mode = DepthMaskMode::Plain;
+  const DepthMaskBoxInfo plain = depth_mask_box(s.view(), box, o);
+  EXPECT_FALSE(plain.rule_applies);  // centre pixel has no depth
+  o.mode = DepthMaskMode::Robust;
+  Mask m(W, H);
+  const DepthMaskBoxInfo robust = depth_mask_box(s.view(), box, o, m.view());
+  EXPECT_TRUE(robust.rule_applies);
+  EXPECT_NEAR(robust.d_c_m, 1.5, 1e-6);
+  EXPECT_NEAR(robust.d_max_m, 4.0, 1e-6);
+  EXPECT_TRUE(robust.masks_missing);
+  // Person pixels all masked; wall pixels with depth never; missing pixels masked (documented).
+  const PixelRect r = pixel_rect(box, W, H);
+  for (int v = r.r0; v < r.r1; ++v)
+    for (int u = r.c0; u < r.c1; ++u) {
+      const Raw d = s.depth[v * W + u];
+      if (d == Raw(0)) {
+        EXPECT_TRUE(m.test(u, v));
+      } else {
+        EXPECT_EQ(m.test(u, v), s.truth[v * W + u] != 0) << u << "," << v;
+      }
+    }
+  o.mask_missing_depth = false;
+  m.reset(W, H);
+  depth_mask_box(s.view(), box, o, m.view());
+  EXPECT_FALSE(m.test(139, 59));
+  EXPECT_TRUE(m.test(139, 70));
+}
+
+TYPED_TEST(DepthMask, BoxWithoutDepthAndBoxesOutsideTheImage) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.hole(20, 20, 60, 60);
+  const std::vector<Box<double>> boxes = {{20, 20, 60, 60},       // no depth at all
+                                          {200, 10, 300, 50},     // outside the image
+                                          {std::nan(""), 0, 5, 5}};  // non-finite
+  const std::vector<Vec2<double>> pts = {{40, 40}, {100, 100}};
+  Mask m(W, H);
+  const DepthMaskResult r = depth_mask(s.view(), boxes, pts, DepthMaskOptions{}, m.view());
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_NE(r.reason.find("2 of 3"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.boxes[0].outcome, DepthMaskOutcome::WholeBox);
+  EXPECT_EQ(r.boxes[0].num_mask_pixels, 41u * 41u);
+  EXPECT_EQ(r.boxes[1].status, Status::Skipped);
+  EXPECT_EQ(r.boxes[2].status, Status::InvalidInput);
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(r.labels[1], FeatureLabel::Static);
+  EXPECT_EQ(m.count(), 41u * 41u);
+
+  // Missing depth image and mismatched mask.
+  const DepthMaskResult none = depth_mask(DepthView<Raw>{}, boxes, pts, DepthMaskOptions{});
+  EXPECT_EQ(none.status, Status::Skipped);
+  EXPECT_EQ(none.labels.size(), 2u);
+  Mask wrong(W - 1, H);
+  EXPECT_EQ(depth_mask(s.view(), boxes, pts, DepthMaskOptions{}, wrong.view()).status, Status::InvalidInput);
+}
+
+TYPED_TEST(DepthMask, ValidRangeIsAParameter) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(80, 60, 20, 40, 1.5);
+  s.person(80, 30, 4, 4, 0.2);  // sensor noise nearer than the valid range
+  const Box<double> box{55, 15, 105, 105};
+  DepthMaskOptions o;
+  o.mode = DepthMaskMode::Plain;
+  Mask m(W, H);
+  depth_mask_box(s.view(0.4f, 10.f), box, o, m.view());
+  EXPECT_FALSE(m.test(80, 30));  // 0.2 m is "no measurement" with min 0.4 m
+  EXPECT_TRUE(m.test(80, 60));
+  // Everything beyond 3 m invalid: the corners have no depth and the plain rule cannot apply.
+  EXPECT_FALSE(depth_mask_box(s.view(0.f, 3.f), box, o).rule_applies);
+}
+
+TYPED_TEST(DepthMask, DynamicVinsThresholdForm) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(80, 60, 20, 40, 1.5);
+  const Box<double> box{55, 15, 105, 105};
+  DepthMaskOptions o;
+  o.form = DepthThresholdForm::DynamicVins;
+  o.mode = DepthMaskMode::Plain;
+  // d_max - d_c = 2.5 > 1.0: midpoint (4.0 + 1.5) / 2.
+  EXPECT_NEAR(depth_mask_box(s.view(), box, o).threshold_m, 2.75, 1e-6);
+  // Wall at 2.0 m: 0.5 <= 1.0 -> d_c + 1.0.
+  Scene<Raw> near;
+  near.fill(2.0);
+  near.person(80, 60, 20, 40, 1.5);
+  EXPECT_NEAR(depth_mask_box(near.view(), box, o).threshold_m, 2.5, 1e-6);
+  // Centre without depth, corners valid -> the corner depth.
+  s.hole(78, 58, 82, 62);
+  EXPECT_NEAR(depth_mask_box(s.view(), box, o).threshold_m, 4.0, 1e-6);
+  // Nothing valid -> whole box.
+  Scene<Raw> empty;
+  EXPECT_EQ(depth_mask_box(empty.view(), box, o).outcome, DepthMaskOutcome::WholeBox);
+}
+
+TEST(DepthMaskRaw, ThresholdIsComparedInRawUnits) {
+  // 000 in TUM raw units: eps 0.3 m = 1500, strict "<": the pixel at exactly d_c + eps is out.
+  std::vector<std::uint16_t> d(W * H, 20000);
+  for (int v = 40; v <= 80; ++v)
+    for (int u = 60; u <= 100; ++u) d[v * W + u] = 10000;
+  d[50 * W + 70] = 11500;
+  d[50 * W + 71] = 11499;
+  DepthMaskOptions o;
+  o.mode = DepthMaskMode::Plain;
+  Mask m(W, H);
+  const DepthMaskBoxInfo info = depth_mask_box(tum_depth_view(d.data(), W, H), Box<float>{50, 30, 110, 90}, o, m.view());
+  EXPECT_EQ(info.threshold_raw, 11500.0);
+  EXPECT_FALSE(m.test(70, 50));
+  EXPECT_TRUE(m.test(71, 50));
+  EXPECT_EQ(m.view().at(71, 50), 255);
+}
+}  // namespace
