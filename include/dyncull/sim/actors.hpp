@@ -51,8 +51,8 @@ struct ActorOptions {
   bool sitting_person = true;          ///< person on a chair moving head, torso and arms only
   bool pushed_chair = true;            ///< chair that slides once, pushed between push_start_s and push_end_s
   double walking_speed_mps = 1.0;      ///< mean walking speed along the loop
-  Vec2<double> loop_centre_m{-0.1, 1.9};  ///< centre of the walking loop on the floor (world x, y)
-  Vec2<double> loop_semi_axes_m{0.85, 0.55};  ///< semi-axes of the loop; camera rests at y = -0.3
+  Vec2<double> loop_centre_m{-0.1, 1.6};  ///< centre of the walking loop on the floor (world x, y)
+  Vec2<double> loop_semi_axes_m{0.9, 0.5};  ///< semi-axes of the loop; camera rests at y = -0.3
   double push_start_s = 3.5;           ///< chair starts moving (seconds from the first frame)
   double push_end_s = 5.0;             ///< chair stops moving
   double texture_scale = 1.0;          ///< multiplies every texture cell size (smaller = more corners)
@@ -108,7 +108,7 @@ inline void add_walker(PrimitiveSink& sink, const Rigid3<double>& world_from_per
   const double bob = 0.02 * std::cos(2.0 * gait_phase);
   auto W = [&](const Rigid3<double>& person_from_part) { return world_from_person * person_from_part; };
   const Mat3<double> I = Mat3<double>::Identity();
-  constexpr double kCloth = 0.07, kSkin = 0.05;
+  constexpr double kCloth = 0.05, kSkin = 0.04;
   sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0, 0, 0.95 + bob})), {0.11, 0.17, 0.12}, instance, true,
            c.seed + 1, kCloth, c.trousers);
   sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0, 0, 1.27 + bob})), {0.13, 0.21, 0.29}, instance, true,
@@ -128,7 +128,7 @@ inline void add_walker(PrimitiveSink& sink, const Rigid3<double>& world_from_per
 inline void add_sitting_person(PrimitiveSink& sink, const Rigid3<double>& world_from_person, double t,
                                std::uint16_t instance, const Clothes& c) {
   constexpr double kTwoPi = 6.283185307179586;
-  constexpr double kCloth = 0.07, kSkin = 0.05;
+  constexpr double kCloth = 0.05, kSkin = 0.04;
   const Mat3<double> I = Mat3<double>::Identity();
   auto W = [&](const Rigid3<double>& person_from_part) { return world_from_person * person_from_part; };
   // Legs and pelvis: static.

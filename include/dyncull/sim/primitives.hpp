@@ -84,20 +84,26 @@ inline double intersect_unit_sphere(const Vec3<double>& o_s, const Vec3<double>&
   return lambda > min_lambda ? lambda : kNoHit;
 }
 
-/// Hit depth (lambda along the unit-depth ray d_cam) of one prepared primitive, or kNoHit.
-inline double intersect(const Primitive& prim, const CameraPrimitive& cp, const Vec3<double>& d_cam,
-                        double min_lambda) {
-  const Vec3<double> d = cp.local_from_cam_R * d_cam;
+/// Hit depth of one prepared primitive along a ray whose direction, rotated into the primitive's
+/// frame, is d_local = local_from_cam_R * (x/z, y/z, 1); kNoHit when missed.
+inline double intersect_local(const Primitive& prim, const CameraPrimitive& cp, const Vec3<double>& d_local,
+                              double min_lambda) {
   switch (prim.shape) {
     case PrimitiveShape::Ellipsoid:
-      return intersect_unit_sphere(cp.origin_local.cwiseProduct(cp.inv_half), d.cwiseProduct(cp.inv_half),
+      return intersect_unit_sphere(cp.origin_local.cwiseProduct(cp.inv_half), d_local.cwiseProduct(cp.inv_half),
                                    min_lambda);
     case PrimitiveShape::Box:
-      return intersect_box(cp.origin_local, d, prim.half_extents, false, min_lambda);
+      return intersect_box(cp.origin_local, d_local, prim.half_extents, false, min_lambda);
     case PrimitiveShape::RoomInterior:
-      return intersect_box(cp.origin_local, d, prim.half_extents, true, min_lambda);
+      return intersect_box(cp.origin_local, d_local, prim.half_extents, true, min_lambda);
   }
   return kNoHit;
+}
+
+/// Hit depth (lambda along the unit-depth camera ray d_cam) of one prepared primitive, or kNoHit.
+inline double intersect(const Primitive& prim, const CameraPrimitive& cp, const Vec3<double>& d_cam,
+                        double min_lambda) {
+  return intersect_local(prim, cp, cp.local_from_cam_R * d_cam, min_lambda);
 }
 
 /// Outward unit normal (inward for RoomInterior) in local coordinates at a surface point, and for

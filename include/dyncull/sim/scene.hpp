@@ -268,12 +268,14 @@ inline void Scene::render(int index, FrameData* out) const {
   std::vector<double> zbuf(n, kNoHit);
   for (std::size_t k = 0; k < prims.size(); ++k) {
     const PixelRect& r = cps[k].bounds;
+    const Mat3<double>& R = cps[k].local_from_cam_R;
     for (int v = r.r0; v < r.r1; ++v) {
-      const double y = ray_y_[static_cast<std::size_t>(v)];
+      // Local ray direction is affine in x along a row: row_base + x * R.col(0).
+      const Vec3<double> row_base = R.col(1) * ray_y_[static_cast<std::size_t>(v)] + R.col(2);
       const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
       for (int u = r.c0; u < r.c1; ++u) {
-        const double lambda = intersect(prims[k], cps[k], Vec3<double>(ray_x_[static_cast<std::size_t>(u)], y, 1.0),
-                                        options_.near_m);
+        const double lambda = intersect_local(prims[k], cps[k], row_base + ray_x_[static_cast<std::size_t>(u)] * R.col(0),
+                                              options_.near_m);
         if (lambda < zbuf[row + static_cast<std::size_t>(u)]) {
           zbuf[row + static_cast<std::size_t>(u)] = lambda;
           prim_id[row + static_cast<std::size_t>(u)] = static_cast<std::uint16_t>(k);

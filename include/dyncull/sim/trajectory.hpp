@@ -31,7 +31,7 @@ struct TrajectoryOptions {
   double static_jitter_deg = 0.4;             ///< Static: rotation amplitude per axis
   Vec3<double> xyz_amplitude_m{0.30, 0.15, 0.25};  ///< Xyz: camera right, down, forward
   double xyz_rotation_deg = 1.5;              ///< Xyz: small hand-held rotation
-  Vec3<double> rpy_amplitude_deg{20.0, 15.0, 20.0};  ///< Rpy: yaw (about down), pitch (right), roll (forward)
+  Vec3<double> rpy_amplitude_deg{16.0, 12.0, 25.0};  ///< Rpy: yaw (about down), pitch (right), roll (forward)
   double rpy_translation_m = 0.015;           ///< Rpy: small translation
   double halfsphere_radius_m = 0.5;           ///< Halfsphere: ~1 m diameter
   double halfsphere_azimuth_deg = 70.0;       ///< Halfsphere: azimuth swing (< 90 keeps one hemisphere)
