@@ -72,9 +72,18 @@ inline int popcount64_swar(std::uint64_t x) noexcept {
 }  // namespace detail
 
 /// Hamming distance of two 256-bit (32-byte) descriptors, e.g. ORB rows of a CV_8UC1 N x 32 cv::Mat.
+/// Single pairs use POPCNT only when the build enables it (-mpopcnt / -march); without it g++ would call
+/// a slow libgcc routine, so SWAR is used. The batch matcher below dispatches at run time instead.
 inline int hamming256(const std::uint8_t* a, const std::uint8_t* b) noexcept {
   int d = 0;
-  for (int w = 0; w < 4; ++w) d += __builtin_popcountll(detail::load_u64(a + 8 * w) ^ detail::load_u64(b + 8 * w));
+  for (int w = 0; w < 4; ++w) {
+    const std::uint64_t x = detail::load_u64(a + 8 * w) ^ detail::load_u64(b + 8 * w);
+#ifdef __POPCNT__
+    d += __builtin_popcountll(x);
+#else
+    d += detail::popcount64_swar(x);
+#endif
+  }
   return d;
 }
 
