@@ -1,0 +1,165 @@
+// Writes a synthetic dynamic RGB-D sequence (dyncull::sim::Scene) in TUM RGB-D format, so any SLAM
+// system can run on it: rgb/*.png, depth/*.png (16-bit, 5000 per metre), rgb.txt, depth.txt,
+// associations.txt, groundtruth.txt (timestamp tx ty tz qx qy qz qw of world_from_cam), camera.txt,
+// detections/*.txt (YOLO style "class cx cy w h conf", normalised) indexed by detections.txt, and
+// the truth masks instance/*.png (16-bit ids) and moving/*.png (255 = moving surface).
+//
+// Usage: write_tum_sequence OUTDIR [--motion static|xyz|rpy|halfsphere] [--frames N] [--seed S]
+//                                  [--clean-depth]
+#include "dyncull/sim/scene.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+int usage(const char* why) {
+  std::cerr << "write_tum_sequence: " << why << "\n"
+            << "usage: write_tum_sequence OUTDIR [--motion static|xyz|rpy|halfsphere] [--frames N] [--seed S] "
+               "[--clean-depth]\n";
+  return 2;
+}
+
+bool parse_motion(const std::string& s, dyncull::sim::CameraMotion* m) {
+  using dyncull::sim::CameraMotion;
+  for (CameraMotion c : {CameraMotion::Static, CameraMotion::Xyz, CameraMotion::Rpy, CameraMotion::Halfsphere}) {
+    if (s == dyncull::sim::to_string(c)) {
+      *m = c;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool parse_int(const std::string& s, long long lo, long long hi, long long* out) {
+  char* end = nullptr;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (end == s.c_str() || *end != '\0' || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+std::string stamp(double t) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(6) << t;
+  return os.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace fs = std::filesystem;
+  using namespace dyncull::sim;
+  if (argc < 2) return usage("missing OUTDIR");
+  const fs::path out = argv[1];
+  SceneOptions options;
+  for (int k = 2; k < argc; ++k) {
+    const std::string arg = argv[k];
+    const bool has_value = k + 1 < argc;
+    long long value = 0;
+    if (arg == "--motion" && has_value) {
+      if (!parse_motion(argv[++k], &options.motion)) return usage("unknown motion");
+    } else if (arg == "--frames" && has_value) {
+      if (!parse_int(argv[++k], 1, 1000000, &value)) return usage("--frames needs a positive integer");
+      options.num_frames = static_cast<int>(value);
+    } else if (arg == "--seed" && has_value) {
+      if (!parse_int(argv[++k], 0, 0x7FFFFFFFFFFFFFFFll, &value)) return usage("--seed needs a non-negative integer");
+      options.seed = static_cast<std::uint64_t>(value);
+    } else if (arg == "--clean-depth") {
+      options.depth_noise = false;
+    } else {
+      return usage(("unknown or incomplete argument " + arg).c_str());
+    }
+  }
+  const Scene scene(options);
+  if (!scene.ok()) return usage(scene.reason().c_str());
+
+  std::error_code ec;
+  for (const char* sub : {"rgb", "depth", "detections", "instance", "moving"}) {
+    fs::create_directories(out / sub, ec);
+    if (ec) {
+      std::cerr << "write_tum_sequence: cannot create " << (out / sub) << ": " << ec.message() << "\n";
+      return 1;
+    }
+  }
+  std::ofstream rgb_txt(out / "rgb.txt"), depth_txt(out / "depth.txt"), gt_txt(out / "groundtruth.txt"),
+      assoc_txt(out / "associations.txt"), det_txt(out / "detections.txt"), cam_txt(out / "camera.txt");
+  if (!rgb_txt || !depth_txt || !gt_txt || !assoc_txt || !det_txt || !cam_txt) {
+    std::cerr << "write_tum_sequence: cannot write the index files in " << out << "\n";
+    return 1;
+  }
+  const std::string name = std::string("dyncull synthetic ") + to_string(options.motion) + " seed " +
+                           std::to_string(options.seed);
+  rgb_txt << "# color images\n# file: '" << name << "'\n# timestamp filename\n";
+  depth_txt << "# depth maps\n# file: '" << name << "'\n# timestamp filename\n";
+  gt_txt << "# ground truth trajectory\n# file: '" << name << "'\n# timestamp tx ty tz qx qy qz qw\n";
+  det_txt << "# detections (YOLO style: class cx cy w h conf, normalised to the image size)\n# timestamp filename\n";
+  const auto cam = scene.camera();
+  cam_txt << "# pinhole camera, no distortion; depth PNG scale 5000 per metre\n# fx fy cx cy width height\n"
+          << std::setprecision(10) << cam.fx << ' ' << cam.fy << ' ' << cam.cx << ' ' << cam.cy << ' ' << cam.width
+          << ' ' << cam.height << '\n';
+
+  FrameData f;
+  cv::Mat bgr, depth16(options.height, options.width, CV_16UC1), moving8(options.height, options.width, CV_8UC1);
+  for (int index = 0; index < scene.num_frames(); ++index) {
+    scene.render(index, &f);
+    if (!f.ok()) {
+      std::cerr << "write_tum_sequence: frame " << index << ": " << f.reason << "\n";
+      return 1;
+    }
+    const std::string ts = stamp(f.timestamp);
+    const cv::Mat rgb(f.height, f.width, CV_8UC3, f.rgb.data());
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    for (int v = 0; v < f.height; ++v) {
+      auto* drow = depth16.ptr<std::uint16_t>(v);
+      auto* mrow = moving8.ptr<std::uint8_t>(v);
+      for (int u = 0; u < f.width; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(f.width) + static_cast<std::size_t>(u);
+        const double units = std::round(static_cast<double>(f.depth_m[i]) * 5000.0);
+        drow[u] = static_cast<std::uint16_t>(units > 65535.0 ? 0.0 : units);  // beyond 13.1 m: no measurement
+        mrow[u] = f.moving[i] ? 255 : 0;
+      }
+    }
+    const cv::Mat instance16(f.height, f.width, CV_16UC1, f.instance.data());
+    const std::string rgb_name = "rgb/" + ts + ".png", depth_name = "depth/" + ts + ".png",
+                      det_name = "detections/" + ts + ".txt";
+    const bool written = cv::imwrite((out / rgb_name).string(), bgr) &&
+                         cv::imwrite((out / depth_name).string(), depth16) &&
+                         cv::imwrite((out / "instance" / (ts + ".png")).string(), instance16) &&
+                         cv::imwrite((out / "moving" / (ts + ".png")).string(), moving8);
+    std::ofstream det(out / det_name);
+    if (!written || !det) {
+      std::cerr << "write_tum_sequence: cannot write frame " << index << " into " << out << "\n";
+      return 1;
+    }
+    det << std::setprecision(6);
+    for (const auto& d : f.detections) {
+      const auto c = d.box.centre();
+      det << d.class_id << ' ' << c.x() / f.width << ' ' << c.y() / f.height << ' ' << d.box.width() / f.width << ' '
+          << d.box.height() / f.height << ' ' << d.confidence << '\n';
+    }
+    rgb_txt << ts << ' ' << rgb_name << '\n';
+    depth_txt << ts << ' ' << depth_name << '\n';
+    assoc_txt << ts << ' ' << rgb_name << ' ' << ts << ' ' << depth_name << '\n';
+    det_txt << ts << ' ' << det_name << '\n';
+    const Eigen::Quaterniond q(f.world_from_cam.R);
+    gt_txt << ts << std::setprecision(9) << ' ' << f.world_from_cam.t.x() << ' ' << f.world_from_cam.t.y() << ' '
+           << f.world_from_cam.t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n';
+    if ((index + 1) % 50 == 0 || index + 1 == scene.num_frames())
+      std::cout << "wrote " << index + 1 << "/" << scene.num_frames() << " frames\n" << std::flush;
+  }
+  std::cout << "sequence '" << name << "' in " << out << "\n";
+  return 0;
+}
