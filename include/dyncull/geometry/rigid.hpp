@@ -39,6 +39,48 @@ struct AlignmentResult {
   }
 };
 
+/// One-pass accumulator of the weighted first and second moments of point pairs (src, dst), shifted by
+/// a reference pair to avoid cancellation. umeyama() and ICP feed it; solve() is Umeyama's closed form.
+template <class T>
+struct AlignmentAccumulator {
+  Vec3<T> s0 = Vec3<T>::Zero(), d0 = Vec3<T>::Zero();  ///< reference shift (any pair near the data)
+  Vec3<T> sum_s = Vec3<T>::Zero(), sum_d = Vec3<T>::Zero();
+  Mat3<T> sum_ds = Mat3<T>::Zero();
+  T sum_ss = T(0);
+  T sum_w = T(0);
+  std::size_t used = 0;  ///< pairs with positive weight
+
+  AlignmentAccumulator() = default;
+  AlignmentAccumulator(const Vec3<T>& src_ref, const Vec3<T>& dst_ref) : s0(src_ref), d0(dst_ref) {}
+  void reset(const Vec3<T>& src_ref, const Vec3<T>& dst_ref) { *this = AlignmentAccumulator(src_ref, dst_ref); }
+
+  template <class A, class B>
+  void add(const Eigen::MatrixBase<A>& src, const Eigen::MatrixBase<B>& dst) {
+    const Vec3<T> s = src - s0;
+    const Vec3<T> d = dst - d0;
+    sum_s += s;
+    sum_d += d;
+    sum_ds.noalias() += d * s.transpose();
+    sum_ss += s.squaredNorm();
+    sum_w += T(1);
+    ++used;
+  }
+  template <class A, class B>
+  void add(const Eigen::MatrixBase<A>& src, const Eigen::MatrixBase<B>& dst, T w) {
+    const Vec3<T> s = src - s0;
+    const Vec3<T> d = dst - d0;
+    const Vec3<T> ws = w * s;
+    sum_s += ws;
+    sum_d += w * d;
+    sum_ds.noalias() += d * ws.transpose();
+    sum_ss += ws.dot(s);
+    sum_w += w;
+    used += (w > T(0));
+  }
+  /// Least-squares dst_from_src of the accumulated pairs (statuses as umeyama()).
+  AlignmentResult<T> solve(const AlignmentOptions& options = {}) const;
+};
+
 /// Least-squares dst_from_src minimising sum_i w_i |dst_i - (s R src_i + t)|^2.
 /// src and dst are 3xN (any Eigen expression, column i corresponds); weights (optional) points to N
 /// non-negative finite weights. Fails with TooFewPoints below 3 points, Degenerate when the
@@ -78,25 +120,9 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
   }
 
   // Shift by the first pair: the one-pass moments then stay well conditioned for data far from the origin.
-  const Vec3<T> s0 = src.col(0);
-  const Vec3<T> d0 = dst.col(0);
-  Vec3<T> sum_s = Vec3<T>::Zero();
-  Vec3<T> sum_d = Vec3<T>::Zero();
-  Mat3<T> sum_ds = Mat3<T>::Zero();
-  T sum_ss = T(0);
-  T sum_w = T(0);
-  std::size_t used = 0;
+  AlignmentAccumulator<T> acc(src.col(0), dst.col(0));
   if (weights == nullptr) {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Vec3<T> s = src.col(i) - s0;
-      const Vec3<T> d = dst.col(i) - d0;
-      sum_s += s;
-      sum_d += d;
-      sum_ds.noalias() += d * s.transpose();
-      sum_ss += s.squaredNorm();
-    }
-    sum_w = T(n);
-    used = static_cast<std::size_t>(n);
+    for (Eigen::Index i = 0; i < n; ++i) acc.add(src.col(i), dst.col(i));
   } else {
     for (Eigen::Index i = 0; i < n; ++i) {
       const T w = weights[i];
@@ -105,17 +131,15 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
         result.reason = "umeyama: weight " + std::to_string(i) + " is negative or non-finite";
         return result;
       }
-      const Vec3<T> s = src.col(i) - s0;
-      const Vec3<T> d = dst.col(i) - d0;
-      const Vec3<T> ws = w * s;
-      sum_s += ws;
-      sum_d += w * d;
-      sum_ds.noalias() += d * ws.transpose();
-      sum_ss += ws.dot(s);
-      sum_w += w;
-      used += (w > T(0));
+      acc.add(src.col(i), dst.col(i), w);
     }
   }
+  return acc.solve(options);
+}
+
+template <class T>
+AlignmentResult<T> AlignmentAccumulator<T>::solve(const AlignmentOptions& options) const {
+  AlignmentResult<T> result;
   result.num_points = used;
   // NaN/Inf anywhere in the input propagates into the sums: one check instead of one per element.
   if (!sum_ds.allFinite() || !sum_s.allFinite() || !sum_d.allFinite() || !std::isfinite(sum_ss) ||
@@ -129,7 +153,6 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
     result.reason = "umeyama: need at least 3 points with positive weight, got " + std::to_string(used);
     return result;
   }
-
   const T inv_w = T(1) / sum_w;
   const Vec3<T> mean_s = sum_s * inv_w;
   const Vec3<T> mean_d = sum_d * inv_w;
