@@ -1,0 +1,102 @@
+#include "dyncull/culling/box_tracker.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <vector>
+
+namespace {
+using namespace dyncull;
+
+template <class T>
+class BoxTrackerT : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(BoxTrackerT, Scalars);
+
+template <class T>
+Detection<T> person_at(T x) {
+  return Detection<T>{Box<T>{x, T(100), x + T(80), T(400)}, 0, T(0.9)};
+}
+
+TYPED_TEST(BoxTrackerT, MissedDetectionIsCarriedForwardThenDropped) {
+  using T = TypeParam;
+  BoxTracker<T> tracker;  // grow 10 px per frame, drop after 2 missed frames
+  const int W = 640, H = 480;
+  // The person walks 6 px per frame to the right for three frames.
+  for (int f = 0; f < 3; ++f) {
+    const auto r = tracker.update({person_at(T(100 + 6 * f))}, W, H);
+    ASSERT_TRUE(r.ok());
+    ASSERT_EQ(r.boxes.size(), 1u);
+    EXPECT_EQ(r.carried[0], 0);
+    EXPECT_EQ(r.track_id[0], 0);
+  }
+  EXPECT_EQ(tracker.tracks()[0].hits, 3);
+  EXPECT_NEAR(tracker.tracks()[0].velocity.x(), T(4.5), T(1e-4));  // EMA 0.5 of 0, 6, 6
+  // Detector misses: carried with its velocity and grown.
+  auto r = tracker.update({}, W, H);
+  ASSERT_EQ(r.boxes.size(), 1u);
+  EXPECT_EQ(r.carried[0], 1);
+  EXPECT_EQ(r.num_carried, 1u);
+  EXPECT_NEAR(r.boxes[0].box.x0, T(112 + 4.5 - 10), T(1e-4));
+  EXPECT_NEAR(r.boxes[0].box.x1, T(192 + 4.5 + 10), T(1e-4));
+  EXPECT_NEAR(r.boxes[0].box.y0, T(90), T(1e-4));
+  r = tracker.update({}, W, H);
+  ASSERT_EQ(r.boxes.size(), 1u);
+  EXPECT_NEAR(r.boxes[0].box.x0, T(112 + 9 - 20), T(1e-4));
+  r = tracker.update({}, W, H);  // third miss: dropped
+  EXPECT_TRUE(r.boxes.empty());
+  EXPECT_EQ(r.num_dropped, 1u);
+  EXPECT_TRUE(tracker.tracks().empty());
+  // A new detection starts a new track.
+  r = tracker.update({person_at(T(300))}, W, H);
+  EXPECT_EQ(r.num_new, 1u);
+  EXPECT_EQ(r.track_id[0], 1);
+}
+
+TYPED_TEST(BoxTrackerT, RedetectionContinuesTheTrack) {
+  using T = TypeParam;
+  BoxTracker<T> tracker;
+  tracker.update({person_at(T(100))}, 640, 480);
+  tracker.update({person_at(T(110))}, 640, 480);
+  tracker.update({}, 640, 480);  // missed once
+  const auto r = tracker.update({person_at(T(130))}, 640, 480);
+  ASSERT_EQ(r.boxes.size(), 1u);
+  EXPECT_EQ(r.num_matched, 1u);
+  EXPECT_EQ(r.track_id[0], 0);
+  EXPECT_EQ(r.carried[0], 0);
+  // Velocity from the last real detection over the gap: (130 - 110) / 2 = 10 px per frame.
+  EXPECT_NEAR(tracker.tracks()[0].velocity.x(), T(0.5) * T(5) + T(0.5) * T(10), T(1e-4));
+}
+
+TYPED_TEST(BoxTrackerT, ClassesBoundsAndBadInput) {
+  using T = TypeParam;
+  BoxTracker<T> tracker;
+  tracker.update({person_at(T(100))}, 640, 480);
+  Detection<T> chair = person_at(T(100));
+  chair.class_id = 56;
+  auto r = tracker.update({chair}, 640, 480);  // same place, other class: new track, person carried
+  EXPECT_EQ(r.num_new, 1u);
+  EXPECT_EQ(r.num_carried, 1u);
+  EXPECT_EQ(r.boxes.size(), 2u);
+  // A box that leaves the image is dropped, not carried.
+  BoxTracker<T> edge;
+  edge.update({Detection<T>{Box<T>{T(600), T(100), T(639), T(200)}, 0, T(1)}}, 640, 480);
+  edge.update({Detection<T>{Box<T>{T(660), T(100), T(700), T(200)}, 0, T(1)}}, 640, 480);
+  EXPECT_EQ(edge.tracks().size(), 2u);
+  r = edge.update({}, 640, 480);
+  EXPECT_EQ(r.num_dropped, 1u);  // the off-image one
+  for (const auto& d : r.boxes) EXPECT_LE(d.box.x1, T(639));
+  // Invalid detections are ignored with a reason; a bad image size changes nothing.
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  BoxTracker<T> t2;
+  r = t2.update({Detection<T>{Box<T>{nan, T(0), T(10), T(10)}, 0, T(1)}}, 640, 480);
+  EXPECT_TRUE(r.ok());
+  EXPECT_FALSE(r.reason.empty());
+  EXPECT_TRUE(t2.tracks().empty());
+  EXPECT_EQ(t2.update({person_at(T(1))}, 0, 480).status, Status::InvalidInput);
+  EXPECT_TRUE(t2.tracks().empty());
+  t2.update({person_at(T(1))}, 640, 480);
+  t2.reset();
+  EXPECT_TRUE(t2.tracks().empty());
+}
+}  // namespace
