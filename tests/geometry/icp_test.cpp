@@ -17,25 +17,7 @@ using dyncull::Rigid3;
 using dyncull::Status;
 using dyncull::Vec3;
 
-/// A structured cloud (three planes and a sphere patch: well-constrained for ICP) with 2 cm spacing.
-template <class T>
-std::vector<Vec3<T>> room_cloud(Random& rng, int n) {
-  std::vector<Vec3<T>> pts;
-  for (int i = 0; i < n; ++i) {
-    const double a = rng.uniform(0, 2), b = rng.uniform(0, 2);
-    switch (i % 4) {
-      case 0: pts.push_back(Vec3<T>(T(a), T(b), T(0))); break;
-      case 1: pts.push_back(Vec3<T>(T(a), T(0), T(b))); break;
-      case 2: pts.push_back(Vec3<T>(T(0), T(a), T(b))); break;
-      default: {
-        Eigen::Vector3d d(rng.normal(), rng.normal(), rng.normal());
-        d = d.normalized() * 0.4 + Eigen::Vector3d(1, 1, 1);
-        pts.push_back(d.cast<T>());
-      }
-    }
-  }
-  return pts;
-}
+using dyncull::test::room_cloud;
 
 template <class T>
 class IcpTest : public ::testing::Test {};

@@ -75,6 +75,28 @@ PnpScene<T> make_pnp_scene(std::uint64_t seed, int n, double noise_px = 0.0, dou
   return s;
 }
 
+/// A structured cloud for ICP: three orthogonal 2 m planes and a sphere patch (well constrained in all
+/// six degrees of freedom), n points sampled uniformly at random.
+template <class T>
+std::vector<Vec3<T>> room_cloud(Random& rng, int n) {
+  std::vector<Vec3<T>> pts;
+  pts.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double a = rng.uniform(0, 2), b = rng.uniform(0, 2);
+    switch (i % 4) {
+      case 0: pts.push_back(Vec3<T>(T(a), T(b), T(0))); break;
+      case 1: pts.push_back(Vec3<T>(T(a), T(0), T(b))); break;
+      case 2: pts.push_back(Vec3<T>(T(0), T(a), T(b))); break;
+      default: {
+        Eigen::Vector3d d(rng.normal(), rng.normal(), rng.normal());
+        d = d.normalized() * 0.4 + Eigen::Vector3d(1, 1, 1);
+        pts.push_back(d.cast<T>());
+      }
+    }
+  }
+  return pts;
+}
+
 /// Rotation error in degrees and translation error (same units as t) between two poses.
 template <class T>
 double rotation_error_deg(const Rigid3<T>& a, const Rigid3<T>& b) {
