@@ -1,0 +1,218 @@
+/// @file projection.hpp
+/// Batch pinhole projection and back-projection, depth image to point cloud with dynamic pixels masked
+/// out (seed 002 eq. 5-6, with fy for y: the paper's eq. 6 divides y by fx, a typo), voxel downsampling.
+#pragma once
+
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/depth.hpp"
+#include "dyncull/core/mask.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dyncull {
+
+/// Projects world points through cam_from_world into pixels[0, n). Points with camera depth z <= 0 or
+/// non-finite coordinates get NaN pixels and valid[i] = 0 (valid and depth_m may be null).
+/// Returns the number of valid projections. pixels must hold world.size() elements.
+template <class T, class Points3>
+std::size_t project_points(const PinholeCamera<T>& camera, const Rigid3<T>& cam_from_world, const Points3& world,
+                           Vec2<T>* pixels, std::uint8_t* valid = nullptr, T* depth_m = nullptr) {
+  static_assert(is_point_container_v<Points3> && PointTraits<container_point_t<Points3>>::dim == 3,
+                "project_points: world must be a container of 3-D points");
+  const std::size_t n = static_cast<std::size_t>(world.size());
+  const Mat3<T> R = cam_from_world.R;
+  const Vec3<T> t = cam_from_world.t;
+  const T fx = camera.fx, fy = camera.fy, cx = camera.cx, cy = camera.cy;
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3<T> p = R * to_vec3<T>(world[i]) + t;
+    const bool ok = p(2) > T(0) && p.allFinite();
+    const T iz = T(1) / p(2);
+    pixels[i] = ok ? Vec2<T>(fx * p(0) * iz + cx, fy * p(1) * iz + cy) : Vec2<T>(nan, nan);
+    if (valid) valid[i] = static_cast<std::uint8_t>(ok);
+    if (depth_m) depth_m[i] = p(2);
+    count += ok;
+  }
+  return count;
+}
+
+/// Back-projects pixels at depths (metres along the optical axis) into camera-frame points (eq. 6:
+/// x = (u - cx) z / fx, y = (v - cy) z / fy). Depth <= 0 or non-finite gives a NaN point.
+/// Returns the number of finite points. out must hold pixels.size() elements.
+template <class T, class Points2>
+std::size_t backproject_points(const PinholeCamera<T>& camera, const Points2& pixels, const T* depths_m,
+                               Vec3<T>* out) {
+  static_assert(is_point_container_v<Points2>, "backproject_points: pixels must be a container of 2-D points");
+  const std::size_t n = static_cast<std::size_t>(pixels.size());
+  const T ifx = T(1) / camera.fx, ify = T(1) / camera.fy;
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const T z = depths_m[i];
+    const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
+    const bool ok = z > T(0) && std::isfinite(z) && std::isfinite(u) && std::isfinite(v);
+    out[i] = ok ? Vec3<T>((u - camera.cx) * z * ifx, (v - camera.cy) * z * ify, z) : Vec3<T>(nan, nan, nan);
+    count += ok;
+  }
+  return count;
+}
+
+/// A point cloud from a depth image, in the camera frame.
+template <class T>
+struct DepthCloud {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::vector<Vec3<T>> points;
+  std::vector<std::uint32_t> pixel_index;  ///< v * width + u of each point (to look up colour or labels)
+  std::size_t num_excluded = 0;            ///< sampled pixels dropped by the exclude mask
+  std::size_t num_missing = 0;             ///< sampled pixels without a depth measurement
+};
+
+/// Depth image -> camera-frame points for every stride-th pixel in u and v that has a measurement
+/// (DepthView::depth_m() > 0) and is not set in `exclude` (dynamic pixels; empty = keep all).
+/// Depths pass through DepthView::to_metres(), which is float: double clouds carry float-precision
+/// depth (1e-7 relative, far below any sensor's noise). Reuses out's buffers. InvalidInput for an empty depth view, stride < 1, an invalid camera, or an
+/// exclude mask / camera whose size differs from the depth image.
+template <class T, class Raw>
+Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& camera, ConstMaskView exclude,
+                       int stride, DepthCloud<T>* out) {
+  out->points.clear();
+  out->pixel_index.clear();
+  out->num_excluded = 0;
+  out->num_missing = 0;
+  out->status = Status::Ok;
+  out->reason.clear();
+  auto fail = [&](std::string why) {
+    out->status = Status::InvalidInput;
+    out->reason = "depth_to_points: " + std::move(why);
+    return out->status;
+  };
+  if (depth.empty()) return fail("empty depth image");
+  if (stride < 1) return fail("stride must be >= 1");
+  if (!camera.valid()) return fail("invalid camera intrinsics");
+  if (camera.width != depth.width || camera.height != depth.height)
+    return fail("camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                " but the depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height));
+  if (!exclude.empty() && (exclude.width != depth.width || exclude.height != depth.height))
+    return fail("exclude mask size differs from the depth image");
+  const int w = depth.width, h = depth.height;
+  const std::size_t cols = static_cast<std::size_t>((w + stride - 1) / stride);
+  const std::size_t rows = static_cast<std::size_t>((h + stride - 1) / stride);
+  out->points.reserve(cols * rows);
+  out->pixel_index.reserve(cols * rows);
+  const T ifx = T(1) / camera.fx, ify = T(1) / camera.fy;
+  const bool use_mask = !exclude.empty();
+  std::size_t excluded = 0, missing = 0;
+  for (int v = 0; v < h; v += stride) {
+    const Raw* drow = depth.row(v);
+    const std::uint8_t* mrow = use_mask ? exclude.row(v) : nullptr;
+    const T y_over_z = (T(v) - camera.cy) * ify;  // eq. 6 with fy (the paper's fx is a typo)
+    for (int u = 0; u < w; u += stride) {
+      if (mrow && mrow[u]) {
+        ++excluded;
+        continue;
+      }
+      const T z = static_cast<T>(depth.to_metres(drow[u]));
+      if (!(z > T(0))) {
+        ++missing;
+        continue;
+      }
+      out->points.emplace_back((T(u) - camera.cx) * ifx * z, y_over_z * z, z);
+      out->pixel_index.push_back(static_cast<std::uint32_t>(v) * static_cast<std::uint32_t>(w) +
+                                 static_cast<std::uint32_t>(u));
+    }
+  }
+  out->num_excluded = excluded;
+  out->num_missing = missing;
+  return Status::Ok;
+}
+
+/// Contract #5 form: returns the cloud by value.
+template <class T, class Raw>
+DepthCloud<T> depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& camera,
+                              ConstMaskView exclude = {}, int stride = 1) {
+  DepthCloud<T> cloud;
+  depth_to_points(depth, camera, exclude, stride, &cloud);
+  return cloud;
+}
+
+/// Voxel-grid downsampling: one point per occupied cubic voxel of side voxel_size_m, the centroid
+/// of its points (as Open3D's VoxelDownSample), ordered by voxel. Keeps its sort buffer between calls
+/// so repeated use does not allocate once warm.
+template <class T>
+class VoxelDownsampler {
+ public:
+  /// Non-finite input points are skipped. InvalidInput when voxel_size_m <= 0 or the cloud spans
+  /// more than 2^21 voxels along an axis (voxel too small for the extent).
+  template <class Points>
+  Status run(const Points& in, T voxel_size_m, std::vector<Vec3<T>>* out, std::string* reason = nullptr) {
+    static_assert(is_point_container_v<Points> && PointTraits<container_point_t<Points>>::dim == 3,
+                  "voxel_downsample: input must be a container of 3-D points");
+    out->clear();
+    auto fail = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(voxel_size_m > T(0)) || !std::isfinite(voxel_size_m)) return fail("voxel_size_m must be finite and > 0");
+    const std::size_t n = static_cast<std::size_t>(in.size());
+    Vec3<T> lo = Vec3<T>::Constant(std::numeric_limits<T>::max());
+    Vec3<T> hi = Vec3<T>::Constant(std::numeric_limits<T>::lowest());
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3<T> p = to_vec3<T>(in[i]);
+      if (!p.allFinite()) continue;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    if (!(hi(0) >= lo(0))) return Status::Ok;  // no finite point: empty output
+    const T inv = T(1) / voxel_size_m;
+    constexpr double kMaxCells = double(1u << 21);
+    if (static_cast<double>((hi - lo).maxCoeff()) * static_cast<double>(inv) >= kMaxCells - 1)
+      return fail("voxel_size_m too small for the cloud's extent (more than 2^21 voxels per axis)");
+    keys_.clear();
+    keys_.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3<T> p = to_vec3<T>(in[i]);
+      if (!p.allFinite()) continue;
+      const Vec3<T> c = ((p - lo) * inv).array().floor();
+      const std::uint64_t key = (static_cast<std::uint64_t>(c(0)) << 42) | (static_cast<std::uint64_t>(c(1)) << 21) |
+                                static_cast<std::uint64_t>(c(2));
+      keys_.emplace_back(key, static_cast<std::uint32_t>(i));
+    }
+    std::sort(keys_.begin(), keys_.end());
+    for (std::size_t a = 0; a < keys_.size();) {
+      std::size_t b = a;
+      Vec3<double> sum = Vec3<double>::Zero();  // double sums: float centroids of dense voxels stay exact
+      while (b < keys_.size() && keys_[b].first == keys_[a].first) {
+        sum += to_vec3<T>(in[keys_[b].second]).template cast<double>();
+        ++b;
+      }
+      out->push_back((sum / static_cast<double>(b - a)).template cast<T>());
+      a = b;
+    }
+    return Status::Ok;
+  }
+
+ private:
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keys_;
+};
+
+/// One-shot voxel downsampling (see VoxelDownsampler).
+template <class T, class Points>
+Status voxel_downsample(const Points& in, T voxel_size_m, std::vector<Vec3<T>>* out, std::string* reason = nullptr) {
+  VoxelDownsampler<T> d;
+  return d.run(in, voxel_size_m, out, reason);
+}
+
+}  // namespace dyncull
