@@ -138,8 +138,9 @@ inline std::size_t sorted_unique_stamp_order(const double* stamps, std::size_t n
     if (std::isfinite(stamps[i])) order->push_back(static_cast<std::uint32_t>(i));
   }
   // Stable sort keeps file order among equal stamps, so the last of a run is the last in the file.
-  std::stable_sort(order->begin(), order->end(),
-                   [stamps](std::uint32_t a, std::uint32_t b) { return stamps[a] < stamps[b]; });
+  // Trajectory files are almost always written in time order: check before sorting.
+  const auto by_stamp = [stamps](std::uint32_t a, std::uint32_t b) { return stamps[a] < stamps[b]; };
+  if (!std::is_sorted(order->begin(), order->end(), by_stamp)) std::stable_sort(order->begin(), order->end(), by_stamp);
   std::size_t kept = 0;
   std::size_t dropped = 0;
   for (std::size_t k = 0; k < order->size(); ++k) {
@@ -330,8 +331,7 @@ inline AssociationResult associate(const double* first, std::size_t num_first, c
 
   struct Candidate {
     double diff;
-    std::uint32_t ia;  // positions in a / b (sorted order, so comparing them compares the stamps)
-    std::uint32_t ib;
+    std::uint64_t ab;  // (position in a) << 32 | (position in b): sorted positions, so ordering them orders the stamps
   };
   std::vector<Candidate> candidates;
   candidates.reserve(a.size() + b.size());
@@ -347,24 +347,24 @@ inline AssociationResult associate(const double* first, std::size_t num_first, c
       if (shifted - ta >= max_diff) break;
       const double diff = std::abs(ta - shifted);  // the exact expression associate.py tests
       if (diff < max_diff) {
-        candidates.push_back(Candidate{diff, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j)});
+        candidates.push_back(Candidate{diff, (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint64_t>(j)});
       }
     }
   }
   // Python sorts the tuples (diff, a, b): ties on diff go to the earlier first stamp, then second.
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-    if (x.diff != y.diff) return x.diff < y.diff;
-    if (x.ia != y.ia) return x.ia < y.ia;
-    return x.ib < y.ib;
+    return x.diff < y.diff || (x.diff == y.diff && x.ab < y.ab);
   });
   std::vector<std::uint8_t> used_a(a.size(), 0);
   std::vector<std::uint8_t> used_b(b.size(), 0);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> matches;  // (position in a, position in b)
   for (const Candidate& c : candidates) {
-    if (used_a[c.ia] || used_b[c.ib]) continue;
-    used_a[c.ia] = 1;
-    used_b[c.ib] = 1;
-    matches.emplace_back(c.ia, c.ib);
+    const std::uint32_t ia = static_cast<std::uint32_t>(c.ab >> 32);
+    const std::uint32_t ib = static_cast<std::uint32_t>(c.ab & 0xffffffffu);
+    if (used_a[ia] || used_b[ib]) continue;
+    used_a[ia] = 1;
+    used_b[ib] = 1;
+    matches.emplace_back(ia, ib);
   }
   std::sort(matches.begin(), matches.end());
   result.first.reserve(matches.size());
