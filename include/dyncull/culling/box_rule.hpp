@@ -59,35 +59,18 @@ namespace detail {
 template <class Dets>
 using detection_scalar_t = std::decay_t<decltype(std::declval<const Dets&>()[std::size_t{0}].box.x0)>;
 
-/// Boxes of one level as structure-of-arrays, so the point loop is branch-free and vectorises.
-template <class T>
-struct BoxSoA {
-  std::vector<T> x0, y0, x1, y1;
-  std::vector<std::int32_t> index;
-  void push(const Box<T>& b, std::int32_t i) {
-    x0.push_back(b.x0);
-    y0.push_back(b.y0);
-    x1.push_back(b.x1);
-    y1.push_back(b.y1);
-    index.push_back(i);
-  }
-  std::size_t size() const { return x0.size(); }
-};
+constexpr std::uint8_t kInHigh = 1, kInMedium = 2, kInLow = 4;
 
-/// in[i] |= point i lies in any box; first[i] = index of the first containing box (kept if none).
+/// flags[i] |= bit when point i lies in the box: branch-free over structure-of-arrays points,
+/// bounds in locals so the store to flags cannot alias them (PERFORMANCE.md).
 template <class T>
-void points_in_boxes(const T* xs, const T* ys, std::size_t n, const BoxSoA<T>& boxes, std::uint8_t* in,
-                     std::int32_t* first) {
-  // Reverse order so the lowest-index box wins the select without a branch.
-  for (std::size_t b = boxes.size(); b-- > 0;) {
-    const T bx0 = boxes.x0[b], by0 = boxes.y0[b], bx1 = boxes.x1[b], by1 = boxes.y1[b];
-    const std::int32_t id = boxes.index[b];
-    for (std::size_t i = 0; i < n; ++i) {
-      const unsigned inside =
-          unsigned(xs[i] >= bx0) & unsigned(xs[i] <= bx1) & unsigned(ys[i] >= by0) & unsigned(ys[i] <= by1);
-      in[i] = static_cast<std::uint8_t>(in[i] | static_cast<std::uint8_t>(inside));
-      if (first) first[i] = inside != 0 ? id : first[i];
-    }
+void mark_points_in_box(const T* xs, const T* ys, std::size_t n, const Box<T>& box, std::uint8_t bit,
+                        std::uint8_t* flags) {
+  const T bx0 = box.x0, by0 = box.y0, bx1 = box.x1, by1 = box.y1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned inside =
+        unsigned(xs[i] >= bx0) & unsigned(xs[i] <= bx1) & unsigned(ys[i] >= by0) & unsigned(ys[i] <= by1);
+    flags[i] = static_cast<std::uint8_t>(flags[i] | (inside * bit));
   }
 }
 }  // namespace detail
@@ -104,7 +87,11 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
   r.reasons.assign(n, CullReason::None);
   r.box_index.assign(n, -1);
 
-  detail::BoxSoA<T> high, medium, low;
+  // Effective boxes (padded / shrunk) with their level bit; detection index kept for box_index.
+  std::vector<Box<T>> boxes;
+  std::vector<std::uint8_t> bits;
+  std::vector<std::int32_t> source;
+  boxes.reserve(detections.size());
   std::size_t skipped = 0;
   for (std::size_t b = 0; b < detections.size(); ++b) {
     const Detection<T>& d = detections[b];
@@ -114,61 +101,92 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
       ++skipped;
       continue;
     }
-    const auto id = static_cast<std::int32_t>(b);
-    if (level == MotionLevel::High) high.push(d.box.padded(options.high_padding_px), id);
-    else if (level == MotionLevel::Medium) medium.push(d.box, id);
-    else {
-      const Box<T> s = d.box.padded(-options.low_shrink_px);
-      if (s.valid()) low.push(s, id);
+    Box<T> e = d.box;
+    std::uint8_t bit = detail::kInMedium;
+    if (level == MotionLevel::High) {
+      e = d.box.padded(options.high_padding_px);
+      bit = detail::kInHigh;
+      ++r.num_high_boxes;
+    } else if (level == MotionLevel::Low) {
+      e = d.box.padded(-options.low_shrink_px);
+      bit = detail::kInLow;
+      if (!e.valid()) continue;
+      ++r.num_low_boxes;
+    } else {
+      ++r.num_medium_boxes;
     }
+    boxes.push_back(e);
+    bits.push_back(bit);
+    source.push_back(static_cast<std::int32_t>(b));
   }
-  r.num_high_boxes = high.size();
-  r.num_medium_boxes = medium.size();
-  r.num_low_boxes = low.size();
   if (skipped) r.reason = std::to_string(skipped) + " invalid box(es) skipped";
 
+  // NaN / Inf coordinates compare false against every finite bound: never inside a box.
   std::vector<T> xs(n), ys(n);
-  std::vector<std::uint8_t> in_high(n, 0), in_medium(n, 0), in_low(n, 0), bad(n, 0);
-  std::vector<std::int32_t> medium_index(n, -1);
+  std::vector<std::uint8_t> flags(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
-    const bool finite = std::isfinite(x) && std::isfinite(y);
-    bad[i] = static_cast<std::uint8_t>(!finite);
-    // Non-finite points are parked far outside every box; their label is set below.
-    xs[i] = finite ? x : T(-1e30);
-    ys[i] = finite ? y : T(-1e30);
+    xs[i] = point_x<T>(points[i]);
+    ys[i] = point_y<T>(points[i]);
   }
-  detail::points_in_boxes(xs.data(), ys.data(), n, high, in_high.data(), r.box_index.data());
-  detail::points_in_boxes(xs.data(), ys.data(), n, medium, in_medium.data(), medium_index.data());
-  detail::points_in_boxes<T>(xs.data(), ys.data(), n, low, in_low.data(), nullptr);
+  for (std::size_t b = 0; b < boxes.size(); ++b)
+    detail::mark_points_in_box(xs.data(), ys.data(), n, boxes[b], bits[b], flags.data());
 
-  const FeatureLabel high_label = options.high_as_candidate ? FeatureLabel::Candidate : FeatureLabel::Dynamic;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (bad[i]) {
-      r.labels[i] = FeatureLabel::Dynamic;
-      r.reasons[i] = CullReason::InvalidInput;
-      ++r.num_non_finite;
-    } else if (in_high[i]) {
-      if (in_low[i]) {
-        r.reasons[i] = CullReason::LowLevelOverride;
-        ++r.num_low_override;
+  // Decision table over the three membership bits.
+  FeatureLabel label_of[8];
+  CullReason reason_of[8];
+  for (unsigned f = 0; f < 8; ++f) {
+    const bool high = f & detail::kInHigh, medium = f & detail::kInMedium, low = f & detail::kInLow;
+    label_of[f] = FeatureLabel::Static;
+    reason_of[f] = CullReason::None;
+    if (high) {
+      if (low) {
+        reason_of[f] = CullReason::LowLevelOverride;
       } else {
-        r.labels[i] = high_label;
-        r.reasons[i] = CullReason::HighLevelBox;
+        label_of[f] = options.high_as_candidate ? FeatureLabel::Candidate : FeatureLabel::Dynamic;
+        reason_of[f] = CullReason::HighLevelBox;
       }
-    } else if (in_medium[i]) {
-      r.box_index[i] = medium_index[i];
-      if (in_low[i] && options.low_overrides_medium) {
-        r.reasons[i] = CullReason::LowLevelOverride;
-        ++r.num_low_override;
+    } else if (medium) {
+      if (low && options.low_overrides_medium) {
+        reason_of[f] = CullReason::LowLevelOverride;
       } else if (options.medium_as_candidate) {
-        r.labels[i] = FeatureLabel::Candidate;
-        r.reasons[i] = CullReason::MediumLevelBox;
+        label_of[f] = FeatureLabel::Candidate;
+        reason_of[f] = CullReason::MediumLevelBox;
       }
     }
-    r.num_dynamic += r.labels[i] == FeatureLabel::Dynamic;
-    r.num_candidate += r.labels[i] == FeatureLabel::Candidate;
   }
+  // Counters in locals: stores through `r` would alias the label stores and serialise the loop.
+  std::size_t num_dynamic = 0, num_candidate = 0, num_override = 0, num_bad = 0;
+  FeatureLabel* labels = r.labels.data();
+  CullReason* reasons = r.reasons.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t f = flags[i];
+    FeatureLabel label = label_of[f];
+    CullReason reason = reason_of[f];
+    if (!(xs[i] - xs[i] == T(0) && ys[i] - ys[i] == T(0))) {  // non-finite: never trusted as static
+      label = FeatureLabel::Dynamic;
+      reason = CullReason::InvalidInput;
+      ++num_bad;
+    }
+    labels[i] = label;
+    reasons[i] = reason;
+    num_override += reason == CullReason::LowLevelOverride;
+    num_dynamic += label == FeatureLabel::Dynamic;
+    num_candidate += label == FeatureLabel::Candidate;
+    if (f & (detail::kInHigh | detail::kInMedium)) {
+      // Few points are boxed: find the deciding box (first high, else first medium) directly.
+      const std::uint8_t want = (f & detail::kInHigh) ? detail::kInHigh : detail::kInMedium;
+      for (std::size_t b = 0; b < boxes.size(); ++b) {
+        if (bits[b] == want && boxes[b].contains(xs[i], ys[i])) {
+          r.box_index[i] = source[b];
+          break;
+        }
+      }
+    }
+  }
+  r.num_dynamic = num_dynamic;
+  r.num_candidate = num_candidate;
+  r.num_low_override = num_override;
+  r.num_non_finite = num_bad;
   r.num_static = n - r.num_dynamic - r.num_candidate;
   return r;
 }
