@@ -126,6 +126,7 @@ BENCHMARK(BM_NearestKeyframes)->Arg(200)->Arg(1000);
 
 #ifdef DYNCULL_HAS_OPENCV
 void BM_OpenCvBfMatcherHamming(benchmark::State& state) {
+  cv::setNumThreads(1);  // one thread like ours (Google Benchmark's CPU time misses worker threads)
   const std::size_t n = static_cast<std::size_t>(state.range(0));
   const BinaryData d(n);
   const cv::Mat Q(int(n), 32, CV_8UC1, const_cast<std::uint8_t*>(d.q.data()));
@@ -140,6 +141,7 @@ void BM_OpenCvBfMatcherHamming(benchmark::State& state) {
 BENCHMARK(BM_OpenCvBfMatcherHamming)->Args({1000, 0})->Args({1000, 1})->Args({300, 0});
 
 void BM_OpenCvBfMatcherL2(benchmark::State& state) {
+  cv::setNumThreads(1);
   const std::size_t n = static_cast<std::size_t>(state.range(0));
   const int dim = static_cast<int>(state.range(1));
   const FloatData d(n, dim);
@@ -155,6 +157,7 @@ void BM_OpenCvBfMatcherL2(benchmark::State& state) {
 BENCHMARK(BM_OpenCvBfMatcherL2)->Args({1000, 256})->Args({300, 256});
 
 void BM_OpenCvNormKeyframes(benchmark::State& state) {
+  cv::setNumThreads(1);
   const std::size_t n = static_cast<std::size_t>(state.range(0));
   const int dim = 4096;
   const auto lib = random_floats(n * dim, 9);
