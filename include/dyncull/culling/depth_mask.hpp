@@ -79,8 +79,10 @@ struct DepthMaskOptions {
   /// Mask box pixels without a depth measurement too: inside a dynamic object's box an unknown
   /// pixel cannot be trusted, and Kinect holes cluster at object boundaries.
   bool mask_missing_depth = true;
-  /// Histogram fallback (rule not applicable): bins of this width from 0 to histogram_max_m.
+  /// Histogram fallback (rule not applicable): bins of this width from 0 to histogram_max_m,
+  /// over every histogram_stride_px-th row and column (a statistic: 1/4 of the pixels suffice).
   double histogram_bin_m = 0.1;
+  int histogram_stride_px = 2;
   double histogram_max_m = 12.0;
   /// A bin is occupied when it holds at least this fraction of the box's valid pixels.
   double histogram_occupied_fraction = 0.002;
@@ -106,7 +108,7 @@ struct DepthMaskBoxInfo {
   double threshold_raw = 0;   ///< exclusive threshold in the view's raw units (TUM: 13085 for 2.617 m)
   bool masks_missing = false; ///< pixels without depth are part of this box's mask
   std::size_t num_mask_pixels = 0;  ///< counted only when a raster was written
-  std::size_t num_valid_pixels = 0; ///< counted only in the histogram fallback
+  std::size_t num_valid_pixels = 0; ///< sampled pixels with depth (histogram fallback only)
 };
 
 struct DepthMaskResult {
@@ -348,20 +350,25 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     // Histogram fallback: the foreground cluster that holds d_c (or the nearest big cluster).
     const double bin_raw = std::max(o.histogram_bin_m, 1e-3) * upm;
     const int nb = std::max(1, static_cast<int>(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3))));
-    std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb), 0u);
-    std::size_t valid = 0;
-    const double inv_bin = 1.0 / bin_raw;
-    for (int y = rc.r0; y < rc.r1; ++y) {
+    // One extra bin collects invalid pixels, so the scatter loop has no branch.
+    std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb) + 1, 0u);
+    const int step = std::max(1, o.histogram_stride_px);
+    const float inv_bin = static_cast<float>(1.0 / bin_raw);
+    const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
+    for (int y = rc.r0; y < rc.r1; y += step) {
       const Raw* d = v.row(y);
-      for (int x = rc.c0; x < rc.c1; ++x) {
-        if (!raw_valid(d[x], range)) continue;
-        const int b = std::min(nb - 1, static_cast<int>(static_cast<double>(d[x]) * inv_bin));
+      for (int x = rc.c0; x < rc.c1; x += step) {
+        const float f = static_cast<float>(d[x]);
+        const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
+        const int b = ok ? std::min(nb - 1, static_cast<int>(f * inv_bin)) : nb;
         ++hist[static_cast<std::size_t>(b)];
-        ++valid;
       }
     }
+    const std::size_t sampled = static_cast<std::size_t>((rc.height() + step - 1) / step) *
+                                static_cast<std::size_t>((rc.width() + step - 1) / step);
+    const std::size_t valid = sampled - hist[static_cast<std::size_t>(nb)];
     info.num_valid_pixels = valid;
-    if (static_cast<double>(valid) < o.min_valid_fraction * static_cast<double>(rc.area()) || valid == 0) {
+    if (static_cast<double>(valid) < o.min_valid_fraction * static_cast<double>(sampled) || valid == 0) {
       whole_box();
       info.reason = "too few pixels with depth: whole box";
     } else {
