@@ -51,8 +51,9 @@ struct ActorOptions {
   bool sitting_person = true;          ///< person on a chair moving head, torso and arms only
   bool pushed_chair = true;            ///< chair that slides once, pushed between push_start_s and push_end_s
   double walking_speed_mps = 1.0;      ///< mean walking speed along the loop
-  Vec2<double> loop_centre_m{-0.1, 1.6};  ///< centre of the walking loop on the floor (world x, y)
-  Vec2<double> loop_semi_axes_m{0.9, 0.5};  ///< semi-axes of the loop; camera rests at y = -0.3
+  Vec2<double> loop_centre_m{-0.1, 1.45};  ///< centre of the walking loop on the floor (world x, y)
+  Vec2<double> loop_semi_axes_m{0.9, 0.65};  ///< semi-axes of the loop; camera rests at y = -0.3
+  double walker_gap_rad = 3.141592653589793;  ///< phase of walker B behind walker A on the loop
   double push_start_s = 3.5;           ///< chair starts moving (seconds from the first frame)
   double push_end_s = 5.0;             ///< chair stops moving
   double texture_scale = 1.0;          ///< multiplies every texture cell size (smaller = more corners)
@@ -108,7 +109,7 @@ inline void add_walker(PrimitiveSink& sink, const Rigid3<double>& world_from_per
   const double bob = 0.02 * std::cos(2.0 * gait_phase);
   auto W = [&](const Rigid3<double>& person_from_part) { return world_from_person * person_from_part; };
   const Mat3<double> I = Mat3<double>::Identity();
-  constexpr double kCloth = 0.05, kSkin = 0.04;
+  constexpr double kCloth = 0.04, kSkin = 0.04;
   sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0, 0, 0.95 + bob})), {0.11, 0.17, 0.12}, instance, true,
            c.seed + 1, kCloth, c.trousers);
   sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0, 0, 1.27 + bob})), {0.13, 0.21, 0.29}, instance, true,
@@ -128,7 +129,7 @@ inline void add_walker(PrimitiveSink& sink, const Rigid3<double>& world_from_per
 inline void add_sitting_person(PrimitiveSink& sink, const Rigid3<double>& world_from_person, double t,
                                std::uint16_t instance, const Clothes& c) {
   constexpr double kTwoPi = 6.283185307179586;
-  constexpr double kCloth = 0.05, kSkin = 0.04;
+  constexpr double kCloth = 0.04, kSkin = 0.04;
   const Mat3<double> I = Mat3<double>::Identity();
   auto W = [&](const Rigid3<double>& person_from_part) { return world_from_person * person_from_part; };
   // Legs and pelvis: static.
@@ -194,8 +195,8 @@ inline Rigid3<double> walker_pose(double t, int walker, const ActorOptions& opti
   const double a = options.loop_semi_axes_m.x(), b = options.loop_semi_axes_m.y();
   const double mean_radius = std::sqrt(0.5 * (a * a + b * b));
   const double omega = options.walking_speed_mps / mean_radius;
-  // Walkers start half a loop apart; the seed shifts the start by up to ~0.3 rad.
-  const double phase0 = 3.141592653589793 * walker + 0.3 * static_cast<double>(seed % 97) / 97.0;
+  // Walker B follows walker A by walker_gap_rad on the loop; the seed shifts the start by up to ~0.3 rad.
+  const double phase0 = -options.walker_gap_rad * walker + 0.3 * static_cast<double>(seed % 97) / 97.0;
   const double phi = phase0 + omega * t;
   const Vec3<double> pos(options.loop_centre_m.x() + a * std::cos(phi), options.loop_centre_m.y() + b * std::sin(phi),
                          0.0);
@@ -221,7 +222,7 @@ inline void build_scene(double t, double frame_dt, std::uint64_t seed, const Act
   using detail::make_pose;
   constexpr std::uint16_t kBg = SceneInstance::kBackground;
   // Room: x in [-3, 3], y in [-1.5, 4.6], z in [0, 2.8].
-  sink.add(PrimitiveShape::RoomInterior, make_pose(I, {0, 1.55, 1.4}), {3.0, 3.05, 1.4}, kBg, false, tex + 100, 0.16,
+  sink.add(PrimitiveShape::RoomInterior, make_pose(I, {0, 1.55, 1.4}), {3.0, 3.05, 1.4}, kBg, false, tex + 100, 0.2,
            {0.85, 0.82, 0.75});
   // Furniture: cabinet under the TV, desk, shelf, two posters.
   sink.add(PrimitiveShape::Box, make_pose(I, {0, 4.3, 0.35}), {0.8, 0.25, 0.35}, kBg, false, tex + 110, 0.08,
