@@ -1,6 +1,9 @@
 // PnP-RANSAC and pose refinement: dyncull vs cv::solvePnPRansac (P3P, EPnP) and cv::solvePnPRefineLM,
 // 1000 (and 100) correspondences, 0.5 px noise, 30 % outliers; accuracy as counters.
 #include "dyncull/geometry/pnp.hpp"
+#ifdef DYNCULL_HAS_CERES
+#include "dyncull/ceres/pose_refinement.hpp"
+#endif
 
 #include "support/pose_data.hpp"
 
@@ -61,6 +64,21 @@ void BM_dyncull_refine_pose(benchmark::State& state) {
   state.counters["rot_err_deg"] = rotation_error_deg(r.cam_from_world, s.cam_from_world);
 }
 BENCHMARK(BM_dyncull_refine_pose)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+#ifdef DYNCULL_HAS_CERES
+void BM_ceres_refine_pose(benchmark::State& state) {
+  auto s = make_pnp_scene<double>(200, static_cast<int>(state.range(0)), 0.5, 0.0);
+  Rigid3<double> start = s.cam_from_world;
+  start.t += dyncull::Vec3<double>(0.02, -0.01, 0.03);
+  for (auto _ : state) {
+    const auto r = dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, start);
+    benchmark::DoNotOptimize(r.cam_from_world.t.data());
+  }
+  const auto r = dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, start);
+  state.counters["rot_err_deg"] = rotation_error_deg(r.cam_from_world, s.cam_from_world);
+}
+BENCHMARK(BM_ceres_refine_pose)->Arg(1000)->Unit(benchmark::kMicrosecond);
+#endif
 
 #ifdef DYNCULL_HAS_OPENCV
 struct CvScene {

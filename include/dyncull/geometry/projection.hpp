@@ -88,13 +88,13 @@ struct DepthCloud {
 template <class T, class Raw>
 Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& camera, ConstMaskView exclude,
                        int stride, DepthCloud<T>* out) {
-  out->points.clear();
-  out->pixel_index.clear();
   out->num_excluded = 0;
   out->num_missing = 0;
   out->status = Status::Ok;
   out->reason.clear();
   auto fail = [&](std::string why) {
+    out->points.clear();
+    out->pixel_index.clear();
     out->status = Status::InvalidInput;
     out->reason = "depth_to_points: " + std::move(why);
     return out->status;
@@ -110,30 +110,42 @@ Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& came
   const int w = depth.width, h = depth.height;
   const std::size_t cols = static_cast<std::size_t>((w + stride - 1) / stride);
   const std::size_t rows = static_cast<std::size_t>((h + stride - 1) / stride);
-  out->points.reserve(cols * rows);
-  out->pixel_index.reserve(cols * rows);
-  const T ifx = T(1) / camera.fx, ify = T(1) / camera.fy;
+  // Sized for every sampled pixel, written branch-free at slot k (a rejected pixel is overwritten by
+  // the next one), trimmed at the end: no per-pixel capacity checks, no reallocation once warm.
+  out->points.resize(cols * rows);
+  out->pixel_index.resize(cols * rows);
+  Vec3<T>* P = out->points.data();
+  std::uint32_t* I = out->pixel_index.data();
+  std::vector<T> x_over_z(cols);
+  for (std::size_t c = 0; c < cols; ++c) x_over_z[c] = (T(c * static_cast<std::size_t>(stride)) - camera.cx) / camera.fx;
+  // Multiply by the inverse scale: equal to DepthView::to_metres() up to one ulp. NaN fails every
+  // comparison and +inf fails d <= max_m, so the range test also rejects non-finite raw values.
+  const float inv_units = 1.f / depth.units_per_metre;
+  const float min_m = depth.min_m, max_m = depth.max_m;
   const bool use_mask = !exclude.empty();
-  std::size_t excluded = 0, missing = 0;
+  std::size_t k = 0, excluded = 0, missing = 0;
   for (int v = 0; v < h; v += stride) {
     const Raw* drow = depth.row(v);
     const std::uint8_t* mrow = use_mask ? exclude.row(v) : nullptr;
-    const T y_over_z = (T(v) - camera.cy) * ify;  // eq. 6 with fy (the paper's fx is a typo)
-    for (int u = 0; u < w; u += stride) {
-      if (mrow && mrow[u]) {
-        ++excluded;
-        continue;
-      }
-      const T z = static_cast<T>(depth.to_metres(drow[u]));
-      if (!(z > T(0))) {
-        ++missing;
-        continue;
-      }
-      out->points.emplace_back((T(u) - camera.cx) * ifx * z, y_over_z * z, z);
-      out->pixel_index.push_back(static_cast<std::uint32_t>(v) * static_cast<std::uint32_t>(w) +
-                                 static_cast<std::uint32_t>(u));
+    const T y_over_z = (T(v) - camera.cy) / camera.fy;  // eq. 6 with fy (the paper's fx is a typo)
+    const std::uint32_t base = static_cast<std::uint32_t>(v) * static_cast<std::uint32_t>(w);
+    std::size_t c = 0;
+    for (int u = 0; u < w; u += stride, ++c) {
+      // Bitwise & and | on 0/1 values: no short-circuit branches to mispredict on holes and mask edges.
+      const unsigned masked = mrow != nullptr ? static_cast<unsigned>(mrow[u] != 0) : 0u;
+      const float d = static_cast<float>(drow[u]) * inv_units;
+      const unsigned measured = static_cast<unsigned>(d > 0.f) & static_cast<unsigned>(d >= min_m) &
+                                static_cast<unsigned>(d <= max_m);
+      const T z = static_cast<T>(d);
+      P[k] = Vec3<T>(x_over_z[c] * z, y_over_z * z, z);
+      I[k] = base + static_cast<std::uint32_t>(u);
+      k += measured & (masked ^ 1u);
+      excluded += masked;
+      missing += (masked ^ 1u) & (measured ^ 1u);
     }
   }
+  out->points.resize(k);
+  out->pixel_index.resize(k);
   out->num_excluded = excluded;
   out->num_missing = missing;
   return Status::Ok;
