@@ -15,7 +15,7 @@ using namespace dyncull::eval;
 template <class T>
 class AteTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(AteTest, Scalars);
+TYPED_TEST_SUITE(AteTest, Scalars, );
 
 // Positions of order 1-3 m: float round-off after alignment is a few 1e-7 m.
 template <class T> T zero_tol() { return std::is_same<T, double>::value ? T(1e-12) : T(2e-6); }

@@ -18,7 +18,7 @@ using namespace dyncull::eval;
 template <class T>
 class RpeTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RpeTest, Scalars);
+TYPED_TEST_SUITE(RpeTest, Scalars, );
 
 template <class T> double tol_m() { return std::is_same<T, double>::value ? 1e-12 : 2e-6; }
 template <class T> double tol_deg() { return std::is_same<T, double>::value ? 1e-5 : 2e-4; }

@@ -16,7 +16,7 @@ using namespace dyncull::eval;
 template <class T>
 class StatisticsTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(StatisticsTest, Scalars);
+TYPED_TEST_SUITE(StatisticsTest, Scalars, );
 
 TYPED_TEST(StatisticsTest, KnownValuesEvenCount) {
   using T = TypeParam;

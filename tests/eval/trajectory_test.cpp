@@ -19,7 +19,7 @@ using namespace dyncull::eval;
 template <class T>
 class TrajectoryIoTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(TrajectoryIoTest, Scalars);
+TYPED_TEST_SUITE(TrajectoryIoTest, Scalars, );
 
 TYPED_TEST(TrajectoryIoTest, ParsesCommentsBlankLinesCommasTabsAndCrlf) {
   using T = TypeParam;

@@ -89,7 +89,7 @@ void expect_stats(const ErrorStatistics<T>& s, const std::string& json, const ch
 template <class T>
 class TumReferenceTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(TumReferenceTest, Scalars);
+TYPED_TEST_SUITE(TumReferenceTest, Scalars, );
 
 // Double must reproduce the scripts to 1e-6 (the requirement; in practice ~1e-12). Float poses carry
 // 1e-7 relative round-off on ~3 m coordinates, so float gets 2e-6 m and 2e-4 deg.
