@@ -92,7 +92,8 @@ TEST(TrajectoryIo, MissingFileIsIoError) {
 TYPED_TEST(TrajectoryIoTest, WriteReadRoundTripIsLossless) {
   using T = TypeParam;
   const Trajectory<T> traj = synthetic::make_loop<T>(50);
-  const std::string path = ::testing::TempDir() + "/dyncull_eval_roundtrip.txt";
+  // One file per scalar type: ctest may run the typed instances in parallel.
+  const std::string path = ::testing::TempDir() + "/dyncull_eval_roundtrip_" + std::to_string(sizeof(T)) + ".txt";
   const WriteResult w = write_tum_trajectory(path, traj);
   ASSERT_TRUE(w.ok()) << w.reason;
   const auto r = read_tum_trajectory<T>(path);
