@@ -29,7 +29,7 @@ FrameData tiny_frame() {
 template <class T>
 class SimTruthTyped : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(SimTruthTyped, Scalars);
+TYPED_TEST_SUITE(SimTruthTyped, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 TYPED_TEST(SimTruthTyped, NearestPixelOfEigenPoints) {
   using V = dyncull::Vec2<TypeParam>;
