@@ -59,6 +59,14 @@ TYPED_TEST(AteTest, Sim3RemovesScaleOnlyWhenAsked) {
   ASSERT_TRUE(fitted.ok()) << fitted.reason;
   EXPECT_LT(fitted.error_m.max, T(10) * zero_tol<T>());
   EXPECT_NEAR(fitted.groundtruth_from_estimate.scale, T(1 / 0.37), T(1e-4));
+  // Applying the fitted alignment brings the estimate onto the ground truth, orientations included.
+  const Trajectory<T> aligned = apply_alignment(fitted.groundtruth_from_estimate, est);
+  ASSERT_EQ(aligned.size(), gt.size());
+  for (std::size_t i = 0; i < gt.size(); i += 17) {
+    EXPECT_LT((aligned.poses[i].t - gt.poses[i].t).norm(), T(10) * zero_tol<T>()) << i;
+    EXPECT_TRUE(aligned.poses[i].R.isApprox(gt.poses[i].R, T(100) * zero_tol<T>())) << i;
+    EXPECT_EQ(aligned.stamps[i], est.stamps[i]);
+  }
   const AteResult<T> rigid = evaluate_ate(gt, est);
   ASSERT_TRUE(rigid.ok());
   EXPECT_GT(rigid.error_m.rmse, T(0.1));  // an SE(3) fit cannot undo a 0.37 scale

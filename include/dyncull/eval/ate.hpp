@@ -114,4 +114,16 @@ AteResult<T> evaluate_ate(const Trajectory<T>& groundtruth, const Trajectory<T>&
   return result;
 }
 
+/// The estimate expressed in the ground-truth frame: world_from_cam' = (s R, t) applied to each pose
+/// (position s R p + t, orientation R R_i), e.g. to plot or write the aligned trajectory. Stamps kept.
+template <class T>
+Trajectory<T> apply_alignment(const Sim3<T>& groundtruth_from_estimate, const Trajectory<T>& estimate) {
+  Trajectory<T> out = estimate;
+  for (Rigid3<T>& pose : out.poses) {
+    pose.t = groundtruth_from_estimate.apply(pose.t);
+    pose.R = groundtruth_from_estimate.R * pose.R;
+  }
+  return out;
+}
+
 }  // namespace dyncull::eval
