@@ -16,7 +16,7 @@ using namespace dyncull;
 template <class T>
 class BoxRule : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(BoxRule, Scalars);
+TYPED_TEST_SUITE(BoxRule, Scalars, );
 
 constexpr int kPerson = 0, kChair = 56, kTv = 62;
 

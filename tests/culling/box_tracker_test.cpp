@@ -11,7 +11,7 @@ using namespace dyncull;
 template <class T>
 class BoxTrackerT : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(BoxTrackerT, Scalars);
+TYPED_TEST_SUITE(BoxTrackerT, Scalars, );
 
 template <class T>
 Detection<T> person_at(T x) {

@@ -48,7 +48,7 @@ struct Scene {
 template <class Raw>
 class DepthMask : public ::testing::Test {};
 using Raws = ::testing::Types<std::uint16_t, float>;
-TYPED_TEST_SUITE(DepthMask, Raws);
+TYPED_TEST_SUITE(DepthMask, Raws, );
 
 // Pixel agreement with the truth inside the box.
 template <class Raw>

@@ -10,7 +10,7 @@ using namespace dyncull;
 template <class T>
 class Detections : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(Detections, Scalars);
+TYPED_TEST_SUITE(Detections, Scalars, );
 
 // Tolerance: a few ulps of a 640-pixel coordinate.
 template <class T>

@@ -19,7 +19,7 @@ using namespace dyncull;
 template <class T>
 class DynamicProbability : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(DynamicProbability, Scalars);
+TYPED_TEST_SUITE(DynamicProbability, Scalars, );
 
 template <class T>
 struct Frame {

@@ -82,7 +82,7 @@ TEST(KeepMask, MismatchedSizesTouchNothing) {
 template <class T>
 class RegionPredicate : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RegionPredicate, Scalars);
+TYPED_TEST_SUITE(RegionPredicate, Scalars, );
 
 TYPED_TEST(RegionPredicate, PyramidLevelsMapToLevelZero) {
   using T = TypeParam;
