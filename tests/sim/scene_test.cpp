@@ -353,6 +353,35 @@ TEST(SimScene, ExactDetectionsAreTightBoxesOfTheInstanceMasks) {
   }
 }
 
+// The TV (low-level class) is behind the walking loop: its box overlaps a person's box in some
+// frames, the case where box-level culling must not drop the TV's static features wholesale.
+TEST(SimScene, TvBoxOverlapsAPersonBoxInSomeFrames) {
+  SceneOptions o;
+  o.width = 320;
+  o.height = 240;
+  o.min_detection_pixels = 75;  // same area share as 300 px at 640x480
+  o.box_jitter_px = 0;
+  o.miss_rate = 0;
+  o.false_positive_rate = 0;
+  const Scene scene(o);
+  FrameData f;
+  int overlapping = 0, with_tv = 0;
+  for (int index = 0; index < scene.num_frames(); index += 10) {
+    scene.render(index, &f);
+    const dyncull::Detection<float>* tv = nullptr;
+    for (const auto& d : f.detections) tv = d.class_id == CocoClass::kTv ? &d : tv;
+    if (!tv) continue;
+    ++with_tv;
+    bool overlap = false;
+    for (const auto& d : f.detections)
+      overlap = overlap || (d.class_id == CocoClass::kPerson && dyncull::iou(d.box, tv->box) > 0.f);
+    overlapping += overlap ? 1 : 0;
+  }
+  EXPECT_GT(with_tv, 20);
+  EXPECT_GT(overlapping, 3);
+  EXPECT_LT(overlapping, with_tv);  // and not in every frame
+}
+
 TEST(SimScene, NoisyDetectionsStayCloseMissAndAddFalsePositives) {
   SceneOptions o;
   o.box_jitter_px = 2.0;
