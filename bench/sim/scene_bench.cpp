@@ -132,6 +132,7 @@ struct PullResult {
 };
 
 PullResult front_end_pull(const Scene& scene, bool cull, int pairs) {
+  cv::setRNGSeed(12345);  // solvePnPRansac samples from OpenCV's global RNG: reset it per run
   auto orb = cv::ORB::create(1500);
   cv::BFMatcher matcher(cv::NORM_HAMMING, true);
   const auto cam = scene.camera();

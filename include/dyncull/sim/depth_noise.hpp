@@ -39,10 +39,9 @@ inline std::uint64_t splitmix(std::uint64_t& x) {
 /// Approximately standard normal from one 64-bit word: the sum of four 16-bit uniforms
 /// (Irwin-Hall, variance 4/12), rescaled. Cheaper than Box-Muller per pixel; tails end at 3.46.
 inline double approx_normal(std::uint64_t bits) {
-  const double sum = static_cast<double>(bits & 0xFFFF) + static_cast<double>((bits >> 16) & 0xFFFF) +
-                     static_cast<double>((bits >> 32) & 0xFFFF) + static_cast<double>(bits >> 48);
+  const std::uint64_t sum = (bits & 0xFFFF) + ((bits >> 16) & 0xFFFF) + ((bits >> 32) & 0xFFFF) + (bits >> 48);
   constexpr double kScale = 1.7320508075688772 / 65536.0;  // sqrt(3) / 2^16: unit variance
-  return (sum - 2.0 * 65535.0) * kScale;
+  return (static_cast<double>(sum) - 2.0 * 65535.0) * kScale;
 }
 
 }  // namespace detail
@@ -79,6 +78,7 @@ inline void apply_depth_noise(float* depth, int width, int height, const DepthNo
   // Pass 2: holes, border, range, noise, quantisation.
   std::uint64_t state = seed ^ 0xD1B54A32D192ED03ull;
   const int border = options.border_px;
+  const double metres_per_unit = 1.0 / options.units_per_metre;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       float& d = at(u, v);
@@ -90,8 +90,10 @@ inline void apply_depth_noise(float* depth, int width, int height, const DepthNo
         continue;
       }
       const double noisy = z + kinect_depth_sigma_m(z, options) * detail::approx_normal(bits);
-      const double q = std::round(noisy * options.units_per_metre) / options.units_per_metre;
-      d = static_cast<float>(q > 0.0 ? q : 0.0);
+      // Round half up by truncation (noisy > 0 here): std::round is a library call without SSE4.1.
+      const double units = noisy * options.units_per_metre + 0.5;
+      d = units >= 1.0 ? static_cast<float>(static_cast<double>(static_cast<std::int64_t>(units)) * metres_per_unit)
+                       : 0.f;
     }
   }
 }
