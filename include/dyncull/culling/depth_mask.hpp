@@ -29,6 +29,10 @@
 #include <type_traits>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace dyncull {
 
 /// Plain: 000 eq. 1-2 on single pixels (corner and integer centre pixels, raw units, strict
@@ -224,13 +228,41 @@ std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, 
     for (int y = r0; y < r1; ++y) {
       const std::uint16_t* d = v.row(y);
       std::uint8_t* o = out.row(y);
-      unsigned row_count = 0;
-      for (int x = c0; x < c1; ++x) {
+      std::size_t row_count = 0;
+      int x = c0;
+#if defined(__SSE2__)
+      // Explicit SSE2 (x86-64 baseline): g++ does not vectorise this loop at -O2, where it ran 4x
+      // slower. x < span <=> subs_epu16(x, span - 1) == 0 (span > 0); x > vspan <=> subs(x, vspan) != 0.
+      if (span > 0) {
+        const __m128i lo8 = _mm_set1_epi16(static_cast<short>(lo));
+        const __m128i span_m1 = _mm_set1_epi16(static_cast<short>(span - 1));
+        const __m128i vlo8 = _mm_set1_epi16(static_cast<short>(vlo));
+        const __m128i vspan8 = _mm_set1_epi16(static_cast<short>(vspan));
+        const __m128i zero = _mm_setzero_si128();
+        const __m128i miss_on = band.missing ? _mm_set1_epi16(-1) : zero;
+        const __m128i val = _mm_set1_epi8(static_cast<char>(value));
+        for (; x + 16 <= c1; x += 16) {
+          const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + x));
+          const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + x + 8));
+          const __m128i in_a = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(a, lo8), span_m1), zero);
+          const __m128i in_b = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(b, lo8), span_m1), zero);
+          const __m128i ok_a = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(a, vlo8), vspan8), zero);
+          const __m128i ok_b = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(b, vlo8), vspan8), zero);
+          const __m128i m_a = _mm_or_si128(in_a, _mm_andnot_si128(ok_a, miss_on));
+          const __m128i m_b = _mm_or_si128(in_b, _mm_andnot_si128(ok_b, miss_on));
+          const __m128i m = _mm_packs_epi16(m_a, m_b);  // 0xFFFF -> 0xFF, 0 -> 0
+          __m128i* dst = reinterpret_cast<__m128i*>(o + x);
+          _mm_storeu_si128(dst, _mm_or_si128(_mm_loadu_si128(dst), _mm_and_si128(m, val)));
+          row_count += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(_mm_movemask_epi8(m))));
+        }
+      }
+#endif
+      for (; x < c1; ++x) {
         const bool in = static_cast<std::uint16_t>(d[x] - lo) < span;
         const bool miss = static_cast<std::uint16_t>(d[x] - vlo) > vspan;
         const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (miss ? miss_value : 0));
         o[x] = static_cast<std::uint8_t>(o[x] | m);
-        row_count += m != 0;
+        row_count += (in || (miss && band.missing)) ? 1u : 0u;
       }
       count += row_count;
     }
