@@ -43,6 +43,7 @@ struct SceneConfig {
   int frames_between = 1;    ///< previous frame = this many frames earlier (tracks)
   double pixel_noise = 0.25; ///< Gaussian pixel noise (std, px) on both ends of a track
   double walk_speed_m = 0.04;  ///< walking speed per frame (1.2 m/s at 30 fps)
+  bool static_camera = false;  ///< camera does not move (F undetermined)
   std::uint64_t seed = 7;
   PinholeCamera<double> camera = PinholeCamera<double>::tum_fr3();
 };
@@ -96,11 +97,15 @@ class SceneWorld {
       add({-3.0, -2.5, 0.9}, {3.0, 2.5, 1.2}, {config.walk_speed_m, 0.0, 0.0}, SceneKind::WalkingPerson, 0);
       return;
     }
+    // Static furniture at 1.4-3.5 m: the depth spread that makes F well determined at small baselines.
+    add({-0.6, 0.55, 1.4}, {0.3, 1.3, 1.9}, {0.0, 0.0, 0.0}, SceneKind::Room, -1);     // desk
+    add({-3.0, -1.6, 0.8}, {-2.3, 1.3, 3.5}, {0.0, 0.0, 0.0}, SceneKind::Room, -1);    // bookcase, left
+    add({2.2, -0.2, 1.2}, {3.0, 1.3, 2.2}, {0.0, 0.0, 0.0}, SceneKind::Room, -1);      // cabinet, right
     if (config.walking)
       add({-1.35, -0.5, 2.3}, {-0.85, 1.3, 2.6}, {config.walk_speed_m, 0.0, -0.01}, SceneKind::WalkingPerson, 0);
     if (config.sitting) {
-      // The upper body (head and shoulders, the top 28 % of the person) leans; hips and legs stay.
-      add({0.35, -0.30, 3.0}, {0.85, 0.15, 3.3}, {0.012, 0.006, -0.006}, SceneKind::SittingUpper, 1);
+      // The upper body (head and shoulders, the top 28 % of the person) sways sideways; hips and legs stay.
+      add({0.35, -0.30, 3.0}, {0.85, 0.15, 3.3}, {0.02, -0.01, 0.0}, SceneKind::SittingUpper, 1);
       add({0.35, 0.15, 3.0}, {0.85, 1.3, 3.3}, {0.0, 0.0, 0.0}, SceneKind::SittingLower, 1);
     }
     if (config.chair) add({1.3, 0.6, 2.6}, {1.8, 1.3, 3.0}, {0.03, 0.0, 0.02}, SceneKind::Chair, 2);
@@ -111,6 +116,7 @@ class SceneWorld {
   /// (the room has depth variation) and epipolar lines are slanted, not parallel to the walk.
   Rigid3<double> cam_from_world(double tau) const {
     Rigid3<double> world_from_cam;
+    if (config_.static_camera) return world_from_cam;
     world_from_cam.R = Eigen::AngleAxisd(0.004 * tau, Vec3<double>::UnitY()).toRotationMatrix() *
                        Eigen::AngleAxisd(0.002 * tau, Vec3<double>::UnitX()).toRotationMatrix();
     world_from_cam.t = Vec3<double>(0.010, 0.014, 0.004) * tau;
