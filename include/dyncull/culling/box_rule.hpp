@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -63,7 +64,7 @@ namespace detail {
 template <class Dets>
 using detection_scalar_t = std::decay_t<decltype(std::declval<const Dets&>()[std::size_t{0}].box.x0)>;
 
-constexpr std::uint8_t kInHigh = 1, kInMedium = 2, kInLow = 4;
+constexpr std::uint8_t kInHigh = 1, kInMedium = 2, kInLow = 4, kNonFinite = 8;
 
 /// flags[i] |= bit when point i lies in the box: branch-free over structure-of-arrays points,
 /// bounds in locals so the store to flags cannot alias them (PERFORMANCE.md).
@@ -157,23 +158,30 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
   }
   if (skipped) r.reason = std::to_string(skipped) + " invalid box(es) skipped";
 
-  // NaN / Inf coordinates compare false against every finite bound: never inside a box.
-  std::vector<T> xs(n), ys(n);
-  std::vector<std::uint8_t> flags(n, 0);
+  // NaN / Inf coordinates compare false against every finite bound: never inside a box; they are
+  // flagged here (x * 0 is NaN only for non-finite x) and labelled by the decision table.
+  // Scratch arrays are left uninitialised: every element is written before it is read.
+  const std::unique_ptr<T[]> xs(new T[n]), ys(new T[n]);
+  const std::unique_ptr<std::uint8_t[]> flags(new std::uint8_t[n]);
   for (std::size_t i = 0; i < n; ++i) {
-    xs[i] = point_x<T>(points[i]);
-    ys[i] = point_y<T>(points[i]);
+    const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
+    xs[i] = x;
+    ys[i] = y;
+    flags[i] = (x * T(0) + y * T(0) == T(0)) ? std::uint8_t(0) : detail::kNonFinite;
   }
-  detail::mark_points(xs.data(), ys.data(), n, boxes, bits, flags.data());
+  detail::mark_points(xs.get(), ys.get(), n, boxes, bits, flags.get());
 
-  // Decision table over the three membership bits.
-  FeatureLabel label_of[8];
-  CullReason reason_of[8];
-  for (unsigned f = 0; f < 8; ++f) {
+  // Decision table over the three membership bits and the non-finite bit.
+  FeatureLabel label_of[16];
+  CullReason reason_of[16];
+  for (unsigned f = 0; f < 16; ++f) {
     const bool high = f & detail::kInHigh, medium = f & detail::kInMedium, low = f & detail::kInLow;
     label_of[f] = FeatureLabel::Static;
     reason_of[f] = CullReason::None;
-    if (high) {
+    if (f & detail::kNonFinite) {  // never trusted as static
+      label_of[f] = FeatureLabel::Dynamic;
+      reason_of[f] = CullReason::InvalidInput;
+    } else if (high) {
       if (low) {
         reason_of[f] = CullReason::LowLevelOverride;
       } else {
@@ -195,15 +203,11 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
   CullReason* reasons = r.reasons.data();
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t f = flags[i];
-    FeatureLabel label = label_of[f];
-    CullReason reason = reason_of[f];
-    if (!(xs[i] - xs[i] == T(0) && ys[i] - ys[i] == T(0))) {  // non-finite: never trusted as static
-      label = FeatureLabel::Dynamic;
-      reason = CullReason::InvalidInput;
-      ++num_bad;
-    }
+    const FeatureLabel label = label_of[f];
+    const CullReason reason = reason_of[f];
     labels[i] = label;
     reasons[i] = reason;
+    num_bad += (f & detail::kNonFinite) != 0;
     num_override += reason == CullReason::LowLevelOverride;
     num_dynamic += label == FeatureLabel::Dynamic;
     num_candidate += label == FeatureLabel::Candidate;
