@@ -18,6 +18,15 @@
 namespace {
 
 using dyncull::Mat3;
+
+#ifdef DYNCULL_HAS_OPENCV
+// One thread for every peer (PERFORMANCE.md): OpenCV's parallel_for would otherwise hide wall time
+// behind other cores, and the machine is shared.
+[[maybe_unused]] const int kSingleThread = [] {
+  cv::setNumThreads(1);
+  return 1;
+}();
+#endif
 using dyncull::test::TwoViewData;
 using dyncull::test::TwoViewOptions;
 

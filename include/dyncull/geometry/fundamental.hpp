@@ -276,23 +276,31 @@ inline Mat3<double> denormalise(const Mat3<double>& Fn, const Normaliser& n1, co
   return F;
 }
 
-/// Weighted 8-point on normalised coordinates of the selected points (idx == nullptr: all n).
+using RowsMatrix = Eigen::Matrix<double, 9, Eigen::Dynamic>;
+
+/// Weighted 8-point on normalised coordinates of the selected points (idx == nullptr: all n). `rows` is
+/// scratch (9 x n, grown if needed): the normal matrix is one vectorised product A A^T, 5-10x faster
+/// than n rank-one updates.
 inline Status eight_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
                                      const std::uint32_t* idx, std::size_t n, const double* weights,
-                                     Mat3<double>* Fn, std::string* reason) {
+                                     RowsMatrix* rows, Mat3<double>* Fn, std::string* reason) {
   if (n < 8) {
     if (reason) *reason = std::to_string(n) + " correspondences, the 8-point algorithm needs 8";
     return Status::TooFewPoints;
   }
-  Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
-  Eigen::Matrix<double, 9, 1> a;
+  const auto N = static_cast<Eigen::Index>(n);
+  if (rows->cols() < N) rows->resize(9, N);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t k = idx ? idx[i] : i;
-    epipolar_row(x1[k], y1[k], x2[k], y2[k], a.data());
-    const double w = weights ? weights[i] : 1.0;
-    ata.selfadjointView<Eigen::Upper>().rankUpdate(a, w);
+    double* a = rows->col(static_cast<Eigen::Index>(i)).data();
+    epipolar_row(x1[k], y1[k], x2[k], y2[k], a);
+    if (weights) {
+      const double sw = std::sqrt(weights[i]);
+      for (int j = 0; j < 9; ++j) a[j] *= sw;
+    }
   }
-  ata.triangularView<Eigen::StrictlyLower>() = ata.transpose();
+  Eigen::Matrix<double, 9, 9> ata;
+  ata.noalias() = rows->leftCols(N) * rows->leftCols(N).transpose();
   Mat3<double> F;
   const Status s = solve_normal_equations(ata, &F, reason);
   if (s != Status::Ok) return s;
@@ -380,6 +388,7 @@ class FundamentalEstimator {
       nx2_[i] = n2_.s * (ux2[i] - n2_.cx), ny2_[i] = n2_.s * (uy2[i] - n2_.cy);
     }
     weights_.resize(m);
+    rows_.resize(9, static_cast<Eigen::Index>(m));
   }
 
   std::size_t num_data() const { return normalisable_ ? index_.size() : 0; }
@@ -398,10 +407,25 @@ class FundamentalEstimator {
     return written;
   }
 
-  void residuals_sq(const Model& F, T* out) const { residuals_sq(F, 0, px1_.size(), out); }
+  void residuals_sq(const Model& F, T* out) const { residuals_sq(F, std::size_t{0}, px1_.size(), out); }
   void residuals_sq(const Model& F, std::size_t begin, std::size_t end, T* out) const {
     epipolar_distances_soa(F, px1_.data() + begin, py1_.data() + begin, px2_.data() + begin, py2_.data() + begin,
                            end - begin, out, EpipolarDistance::SampsonSq);
+  }
+
+  /// Residuals at given indices (RANSAC's probe pre-test): a scalar loop, n is small.
+  void residuals_sq(const Model& F, const std::uint32_t* idx, std::size_t n, T* out) const {
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t k = idx[i];
+      const T x1 = px1_[k], y1 = py1_[k], x2 = px2_[k], y2 = py2_[k];
+      const T X = F(0, 0) * x1 + F(0, 1) * y1 + F(0, 2);
+      const T Y = F(1, 0) * x1 + F(1, 1) * y1 + F(1, 2);
+      const T Z = F(2, 0) * x1 + F(2, 1) * y1 + F(2, 2);
+      const T A = F(0, 0) * x2 + F(1, 0) * y2 + F(2, 0);
+      const T B = F(0, 1) * x2 + F(1, 1) * y2 + F(2, 1);
+      const T e = x2 * X + y2 * Y + Z;
+      out[i] = e * e / (X * X + Y * Y + A * A + B * B);
+    }
   }
 
   bool refit(const std::uint32_t* inliers, std::size_t n, Model* model) const {
@@ -420,8 +444,8 @@ class FundamentalEstimator {
       w = weights_.data();
     }
     Mat3<double> Fn;
-    if (detail::eight_point_normalised(nx1_.data(), ny1_.data(), nx2_.data(), ny2_.data(), inliers, n, w, &Fn,
-                                       nullptr) != Status::Ok)
+    if (detail::eight_point_normalised(nx1_.data(), ny1_.data(), nx2_.data(), ny2_.data(), inliers, n, w, &rows_,
+                                       &Fn, nullptr) != Status::Ok)
       return false;
     const Mat3<double> F = detail::denormalise(Fn, n1_, n2_);
     if (!F.allFinite()) return false;
@@ -502,6 +526,7 @@ class FundamentalEstimator {
   std::vector<double> nx1_, ny1_, nx2_, ny2_;    // Hartley-normalised, for the solvers
   std::vector<std::uint32_t> index_;
   mutable std::vector<double> weights_;          // refit scratch, sized once
+  mutable detail::RowsMatrix rows_;              // refit scratch (9 x n), sized once
 };
 
 /// Normalised 8-point algorithm on all correspondences (least squares, rank 2 enforced). Non-finite
