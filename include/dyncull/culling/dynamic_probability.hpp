@@ -234,9 +234,12 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
       r.reference_flow = s / T(ref.size());
     }
   }
-  if (ego.model == FlowModel::MeanFlow)
+  if (ego.model == FlowModel::MeanFlow) {
+    const Vec2<T> ref_flow = r.reference_flow;  // a local: stores into r must not force reloads
+    T* res = r.residual_px.data();
     for (std::size_t i = 0; i < n; ++i)
-      if (has_flow[i]) r.residual_px[i] = (flow[i] - r.reference_flow).norm();
+      if (has_flow[i]) res[i] = (flow[i] - ref_flow).norm();
+  }
 
   // Adaptive t: robust spread of the reference features' own residuals, with a floor.
   if (r.used_fallback || ref.empty()) {
@@ -256,32 +259,45 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
                std::to_string(o.min_reference_features) + " outside masks): fallback threshold used";
   }
 
+  // Locals and raw pointers: stores through `r` would otherwise alias every read of `r`.
+  const T t = r.motion_threshold_px;
+  const T a1 = o.weight_semantic, a2 = o.weight_motion, a3 = o.weight_temporal, threshold = o.threshold;
+  const T* res = r.residual_px.data();
+  std::uint8_t* moving = r.moving.data();
+  std::uint8_t* temporal = r.temporal.data();
+  T* prob = r.probability.data();
+  FeatureLabel* labels = r.labels.data();
+  CullReason* reasons = r.reasons.data();
+  std::size_t num_no_flow = 0, num_masked = 0, num_dynamic = 0;
+  const bool use_store = store && track_ids;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!has_flow[i]) ++r.num_no_flow;
-    const bool m = has_flow[i] && r.residual_px[i] > r.motion_threshold_px;
-    r.moving[i] = static_cast<std::uint8_t>(m);
+    num_no_flow += !has_flow[i];
+    const bool m = has_flow[i] && res[i] > t;
+    moving[i] = static_cast<std::uint8_t>(m);
     bool k = false;
-    const bool tracked = store && track_ids && (*track_ids)[i] >= 0;
+    const bool tracked = use_store && (*track_ids)[i] >= 0;
     if (tracked) {
-      if (const TrackStateStore::State* s = store->find((*track_ids)[i]))
-        k = o.temporal_source == TemporalSource::PreviousMotion ? s->moving != 0 : s->dynamic != 0;
+      if (const TrackStateStore::State* st = store->find((*track_ids)[i]))
+        k = o.temporal_source == TemporalSource::PreviousMotion ? st->moving != 0 : st->dynamic != 0;
     }
-    r.temporal[i] = static_cast<std::uint8_t>(k);
+    temporal[i] = static_cast<std::uint8_t>(k);
     bool dynamic = false;
     if (levels[i] != MotionLevel::Ignore) {
-      ++r.num_masked;
-      const T p = o.weight_semantic * motion_level_score<T>(levels[i]) + o.weight_motion * T(m) +
-                  o.weight_temporal * T(k);
-      r.probability[i] = p;
-      dynamic = p >= o.threshold;
+      ++num_masked;
+      const T p = a1 * motion_level_score<T>(levels[i]) + a2 * T(m) + a3 * T(k);
+      prob[i] = p;
+      dynamic = p >= threshold;
       if (dynamic) {
-        r.labels[i] = FeatureLabel::Dynamic;
-        r.reasons[i] = CullReason::Probability;
-        ++r.num_dynamic;
+        labels[i] = FeatureLabel::Dynamic;
+        reasons[i] = CullReason::Probability;
+        ++num_dynamic;
       }
     }
     if (tracked) store->update((*track_ids)[i], m, dynamic);
   }
+  r.num_no_flow = num_no_flow;
+  r.num_masked = num_masked;
+  r.num_dynamic = num_dynamic;
   return r;
 }
 
