@@ -1,0 +1,524 @@
+/// @file pipeline.hpp
+/// The culling pipeline: composes the semantic (002/004 box rule, 000 depth mask and probability) and
+/// geometric (003 epipolar + sub-box, 001 multi-view) strategies in front-end order, with a survivor guard.
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/depth.hpp"
+#include "dyncull/core/mask.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/box_rule.hpp"
+#include "dyncull/culling/box_tracker.hpp"
+#include "dyncull/culling/depth_mask.hpp"
+#include "dyncull/culling/detections.hpp"
+#include "dyncull/culling/dynamic_probability.hpp"
+#include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/motion_levels.hpp"
+#include "dyncull/culling/moving_consistency.hpp"
+#include "dyncull/culling/multiview_check.hpp"
+#include "dyncull/culling/subbox_refine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+
+/// What happens to features still labelled Candidate (medium-level boxes, 001 §III.D) at the end.
+enum class CandidatePolicy : std::uint8_t {
+  Keep = 0,  ///< static: only proven motion culls them
+  Cull,      ///< dynamic: treat medium-level objects as moving (004 Algorithm 1)
+  Verify,    ///< dynamic only when a geometric stage flags the feature, else static (001)
+};
+
+/// What the minimum-survivor guard did.
+enum class GuardAction : std::uint8_t { None = 0, Softened, Undone };
+
+constexpr const char* to_string(GuardAction a) noexcept {
+  switch (a) {
+    case GuardAction::None: return "none";
+    case GuardAction::Softened: return "softened";
+    case GuardAction::Undone: return "undone";
+  }
+  return "unknown";
+}
+
+/// Which strategies run and their options. presets.hpp builds the papers' configurations.
+template <class T>
+struct PipelineOptions {
+  bool use_detection_filter = true;   ///< padding and class-dependent confidence (detections.hpp)
+  bool use_box_tracker = false;       ///< carry missed boxes forward (Dynamic-VINS)
+  bool use_box_rule = true;           ///< 002 Table 2 / 004 Algorithm 1
+  bool use_depth_mask = false;        ///< 000 eq. 1-2: box culls limited to the object's depth band
+  bool use_probability = false;       ///< 000 eq. 3-5 for features in object masks (needs tracks)
+  bool use_moving_consistency = true; ///< 003 eq. 1-3 (needs tracks)
+  bool use_subbox = true;             ///< 003 Algorithm 1 (needs the moving-consistency labels)
+  bool use_multiview = false;         ///< 001 §III.A (needs the current pose and a keyframe)
+
+  DetectionOptions<T> detections{};
+  BoxTrackerOptions<T> tracker{};
+  MotionLevelTable levels = MotionLevelTable::coco80();
+  BoxRuleOptions<T> box_rule{};
+  DepthMaskOptions depth_mask{};
+  DynamicProbabilityOptions<T> probability{};
+  /// Flow model of the probability's M term: Fundamental reuses the moving-consistency F when it ran.
+  FlowModel probability_flow_model = FlowModel::Fundamental;
+  MovingConsistencyOptions<T> moving{};
+  SubBoxOptions<T> subbox{};
+  MultiViewOptions<T> multiview{};
+  std::size_t max_reference_keyframes = 2;  ///< keyframes checked per frame (DynaSLAM: 5)
+
+  CandidatePolicy candidates = CandidatePolicy::Verify;
+  /// Epipolar-dynamic features outside every dynamic-class box are culled (DS-SLAM) or only used as
+  /// evidence inside boxes (false: an unexplained flow outlier outside boxes is more often LK error).
+  bool cull_geometric_outside_boxes = true;
+  /// Multi-view-dynamic features are culled wherever they are (DynaSLAM); false: only candidates.
+  bool multiview_overrides_static = true;
+  /// Run the sub-box refinement only when F was fitted on tracks outside the dynamic-class boxes
+  /// (or no track lay inside one). An F fitted through a large mover absorbs its motion (measured in
+  /// docs/parts/geometric-algorithms.md), and the refinement would then clear the whole box.
+  bool subbox_requires_fit_outside_boxes = true;
+
+  /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
+  /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
+  /// all culling. ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
+  bool survivor_guard = true;
+  double min_survivor_fraction = 0.10;
+  std::size_t min_survivors = 30;
+};
+
+/// Outcome of one stage in one frame.
+struct StageReport {
+  bool enabled = false;
+  Status status = Status::Skipped;
+  std::string reason;
+  std::size_t num_dynamic = 0;  ///< features this stage labelled Dynamic (before combination)
+  bool ran() const { return enabled && status == Status::Ok; }
+};
+
+/// Per-frame result: labels for the caller's keypoint vector (same order), why, and per-stage counts.
+template <class T>
+struct PipelineResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  std::vector<FeatureLabel> labels;  ///< Static or Dynamic (Candidates are resolved by CandidatePolicy)
+  std::vector<CullReason> reasons;   ///< deciding strategy (None for untouched statics)
+  std::vector<std::uint8_t> keep;    ///< 1 = static: apply to every parallel per-keypoint array
+  std::size_t num_features = 0, num_static = 0, num_dynamic = 0;
+  StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, subbox, multiview;
+  GuardAction guard = GuardAction::None;
+  std::size_t guard_restored = 0;   ///< features the guard turned back to static
+};
+
+/// Caller-owned state carried between frames, plus scratch buffers reused so the pipeline's own
+/// stages allocate nothing after warm-up.
+template <class T>
+struct PipelineState {
+  BoxTracker<T> tracker;
+  TrackStateStore track_states;      ///< K of 000 eq. 3, keyed by the caller's track ids
+  KeyframeRing<T> keyframes;         ///< multi-view references (push with is_keyframe or by hand)
+  std::uint64_t frame_index = 0;
+
+  PipelineResult<T> result;
+  // Scratch (internal).
+  std::vector<Detection<T>> boxes, dyn_boxes;
+  std::vector<std::int32_t> dyn_box_source;
+  std::vector<FeatureLabel> sem_labels;
+  std::vector<CullReason> sem_reasons;
+  std::vector<std::uint8_t> in_dyn_box, in_object, mv_dynamic;
+  std::vector<MotionLevel> prob_levels;
+  std::vector<Vec2<T>> prob_prev;
+  std::vector<T> keypoint_depth;
+  MovingConsistencyResult<T> moving;
+  SubBoxResult<T> subbox;
+  MultiViewResult<T> multiview;
+  Mask multiview_mask;
+  std::vector<std::uint32_t> flood_stack;
+  std::vector<std::size_t> ref_index;
+
+  explicit PipelineState(std::size_t keyframe_capacity = 20) : keyframes(keyframe_capacity) {}
+  void reset() {
+    tracker = BoxTracker<T>(tracker_options_);
+    track_states.clear();
+    keyframes.clear();
+    frame_index = 0;
+  }
+
+ private:
+  BoxTrackerOptions<T> tracker_options_{};
+};
+
+/// One frame as the front end has it. Keypoints: the caller's container (cv::KeyPoint, Eigen, ...);
+/// prev_keypoints: previous-frame positions parallel to keypoints (any point container), with
+/// track_valid (nullptr = all valid); nothing is copied out of them except into scratch buffers.
+template <class T, class Keypoints, class Prev = Keypoints, class Raw = float>
+struct CullingFrame {
+  const Keypoints* keypoints = nullptr;
+  const Prev* prev_keypoints = nullptr;
+  const std::uint8_t* track_valid = nullptr;
+  const std::vector<std::int64_t>* track_ids = nullptr;  ///< for the probability's K term (optional)
+  const std::vector<Detection<T>>* detections = nullptr;  ///< pixel boxes after NMS
+  DepthView<Raw> depth{};
+  PinholeCamera<T> camera{};
+  const Rigid3<T>* cam_from_world = nullptr;  ///< current pose (a motion-model prediction is enough)
+  bool is_keyframe = false;  ///< store this frame's static features with depth as a multi-view reference
+};
+
+namespace detail {
+inline bool is_soft_cull(CullReason r) {
+  return r == CullReason::Epipolar || r == CullReason::MultiView || r == CullReason::SubBox ||
+         r == CullReason::MediumLevelBox || r == CullReason::TrackedBox;
+}
+
+template <class T, class Keypoints>
+bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u, int* v) {
+  const T x = point_x<T>(kp[i]), y = point_y<T>(kp[i]);
+  if (!std::isfinite(x) || !std::isfinite(y)) return false;
+  *u = static_cast<int>(std::lround(x));
+  *v = static_cast<int>(std::lround(y));
+  return *u >= 0 && *v >= 0 && *u < w && *v < h;
+}
+}  // namespace detail
+
+/// Runs the enabled strategies on one frame and returns the labels (a reference into `state`, valid
+/// until the next call). Never throws; bad or missing inputs skip the stages that need them, with a
+/// reason in the stage report.
+template <class T, class Keypoints, class Prev, class Raw>
+const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>& frame,
+                                    const PipelineOptions<T>& options, PipelineState<T>* state) {
+  static_assert(is_point_container_v<Keypoints>, "dyncull::cull_frame: keypoints must hold points (see PointTraits)");
+  static_assert(is_point_container_v<Prev>, "dyncull::cull_frame: prev_keypoints must hold points");
+  PipelineState<T>& s = *state;
+  PipelineResult<T>& r = s.result;
+  ++s.frame_index;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.guard = GuardAction::None;
+  r.guard_restored = 0;
+  for (StageReport* st : {&r.detections, &r.tracker, &r.box_rule, &r.depth_mask, &r.probability,
+                          &r.moving_consistency, &r.subbox, &r.multiview}) {
+    st->status = Status::Skipped;
+    st->reason.clear();
+    st->num_dynamic = 0;
+  }
+  r.detections.enabled = options.use_detection_filter;
+  r.tracker.enabled = options.use_box_tracker;
+  r.box_rule.enabled = options.use_box_rule;
+  r.depth_mask.enabled = options.use_depth_mask;
+  r.probability.enabled = options.use_probability;
+  r.moving_consistency.enabled = options.use_moving_consistency;
+  r.subbox.enabled = options.use_subbox;
+  r.multiview.enabled = options.use_multiview;
+
+  if (!frame.keypoints) {
+    r.status = Status::InvalidInput;
+    r.reason = "no keypoints given";
+    r.labels.clear();
+    r.reasons.clear();
+    r.keep.clear();
+    r.num_features = r.num_static = r.num_dynamic = 0;
+    return r;
+  }
+  const Keypoints& kp = *frame.keypoints;
+  const std::size_t n = static_cast<std::size_t>(kp.size());
+  const int W = frame.camera.width, H = frame.camera.height;
+  r.num_features = n;
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  s.sem_labels.assign(n, FeatureLabel::Static);
+  s.sem_reasons.assign(n, CullReason::None);
+  s.in_dyn_box.assign(n, 0);
+  s.in_object.assign(n, 1);
+  s.mv_dynamic.assign(n, 0);
+  const bool have_tracks = frame.prev_keypoints && static_cast<std::size_t>(frame.prev_keypoints->size()) == n;
+
+  // 1. Boxes: filter (padding, class thresholds), then carry missed ones forward.
+  s.boxes.clear();
+  if (frame.detections) {
+    if (options.use_detection_filter) {
+      DetectionsResult<T> d = filter_detections(*frame.detections, W, H, options.detections);
+      r.detections.status = d.status;
+      r.detections.reason = d.reason;
+      if (d.ok()) s.boxes = d.detections;
+    } else {
+      s.boxes = *frame.detections;
+    }
+  } else if (options.use_detection_filter) {
+    r.detections.reason = "no detections given";
+  }
+  if (options.use_box_tracker) {
+    BoxTrackerResult<T> t = s.tracker.update(s.boxes, W, H);
+    r.tracker.status = t.status;
+    r.tracker.reason = t.reason;
+    if (t.ok()) s.boxes = t.boxes;
+  }
+  // Dynamic-class boxes (high and medium level): the ones sub-box refinement and the depth mask act on.
+  s.dyn_boxes.clear();
+  s.dyn_box_source.clear();
+  for (std::size_t b = 0; b < s.boxes.size(); ++b) {
+    const MotionLevel lv = options.levels.level(s.boxes[b].class_id);
+    if (lv == MotionLevel::High || lv == MotionLevel::Medium) {
+      s.dyn_boxes.push_back(s.boxes[b]);
+      s.dyn_box_source.push_back(static_cast<std::int32_t>(b));
+    }
+  }
+
+  // 2. Box rule.
+  std::vector<std::int32_t> no_index;
+  const std::vector<std::int32_t>* rule_box_index = &no_index;
+  BoxRuleResult<T> rule;
+  if (options.use_box_rule) {
+    rule = apply_box_rule(kp, s.boxes, options.levels, options.box_rule);
+    r.box_rule.status = rule.status;
+    r.box_rule.reason = rule.reason;
+    if (rule.ok()) {
+      rule_box_index = &rule.box_index;
+      for (std::size_t i = 0; i < n; ++i) {
+        s.sem_labels[i] = rule.labels[i];
+        s.sem_reasons[i] = rule.reasons[i];
+        s.in_dyn_box[i] = rule.reasons[i] == CullReason::HighLevelBox || rule.reasons[i] == CullReason::MediumLevelBox;
+      }
+      r.box_rule.num_dynamic = rule.num_dynamic;
+    }
+  }
+
+  // 3. Depth mask: inside dynamic-class boxes only the object's depth band is culled.
+  if (options.use_depth_mask) {
+    if (frame.depth.empty()) {
+      r.depth_mask.reason = "no depth image";
+    } else {
+      const DepthMaskResult dm = depth_mask(frame.depth, s.dyn_boxes, kp, options.depth_mask);
+      r.depth_mask.status = dm.status;
+      r.depth_mask.reason = dm.reason;
+      if (dm.ok()) {
+        r.depth_mask.num_dynamic = dm.num_dynamic;
+        for (std::size_t i = 0; i < n; ++i) {
+          s.in_object[i] = dm.labels[i] != FeatureLabel::Static;
+          if (dm.labels[i] == FeatureLabel::Dynamic && dm.reasons[i] == CullReason::InvalidInput) {
+            s.sem_labels[i] = FeatureLabel::Dynamic;
+            s.sem_reasons[i] = CullReason::InvalidInput;
+          } else if (s.in_dyn_box[i] && dm.labels[i] == FeatureLabel::Static) {
+            s.sem_labels[i] = FeatureLabel::Static;  // box background behind or in front of the object
+            s.sem_reasons[i] = CullReason::None;
+          } else if (s.in_dyn_box[i] && dm.labels[i] == FeatureLabel::Dynamic &&
+                     s.sem_labels[i] == FeatureLabel::Dynamic) {
+            s.sem_reasons[i] = CullReason::DepthMask;
+          } else if (!options.use_box_rule && dm.labels[i] != FeatureLabel::Static) {
+            s.sem_labels[i] = dm.labels[i];
+            s.sem_reasons[i] = dm.reasons[i];
+            s.in_dyn_box[i] = 1;
+          }
+        }
+      }
+    }
+  }
+
+  // 4. Moving consistency (tracks -> F -> eq. 3 distance), SG-SLAM fit outside boxes when flagged.
+  const bool have_boxes = !s.dyn_boxes.empty();
+  if (options.use_moving_consistency) {
+    if (!have_tracks) {
+      r.moving_consistency.reason = "no previous-frame positions (tracks) given";
+    } else {
+      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &s.moving, frame.track_valid,
+                               have_boxes ? s.in_dyn_box.data() : nullptr);
+      r.moving_consistency.status = s.moving.status;
+      r.moving_consistency.reason = s.moving.reason;
+      r.moving_consistency.num_dynamic = s.moving.num_dynamic;
+    }
+  }
+  const bool geo_ok = r.moving_consistency.ran();
+
+  // 5. Dynamic probability for features in object masks (000 Algorithm 1).
+  if (options.use_probability) {
+    if (!have_tracks) {
+      r.probability.reason = "no previous-frame positions (tracks) given";
+    } else {
+      s.prob_levels.assign(n, MotionLevel::Ignore);
+      s.prob_prev.resize(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const bool valid = !frame.track_valid || frame.track_valid[i];
+        s.prob_prev[i] = valid ? Vec2<T>(point_x<T>((*frame.prev_keypoints)[i]), point_y<T>((*frame.prev_keypoints)[i]))
+                               : Vec2<T>(Constants<T>::nan(), Constants<T>::nan());
+        if (s.in_dyn_box[i] && s.in_object[i] && i < rule_box_index->size() && (*rule_box_index)[i] >= 0)
+          s.prob_levels[i] = options.levels.level(s.boxes[static_cast<std::size_t>((*rule_box_index)[i])].class_id);
+      }
+      EgoMotion<T> ego;
+      if (options.probability_flow_model == FlowModel::Fundamental && geo_ok) {
+        ego.model = FlowModel::Fundamental;
+        ego.matrix = s.moving.F;
+      }
+      if (frame.track_ids) s.track_states.begin_frame();
+      const DynamicProbabilityResult<T> pr = dynamic_probability(s.prob_prev, kp, s.prob_levels, options.probability, ego,
+                                                                 frame.track_ids ? &s.track_states : nullptr, frame.track_ids);
+      r.probability.status = pr.status;
+      r.probability.reason = pr.reason;
+      if (pr.ok()) {
+        r.probability.num_dynamic = pr.num_dynamic;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (s.prob_levels[i] == MotionLevel::Ignore || s.sem_reasons[i] == CullReason::InvalidInput) continue;
+          s.sem_labels[i] = pr.labels[i];
+          s.sem_reasons[i] = pr.labels[i] == FeatureLabel::Dynamic ? CullReason::Probability : CullReason::None;
+        }
+      }
+    }
+  }
+
+  // 6. Sub-box refinement of the dynamic-class boxes with the geometric labels.
+  if (options.use_subbox) {
+    if (!geo_ok) {
+      r.subbox.reason = "needs the moving-consistency labels, which are unavailable this frame";
+    } else if (!have_boxes) {
+      r.subbox.reason = "no dynamic-class boxes";
+    } else if (options.subbox_requires_fit_outside_boxes && !s.moving.fitted_outside_boxes &&
+               std::any_of(s.in_dyn_box.begin(), s.in_dyn_box.end(), [](std::uint8_t f) { return f != 0; })) {
+      r.subbox.reason = "F was fitted through the dynamic-class boxes (too few tracks outside them): "
+                        "its epipolar evidence inside the boxes is not trusted";
+    } else {
+      refine_subboxes(kp, s.moving.labels.data(), s.dyn_boxes, options.subbox, &s.subbox,
+                      options.use_depth_mask && r.depth_mask.ran() ? s.in_object.data() : nullptr);
+      r.subbox.status = s.subbox.status;
+      r.subbox.reason = s.subbox.reason;
+      r.subbox.num_dynamic = s.subbox.num_dynamic;
+    }
+  }
+  const bool subbox_ok = r.subbox.ran();
+
+  // 7. Multi-view depth check against stored keyframes, grown into a mask over the depth image.
+  if (options.use_multiview) {
+    if (!frame.cam_from_world || !frame.cam_from_world->all_finite()) {
+      r.multiview.reason = "no current pose (tracking not initialised or lost)";
+    } else if (s.keyframes.empty()) {
+      r.multiview.reason = "no keyframe stored yet";
+    } else if (frame.depth.empty()) {
+      r.multiview.reason = "no depth image";
+    } else {
+      s.ref_index.resize(std::max<std::size_t>(1, options.max_reference_keyframes));
+      const std::size_t k = s.keyframes.select_references(*frame.cam_from_world, options.max_reference_keyframes,
+                                                          s.ref_index.data());
+      if (s.multiview_mask.width != frame.depth.width || s.multiview_mask.height != frame.depth.height)
+        s.multiview_mask.reset(frame.depth.width, frame.depth.height, 0);
+      else
+        std::fill(s.multiview_mask.pixels.begin(), s.multiview_mask.pixels.end(), std::uint8_t(0));
+      std::size_t checked = 0;
+      for (std::size_t j = 0; j < k; ++j) {
+        const MultiViewKeyframe<T>& kf = s.keyframes[s.ref_index[j]];
+        check_multiview(kf.points, kf.depth_m, kf.cam_from_world, *frame.cam_from_world, frame.depth, frame.camera,
+                        options.multiview, &s.multiview);
+        if (s.multiview.num_checked == 0) continue;
+        ++checked;
+        grow_multiview_regions(s.multiview, frame.depth, options.multiview, &s.multiview_mask, &s.flood_stack);
+      }
+      if (checked == 0) {
+        r.multiview.status = Status::TooFewPoints;
+        r.multiview.reason = "no keyframe point could be compared";
+      } else {
+        r.multiview.status = Status::Ok;
+        for (std::size_t i = 0; i < n; ++i) {
+          int u = 0, v = 0;
+          if (detail::keypoint_in_image<T>(kp, i, s.multiview_mask.width, s.multiview_mask.height, &u, &v))
+            s.mv_dynamic[i] = s.multiview_mask.pixels[static_cast<std::size_t>(v) * s.multiview_mask.width + u] != 0;
+          r.multiview.num_dynamic += s.mv_dynamic[i];
+        }
+      }
+    }
+  }
+  const bool mv_ok = r.multiview.ran();
+
+  // 8. Combination, in the order of evidence strength: semantics, then the geometric refinements.
+  for (std::size_t i = 0; i < n; ++i) {
+    FeatureLabel lab = s.sem_labels[i];
+    CullReason why = s.sem_reasons[i];
+    if (why == CullReason::InvalidInput) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      r.reasons[i] = why;
+      continue;
+    }
+    const bool sheltered = why == CullReason::LowLevelOverride;
+    const bool geo_dyn = geo_ok && s.moving.labels[i] == FeatureLabel::Dynamic;
+    bool geo_flagged = geo_dyn;
+    if (subbox_ok) {
+      if (s.subbox.reasons[i] == CullReason::SubBox && (!sheltered || geo_dyn)) {
+        lab = FeatureLabel::Dynamic;
+        why = CullReason::SubBox;
+        geo_flagged = true;
+      } else if (s.in_dyn_box[i] && s.sem_reasons[i] != CullReason::Probability) {
+        lab = FeatureLabel::Static;  // refined: in a static sub-box of its box
+        why = CullReason::None;
+      } else if (geo_dyn && options.cull_geometric_outside_boxes && lab == FeatureLabel::Static && !sheltered) {
+        lab = FeatureLabel::Dynamic;
+        why = CullReason::Epipolar;
+      }
+    } else if (geo_dyn && lab != FeatureLabel::Dynamic &&
+               (lab == FeatureLabel::Candidate || (options.cull_geometric_outside_boxes && !sheltered))) {
+      lab = FeatureLabel::Dynamic;
+      why = CullReason::Epipolar;
+    }
+    if (mv_ok && s.mv_dynamic[i]) {
+      geo_flagged = true;
+      if (lab == FeatureLabel::Candidate || (lab == FeatureLabel::Static && options.multiview_overrides_static)) {
+        lab = FeatureLabel::Dynamic;
+        why = CullReason::MultiView;
+      }
+    }
+    if (lab == FeatureLabel::Candidate) {
+      const bool cull = options.candidates == CandidatePolicy::Cull ||
+                        (options.candidates == CandidatePolicy::Verify && geo_flagged);
+      lab = cull ? FeatureLabel::Dynamic : FeatureLabel::Static;
+      if (!cull) why = CullReason::None;
+    }
+    r.labels[i] = lab;
+    r.reasons[i] = lab == FeatureLabel::Static ? CullReason::None : why;
+  }
+
+  // 9. Minimum-survivor guard.
+  auto count_static = [&]() {
+    std::size_t c = 0;
+    for (std::size_t i = 0; i < n; ++i) c += r.labels[i] == FeatureLabel::Static;
+    return c;
+  };
+  std::size_t survivors = count_static();
+  const std::size_t need = std::max(options.min_survivors, static_cast<std::size_t>(std::ceil(options.min_survivor_fraction * double(n))));
+  if (options.survivor_guard && survivors < need && n > 0) {
+    std::size_t soft = 0;
+    for (std::size_t i = 0; i < n; ++i) soft += r.labels[i] == FeatureLabel::Dynamic && detail::is_soft_cull(r.reasons[i]);
+    const bool soften_enough = survivors + soft >= need;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (r.labels[i] != FeatureLabel::Dynamic || r.reasons[i] == CullReason::InvalidInput) continue;
+      if (soften_enough && !detail::is_soft_cull(r.reasons[i])) continue;
+      r.labels[i] = FeatureLabel::Static;
+      r.reasons[i] = CullReason::SurvivorGuardUndo;
+      ++r.guard_restored;
+    }
+    r.guard = soften_enough ? GuardAction::Softened : GuardAction::Undone;
+    r.reason = std::string("survivor guard ") + to_string(r.guard) + ": " + std::to_string(survivors) +
+               " static features of " + std::to_string(n) + " were below " + std::to_string(need) + ", " +
+               std::to_string(r.guard_restored) + " restored";
+    survivors = count_static();
+  }
+  r.num_static = survivors;
+  r.num_dynamic = n - survivors;
+  r.keep.resize(n);
+  for (std::size_t i = 0; i < n; ++i) r.keep[i] = r.labels[i] == FeatureLabel::Static;
+
+  // 10. Keyframe for later multi-view checks: this frame's static features with their depth.
+  if (frame.is_keyframe && frame.cam_from_world && frame.cam_from_world->all_finite() && !frame.depth.empty()) {
+    s.keypoint_depth.assign(n, T(0));
+    for (std::size_t i = 0; i < n; ++i) {
+      int u = 0, v = 0;
+      if (detail::keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
+        s.keypoint_depth[i] = T(frame.depth.depth_m(u, v));
+    }
+    s.keyframes.push(*frame.cam_from_world, kp, s.keypoint_depth, r.keep.data());
+  }
+  return r;
+}
+
+}  // namespace dyncull
