@@ -10,6 +10,7 @@
 #include "dyncull/geometry/epipolar.hpp"
 #include "dyncull/geometry/ransac.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -281,9 +282,14 @@ using RowsMatrix = Eigen::Matrix<double, 9, Eigen::Dynamic>;
 /// Weighted 8-point on normalised coordinates of the selected points (idx == nullptr: all n). `rows` is
 /// scratch (9 x n, grown if needed): the normal matrix is one vectorised product A A^T, 5-10x faster
 /// than n rank-one updates.
+/// `warm` (optional): a nearby solution in normalised coordinates (LO refits). The null vector is then found
+/// by three steps of inverse iteration on an LDLT of A^T A (~1 us) instead of a full 9x9 eigen-decomposition
+/// (~10 us, the largest LO cost); the eigen-decomposition remains the fallback and the only path that runs
+/// the rank (degeneracy) test.
 inline Status eight_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
                                      const std::uint32_t* idx, std::size_t n, const double* weights,
-                                     RowsMatrix* rows, Mat3<double>* Fn, std::string* reason) {
+                                     RowsMatrix* rows, Mat3<double>* Fn, std::string* reason,
+                                     const Mat3<double>* warm = nullptr) {
   if (n < 8) {
     if (reason) *reason = std::to_string(n) + " correspondences, the 8-point algorithm needs 8";
     return Status::TooFewPoints;
@@ -301,6 +307,21 @@ inline Status eight_point_normalised(const double* x1, const double* y1, const d
   }
   Eigen::Matrix<double, 9, 9> ata;
   ata.noalias() = rows->leftCols(N) * rows->leftCols(N).transpose();
+  if (warm) {
+    const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(ata);
+    if (ldlt.info() == Eigen::Success) {
+      Eigen::Matrix<double, 9, 1> v;
+      v << (*warm)(0, 0), (*warm)(0, 1), (*warm)(0, 2), (*warm)(1, 0), (*warm)(1, 1), (*warm)(1, 2), (*warm)(2, 0),
+          (*warm)(2, 1), (*warm)(2, 2);
+      for (int it = 0; it < 3 && v.allFinite(); ++it) v = ldlt.solve(v).normalized();
+      if (v.allFinite()) {
+        Mat3<double> F;
+        F << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
+        *Fn = enforce_rank2(F);
+        return Status::Ok;
+      }
+    }
+  }
   Mat3<double> F;
   const Status s = solve_normal_equations(ata, &F, reason);
   if (s != Status::Ok) return s;
@@ -430,10 +451,11 @@ class FundamentalEstimator {
 
   bool refit(const std::uint32_t* inliers, std::size_t n, Model* model) const {
     const double* w = nullptr;
+    // The current model in normalised coordinates, Fn = T2^-T F T1^-1: warm start and Sampson weights.
+    const Mat3<double> Fn_current =
+        n2_.matrix().transpose().inverse() * model->template cast<double>() * n1_.matrix().inverse();
     if (weighted_) {
-      // Sampson denominators of the current model in normalised coordinates: Fn = T2^-T F T1^-1.
-      const Mat3<double> Fn =
-          n2_.matrix().transpose().inverse() * model->template cast<double>() * n1_.matrix().inverse();
+      const Mat3<double>& Fn = Fn_current;
       for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t k = inliers[i];
         const Vec3<double> p1(nx1_[k], ny1_[k], 1.0), p2(nx2_[k], ny2_[k], 1.0);
@@ -444,8 +466,9 @@ class FundamentalEstimator {
       w = weights_.data();
     }
     Mat3<double> Fn;
+    const bool warm = model->allFinite() && !model->isZero();
     if (detail::eight_point_normalised(nx1_.data(), ny1_.data(), nx2_.data(), ny2_.data(), inliers, n, w, &rows_,
-                                       &Fn, nullptr) != Status::Ok)
+                                       &Fn, nullptr, warm ? &Fn_current : nullptr) != Status::Ok)
       return false;
     const Mat3<double> F = detail::denormalise(Fn, n1_, n2_);
     if (!F.allFinite()) return false;
