@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -120,6 +121,38 @@ TEST(SimScene, DeterministicForASeedAndDifferentAcrossSeeds) {
   s3.render(37, &c);
   EXPECT_NE(a.rgb, c.rgb);
   EXPECT_NE(a.depth_m, c.depth_m);
+}
+
+// wall_contrast scales the texture of walls, floor and ceiling only: lower contrast lowers their
+// gray-level spread and leaves the people untouched.
+TEST(SimScene, WallContrastOnlyAffectsTheRoom) {
+  SceneOptions o;
+  o.width = 320;
+  o.height = 240;
+  o.depth_noise = false;
+  SceneOptions plain = o;
+  plain.actors.wall_contrast = 0.4;
+  FrameData a, b;
+  Scene(o).render(30, &a);
+  Scene(plain).render(30, &b);
+  std::vector<Primitive> prims;
+  Scene(o).primitives(30, &prims);
+  auto spread = [&](const FrameData& f, bool room) {
+    double sum = 0, sum_sq = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < f.gray.size(); ++i) {
+      if ((prims[f.primitive[i]].shape == PrimitiveShape::RoomInterior) != room) continue;
+      sum += f.gray[i];
+      sum_sq += static_cast<double>(f.gray[i]) * f.gray[i];
+      ++n;
+    }
+    return std::sqrt(sum_sq / n - (sum / n) * (sum / n));
+  };
+  EXPECT_LT(spread(b, true), 0.6 * spread(a, true));
+  EXPECT_NEAR(spread(b, false), spread(a, false), 1e-9);
+  SceneOptions bad = o;
+  bad.actors.wall_contrast = 1.5;
+  EXPECT_EQ(Scene(bad).status(), Status::InvalidInput);
 }
 
 TEST(SimScene, TimestampsFollowTheFrameRate) {

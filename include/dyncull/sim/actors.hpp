@@ -56,6 +56,7 @@ struct ActorOptions {
   double walker_gap_rad = 3.141592653589793;  ///< phase of walker B behind walker A on the loop
   double push_start_s = 3.5;           ///< chair starts moving (seconds from the first frame)
   double push_end_s = 5.0;             ///< chair stops moving
+  double wall_contrast = 1.0;          ///< texture contrast of walls, floor, ceiling in [0, 1]; 0.7 = plainer, harder
   double texture_scale = 1.0;          ///< multiplies every texture cell size (smaller = more corners)
 };
 
@@ -224,6 +225,7 @@ inline void build_scene(double t, double frame_dt, std::uint64_t seed, const Act
   // Room: x in [-3, 3], y in [-1.5, 4.6], z in [0, 2.8].
   sink.add(PrimitiveShape::RoomInterior, make_pose(I, {0, 1.55, 1.4}), {3.0, 3.05, 1.4}, kBg, false, tex + 100, 0.2,
            {0.85, 0.82, 0.75});
+  out->back().texture_contrast = options.wall_contrast;
   // Furniture: cabinet under the TV, desk, shelf, two posters.
   sink.add(PrimitiveShape::Box, make_pose(I, {0, 4.3, 0.35}), {0.8, 0.25, 0.35}, kBg, false, tex + 110, 0.08,
            {0.6, 0.45, 0.35});

@@ -29,6 +29,7 @@ struct Primitive {
   std::uint8_t moving = 0;             ///< 1 when the primitive moves in the world around this frame
   std::uint32_t texture_seed = 0;      ///< texture pattern (fixed per primitive so features track)
   double texture_cell_m = 0.1;         ///< coarse texture cell size in metres
+  double texture_contrast = 1.0;       ///< 1 = full texture; smaller blends towards mid-grey (plainer walls)
   Vec3<double> albedo = Vec3<double>::Constant(0.8);  ///< RGB in [0, 1]
 };
 

@@ -58,6 +58,7 @@ struct SceneOptions {
     if (!std::isfinite(start_time_s)) return bad("start_time_s must be finite");
     if (actors.walking_people < 0 || actors.walking_people > 2) return bad("actors.walking_people must be 0, 1 or 2");
     if (!(actors.texture_scale > 0)) return bad("actors.texture_scale must be positive");
+    if (!(actors.wall_contrast >= 0 && actors.wall_contrast <= 1)) return bad("actors.wall_contrast must be in [0, 1]");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -313,7 +314,8 @@ inline void Scene::render(int index, FrameData* out) const {
         tex_point[axis] = 0;
         if (p.shape == PrimitiveShape::RoomInterior) albedo = detail::room_face_albedo(albedo, axis, local[axis]);
       }
-      const double texture = texture_value(tex_point, p.texture_cell_m, tex_seed);
+      const double texture =
+          0.55 + p.texture_contrast * (texture_value(tex_point, p.texture_cell_m, tex_seed) - 0.55);
       const double shade = 0.45 + 0.55 * std::max(0.0, (p.world_from_local.R * n_local).dot(light));
       const double g = 255.0 * texture * shade;
       const double r8 = std::min(255.0, albedo.x() * g), g8 = std::min(255.0, albedo.y() * g),
