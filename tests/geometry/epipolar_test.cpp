@@ -24,7 +24,7 @@ using test::make_two_view;
 template <class T>
 class EpipolarTyped : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(EpipolarTyped, Scalars);
+TYPED_TEST_SUITE(EpipolarTyped, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 /// Relative tolerance of the batch kernels against the double oracle: float rounding of ~1e3-magnitude
 /// products (pixels times F entries) leaves ~1e-4 relative error in the residual p2^T F p1.

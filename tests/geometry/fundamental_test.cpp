@@ -28,7 +28,7 @@ using test::make_two_view;
 template <class T>
 class FundamentalTyped : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FundamentalTyped, Scalars);
+TYPED_TEST_SUITE(FundamentalTyped, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 /// Relative tolerance on exact recovery (Frobenius difference of unit-norm F): double 1e-9 (the task's bound);
 /// float: coordinates of ~500 px carry ~3e-5 px rounding, which the normalised solve amplifies by the

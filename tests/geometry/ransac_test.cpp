@@ -98,7 +98,7 @@ E make_line(std::size_t n, std::size_t outliers, double sigma, std::uint64_t see
 template <class T>
 class RansacTyped : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RansacTyped, Scalars);
+TYPED_TEST_SUITE(RansacTyped, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 TYPED_TEST(RansacTyped, RecoversLineWith40PercentOutliers) {
   using T = TypeParam;
