@@ -232,7 +232,14 @@ TEST(SimScene, StaticPointsReprojectConsistentlyBetweenFrames) {
       // floors change by a few cm per pixel at 4 m), or a depth edge at the pixel.
       const int uj = static_cast<int>(std::lround(uv.x())), vj = static_cast<int>(std::lround(uv.y()));
       const double dz = std::abs(fj.depth_m[pixel(fj, uj, vj)] - pj.z());
-      if (dz < 0.05 * pj.z()) ++agreed;
+      if (dz < 0.05 * pj.z()) {
+        ++agreed;
+        // Round trip: frame j's nearest pixel, back-projected with its depth, lands within a
+        // pixel of where we started in frame i (rounding moves it by at most half a pixel in j).
+        const Vec3<double> back = fj.world_from_cam.apply(cam.backproject(Vec2<double>(uj, vj), fj.depth_m[pixel(fj, uj, vj)]));
+        const Vec2<double> uv_i = cam.project(fi.world_from_cam.inverse().apply(back));
+        EXPECT_LT((uv_i - Vec2<double>(u, v)).norm(), 1.0) << u << "," << v;
+      }
     }
   }
   EXPECT_GT(visible, 200);
