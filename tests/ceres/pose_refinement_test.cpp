@@ -23,7 +23,7 @@ using dyncull::test::translation_error;
 template <class T>
 class CeresPoseTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(CeresPoseTest, Scalars);
+TYPED_TEST_SUITE(CeresPoseTest, Scalars, dyncull::test::ScalarNames);
 
 TYPED_TEST(CeresPoseTest, AgreesWithCoreRefinement) {
   using T = TypeParam;

@@ -22,7 +22,7 @@ using dyncull::test::room_cloud;
 template <class T>
 class IcpTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(IcpTest, Scalars);
+TYPED_TEST_SUITE(IcpTest, Scalars, dyncull::test::ScalarNames);
 
 TYPED_TEST(IcpTest, RecoversSmallMotionExactly) {
   using T = TypeParam;

@@ -19,7 +19,7 @@ using dyncull::Vec3;
 template <class T>
 class KdTreeTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(KdTreeTest, Scalars);
+TYPED_TEST_SUITE(KdTreeTest, Scalars, dyncull::test::ScalarNames);
 
 template <class T>
 std::uint32_t brute_force(const std::vector<Vec3<T>>& pts, const Vec3<T>& q, T* best) {

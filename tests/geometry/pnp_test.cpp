@@ -69,7 +69,7 @@ TEST(P3P, CollinearPointsGiveNoSolution) {
 template <class T>
 class PnpTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(PnpTest, Scalars);
+TYPED_TEST_SUITE(PnpTest, Scalars, dyncull::test::ScalarNames);
 
 template <class T>
 constexpr bool is_double() {

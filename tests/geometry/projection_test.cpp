@@ -26,7 +26,7 @@ class ProjectionTest : public ::testing::Test {
   static T tol() { return std::is_same<T, double>::value ? T(1e-9) : T(2e-4); }
 };
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(ProjectionTest, Scalars);
+TYPED_TEST_SUITE(ProjectionTest, Scalars, dyncull::test::ScalarNames);
 
 TYPED_TEST(ProjectionTest, ProjectBackprojectRoundTrip) {
   using T = TypeParam;

@@ -26,7 +26,7 @@ class UmeyamaTest : public ::testing::Test {
   static T tol() { return std::is_same<T, double>::value ? T(1e-10) : T(2e-4); }
 };
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(UmeyamaTest, Scalars);
+TYPED_TEST_SUITE(UmeyamaTest, Scalars, dyncull::test::ScalarNames);
 
 TYPED_TEST(UmeyamaTest, RecoversRigidTransformExactly) {
   using T = TypeParam;
