@@ -17,7 +17,7 @@ using test::SceneKind;
 template <class T>
 class MovingConsistencyTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(MovingConsistencyTest, Scalars);
+TYPED_TEST_SUITE(MovingConsistencyTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 struct Counts {
   std::size_t n = 0, dyn = 0;

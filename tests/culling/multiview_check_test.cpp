@@ -18,7 +18,7 @@ using test::SceneWorld;
 template <class T>
 class MultiViewTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(MultiViewTest, Scalars);
+TYPED_TEST_SUITE(MultiViewTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 // Keyframe 8 frames back: the walking person has moved 0.32 m, the chair 0.24 m sideways.
 constexpr int kFramesBack = 8;

@@ -18,7 +18,7 @@ using test::SceneKind;
 template <class T>
 class PipelineTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(PipelineTest, Scalars);
+TYPED_TEST_SUITE(PipelineTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 /// Fraction of features of one kind labelled Dynamic.
 template <class T>

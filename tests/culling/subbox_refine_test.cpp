@@ -16,7 +16,7 @@ using test::SceneKind;
 template <class T>
 class SubBoxTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(SubBoxTest, Scalars);
+TYPED_TEST_SUITE(SubBoxTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 // Geometric labels as an epipolar check would give them: truth with 8 % of static features flagged
 // (noise, epipolar-line errors) and 15 % of moving ones missed (motion along the epipolar line).
@@ -74,7 +74,7 @@ TYPED_TEST(SubBoxTest, SittingPersonKeepsStaticLegsAndCullsTheMovingUpperBody) {
 }
 
 TYPED_TEST(SubBoxTest, PaperMergeRuleCullsTheWholeSittingPerson) {
-  // Documents why merge_ratio defaults to 0.2: merging every static neighbour (the paper's literal
+  // Documents why merge_ratio defaults to 0.35: merging every static neighbour (the paper's literal
   // rule) turns the middle row dynamic, 6 > sigma2 = 4 cells, and the whole person is culled.
   using T = TypeParam;
   SceneConfig config;

@@ -28,9 +28,10 @@ struct SubBoxOptions {
   int sigma2 = 4;               ///< more than sigma2 dynamic sub-boxes (after merging) -> whole box dynamic
   std::size_t min_points = 2;   ///< sub-boxes with fewer labelled points carry no evidence ("empty")
   /// A static sub-box next to a dynamic one is merged into the dynamic set when it is empty or its
-  /// ratio is at least merge_ratio. The paper merges every neighbour (merge_ratio = 0); 0.2 keeps
-  /// sub-boxes whose points clearly agree on "static" (the legs of a person who only moves the arms).
-  T merge_ratio = T(0.2);
+  /// ratio is at least merge_ratio. The paper merges every neighbour (merge_ratio = 0); 0.35 keeps
+  /// sub-boxes whose points clearly agree on "static" (the legs of a person who only moves the upper
+  /// body) even with the 15-25 % false flags that a 0.5 px in-box epipolar threshold gives on still parts.
+  T merge_ratio = T(0.35);
   bool merge_8_neighbours = false;  ///< false: 4-neighbours (edge-sharing), true: 8 (corners too)
   /// Features outside every box keep their geometric label (there is no semantic evidence against it);
   /// false: they become static (trust only boxed objects).

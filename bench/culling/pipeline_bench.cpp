@@ -1,0 +1,130 @@
+// One frame of culling at ~1000 features, 5 boxes, 640x480 depth: the recommended pipeline (box rule,
+// depth mask, epipolar + sub-box, multi-view, box tracker, guard) and everything on (plus probability),
+// against cv::calcOpticalFlowPyrLK on the same features (the target: at most 0.05x of LK).
+#include "dyncull/culling/pipeline.hpp"
+#include "dyncull/culling/presets.hpp"
+
+#include "support/culling_scenes.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#ifdef DYNCULL_HAS_OPENCV
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#endif
+
+namespace {
+using namespace dyncull;
+
+struct Data {
+  test::CullingScene<float> scene;
+  test::SceneKeyframe<float> keyframe;
+  std::vector<Detection<float>> dets;
+};
+
+const Data& data() {
+  static const Data d = [] {
+    Data x;
+    test::SceneConfig config;
+    config.num_uniform = 760;
+    x.scene = test::make_culling_scene<float>(config);
+    x.keyframe = test::make_scene_keyframe<float>(config, 8, 600);
+    x.dets = x.scene.detections;
+    // A fifth box: a cup (medium level) on the desk.
+    x.dets.push_back(Detection<float>{Box<float>{300.f, 330.f, 360.f, 390.f}, 41, 0.8f});
+    return x;
+  }();
+  return d;
+}
+
+void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options) {
+  const Data& d = data();
+  PipelineState<float> st;
+  st.keyframes.push(d.keyframe.cam_from_world, d.keyframe.keypoints, d.keyframe.depth_m);
+  CullingFrame<float, std::vector<Vec2<float>>> frame;
+  frame.keypoints = &d.scene.keypoints;
+  frame.prev_keypoints = &d.scene.prev_keypoints;
+  frame.track_valid = d.scene.track_valid.data();
+  frame.detections = &d.dets;
+  frame.depth = d.scene.depth_view();
+  frame.camera = d.scene.camera;
+  frame.cam_from_world = &d.scene.cam_from_world;
+  std::size_t dyn = 0;
+  for (auto _ : state) {
+    const auto& r = cull_frame(frame, options, &st);
+    dyn = r.num_dynamic;
+    benchmark::DoNotOptimize(r.labels.data());
+  }
+  const auto& r = st.result;
+  std::vector<std::uint8_t> pred(r.labels.size());
+  for (std::size_t i = 0; i < pred.size(); ++i) pred[i] = r.labels[i] == FeatureLabel::Dynamic;
+  const auto pr = test::precision_recall(pred, d.scene.truth_dynamic, pred.size());
+  state.counters["features"] = double(pred.size());
+  state.counters["boxes"] = double(d.dets.size());
+  state.counters["dynamic"] = double(dyn);
+  state.counters["precision"] = pr.precision;
+  state.counters["recall"] = pr.recall;
+  state.counters["multiview_ran"] = r.multiview.ran();
+  state.counters["subbox_ran"] = r.subbox.ran();
+}
+
+void BM_Pipeline_Recommended(benchmark::State& state) { run_pipeline(state, presets::recommended<float>()); }
+BENCHMARK(BM_Pipeline_Recommended)->Unit(benchmark::kMicrosecond);
+
+void BM_Pipeline_AllStrategies(benchmark::State& state) {
+  PipelineOptions<float> o = presets::recommended<float>();
+  o.use_probability = true;
+  run_pipeline(state, o);
+}
+BENCHMARK(BM_Pipeline_AllStrategies)->Unit(benchmark::kMicrosecond);
+
+void BM_Pipeline_SemanticOnly(benchmark::State& state) { run_pipeline(state, presets::zhang_2023<float>()); }
+BENCHMARK(BM_Pipeline_SemanticOnly)->Unit(benchmark::kMicrosecond);
+
+#ifdef DYNCULL_HAS_OPENCV
+// Peer: pyramidal LK (21x21 window, 3 levels, 30 iterations / 0.01) of the same features between two
+// textured 640x480 frames shifted by a few pixels.
+void BM_Pipeline_PeerLK(benchmark::State& state) {
+  const Data& d = data();
+  cv::Mat noise(480, 640, CV_8U);
+  cv::randu(noise, 0, 255);
+  cv::Mat prev;
+  cv::GaussianBlur(noise, prev, cv::Size(0, 0), 2.0);
+  cv::Mat cur;
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 3.5, 0, 1, -2.25);
+  cv::warpAffine(prev, cur, shift, prev.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  std::vector<cv::Point2f> p0, p1;
+  for (const auto& k : d.scene.keypoints) p0.emplace_back(k.x(), k.y());
+  std::vector<std::uint8_t> status;
+  std::vector<float> err;
+  const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  for (auto _ : state) {
+    cv::calcOpticalFlowPyrLK(prev, cur, p0, p1, status, err, cv::Size(21, 21), 3, term);
+    benchmark::DoNotOptimize(p1.data());
+  }
+  state.counters["features"] = double(p0.size());
+}
+BENCHMARK(BM_Pipeline_PeerLK)->Unit(benchmark::kMicrosecond);
+#endif
+
+}  // namespace
+
+namespace {
+// Cost of each stage: the recommended pipeline with one stage switched off (arg: 0 multi-view,
+// 1 depth mask, 2 sub-box, 3 moving consistency (and so sub-box), 4 box tracker).
+void BM_Pipeline_RecommendedWithout(benchmark::State& state) {
+  dyncull::PipelineOptions<float> o = dyncull::presets::recommended<float>();
+  switch (state.range(0)) {
+    case 0: o.use_multiview = false; break;
+    case 1: o.use_depth_mask = false; break;
+    case 2: o.use_subbox = false; break;
+    case 3: o.use_moving_consistency = false; break;
+    default: o.use_box_tracker = false; break;
+  }
+  run_pipeline(state, o);
+}
+BENCHMARK(BM_Pipeline_RecommendedWithout)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+}  // namespace

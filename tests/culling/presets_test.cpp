@@ -1,0 +1,73 @@
+// Tests that each preset switches on exactly its paper's strategies, with the documented values.
+#include "dyncull/culling/presets.hpp"
+
+#include <gtest/gtest.h>
+
+namespace dyncull {
+namespace {
+
+TEST(Presets, EachPaperRunsItsStrategies) {
+  const auto dld = presets::dld_slam<double>();
+  EXPECT_TRUE(dld.use_depth_mask && dld.use_probability && dld.use_box_rule);
+  EXPECT_FALSE(dld.use_moving_consistency || dld.use_subbox || dld.use_multiview);
+  EXPECT_EQ(dld.depth_mask.mode, DepthMaskMode::Plain);
+  EXPECT_EQ(dld.probability_flow_model, FlowModel::MeanFlow);
+
+  const auto rtd = presets::rtd_slam<double>();
+  EXPECT_TRUE(rtd.use_box_rule && rtd.use_multiview);
+  EXPECT_FALSE(rtd.use_moving_consistency || rtd.use_depth_mask || rtd.use_probability);
+  EXPECT_DOUBLE_EQ(rtd.multiview.depth_threshold_m, 0.4);
+  EXPECT_DOUBLE_EQ(rtd.multiview.max_parallax_deg, 30.0);
+  EXPECT_EQ(rtd.candidates, CandidatePolicy::Verify);
+
+  const auto zhu = presets::zhu_2024<float>();
+  EXPECT_TRUE(zhu.use_box_rule);
+  EXPECT_FALSE(zhu.box_rule.medium_as_candidate);
+  EXPECT_FALSE(zhu.use_moving_consistency || zhu.use_multiview || zhu.use_depth_mask);
+
+  const auto dfd = presets::dfd_slam<float>();
+  EXPECT_TRUE(dfd.use_moving_consistency && dfd.use_subbox);
+  EXPECT_FLOAT_EQ(dfd.subbox.merge_ratio, 0.f);  // the paper's literal merge
+  EXPECT_EQ(dfd.subbox.sigma2, 4);
+  EXPECT_FALSE(dfd.moving.fit_outside_boxes);
+  EXPECT_FLOAT_EQ(dfd.moving.max_epipolar_distance_px, 1.f);
+  EXPECT_FLOAT_EQ(dfd.moving.max_epipolar_distance_in_boxes_px, 1.f);
+
+  const auto zhang = presets::zhang_2023<float>();
+  EXPECT_EQ(zhang.candidates, CandidatePolicy::Cull);
+  EXPECT_FALSE(zhang.use_moving_consistency);
+}
+
+TEST(Presets, RecommendedCombinesThemWithTheGuard) {
+  const auto o = presets::recommended<float>();
+  EXPECT_TRUE(o.use_box_rule && o.use_depth_mask && o.use_moving_consistency && o.use_subbox && o.use_multiview &&
+              o.use_box_tracker && o.use_detection_filter && o.survivor_guard);
+  EXPECT_FALSE(o.use_probability);
+  EXPECT_TRUE(o.moving.fit_outside_boxes);
+  EXPECT_FLOAT_EQ(o.moving.max_epipolar_distance_in_boxes_px, 0.5f);
+  EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
+  EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
+  EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);
+  EXPECT_EQ(o.min_survivors, 30u);
+  EXPECT_FLOAT_EQ(o.detections.box_padding_px, 5.f);
+}
+
+TEST(Presets, DefaultsOfTheGeometricOptions) {
+  const MovingConsistencyOptions<double> m;
+  EXPECT_DOUBLE_EQ(m.fundamental.ransac.max_residual, 1.0);
+  EXPECT_DOUBLE_EQ(m.fundamental.ransac.confidence, 0.99);
+  EXPECT_FALSE(m.fundamental.check_homography_degeneracy);
+  EXPECT_EQ(m.min_tracks_outside_boxes, 20u);
+  const SubBoxOptions<double> s;
+  EXPECT_EQ(s.grid, 3);
+  EXPECT_DOUBLE_EQ(s.sigma1, 0.5);
+  EXPECT_EQ(s.dilation_radius_px, 15);
+  EXPECT_FALSE(s.merge_8_neighbours);
+  const MultiViewOptions<double> v;
+  EXPECT_DOUBLE_EQ(v.depth_threshold_m, 0.4);
+  EXPECT_DOUBLE_EQ(v.max_parallax_deg, 30.0);
+  EXPECT_DOUBLE_EQ(v.region_depth_tolerance_m, 0.2);
+}
+
+}  // namespace
+}  // namespace dyncull
