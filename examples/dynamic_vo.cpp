@@ -173,14 +173,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
       return 1;
     }
+    // A TUM directory has no per-pixel motion truth: the oracle cannot run there.
     std::vector<vo::StrategySpec> run;
-    if (!source.has_detections()) {
+    if (!source.has_detections())
       std::printf("No detections given (--detections): running only the strategies that need none.\n");
-      for (const auto& s : chosen)
-        if (!s.needs_detections) run.push_back(s);
-    } else {
-      run = chosen;
-    }
+    for (const auto& s : chosen)
+      if (!s.oracle && (source.has_detections() || !s.needs_detections)) run.push_back(s);
     std::string name = std::filesystem::path(args.tum).filename().string();
     if (name.empty()) name = std::filesystem::path(args.tum).parent_path().filename().string();
     vo::SequenceReport rep;

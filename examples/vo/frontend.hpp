@@ -36,6 +36,8 @@ struct FrontEndOptions {
   int lk_window_px = 21;              ///< LK window and pyramid depth (PRIOR_ART: 21 px, 3-5 levels)
   int lk_levels = 3;
   double pnp_threshold_px = 2.0;      ///< reprojection inlier threshold of PnP-RANSAC
+  double track_max_error_px = 4.0;    ///< tracks (kept or culled) further than this from their point's
+                                      ///< projection at the accepted pose are dropped (ORB-SLAM discards outliers)
   int min_pnp_inliers = 15;           ///< ORB-SLAM2 loses reference tracking below 15 matches
   int keyframe_min_inliers = 120;     ///< new keyframe when fewer inliers remain ...
   double keyframe_min_tracked_ratio = 0.5;  ///< ... or fewer tracks than this share of the keyframe's ...
@@ -185,6 +187,7 @@ class FrontEnd {
       stats.reason = "too few kept tracks for PnP";
     }
     if (!ok) stats.fallback = true;
+    if (ok) drop_outlier_tracks(world_from_cam.inverse());
 
     velocity_ = world_from_cam_.inverse() * world_from_cam;
     world_from_cam_ = world_from_cam;
@@ -221,6 +224,32 @@ class FrontEnd {
       }
     }
     return z;
+  }
+
+  /// Removes tracks whose 3-D point does not reproject near them: LK tracks dragged along by an
+  /// occluding person and points that were on a moving surface when their keyframe was made. Without
+  /// this they accumulate until the next keyframe and can form a coherent wrong consensus.
+  void drop_outlier_tracks(const Rigid3<double>& cam_from_world) {
+    const double max_sq = options_.track_max_error_px * options_.track_max_error_px;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      const Vec3<double> pc = cam_from_world.apply(tracks_.world[i]);
+      if (!(pc.z() > 0)) continue;
+      const Vec2<double> q = camera_.project(pc);
+      const double du = q.x() - tracks_.cur_px[i].x, dv = q.y() - tracks_.cur_px[i].y;
+      if (!(du * du + dv * dv <= max_sq)) continue;
+      tracks_.ids[n] = tracks_.ids[i];
+      tracks_.prev_px[n] = tracks_.prev_px[i];
+      tracks_.cur_px[n] = tracks_.cur_px[i];
+      tracks_.world[n] = tracks_.world[i];
+      tracks_.pnp_inlier[n] = tracks_.pnp_inlier[i];
+      ++n;
+    }
+    tracks_.ids.resize(n);
+    tracks_.prev_px.resize(n);
+    tracks_.cur_px.resize(n);
+    tracks_.world.resize(n);
+    tracks_.pnp_inlier.resize(n);
   }
 
   /// The current frame becomes the keyframe: its PnP inliers are re-anchored on its own depth

@@ -120,6 +120,20 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       const auto t1 = std::chrono::steady_clock::now();
       cullers[k].cull(frame, fe.tracks(), fe.world_from_cam(), &keep);
       run.cull_ms += detail::ms_since(t1);
+      // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
+      const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
+      if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
+      if (draw && k == draw_strategy && fe.tracks().size() > 0) {
+        source.load_colour(&frame);
+        char file[64];
+        std::snprintf(file, sizeof file, "/%s_frame%04d.png", name.c_str(), i);
+        std::ostringstream cap;
+        cap << name << " frame " << i << ", " << specs[k].name << ": " << kept << " kept of " << fe.tracks().size()
+            << (frame.moving.empty() ? " (green kept, red culled)" : " (green kept, red culled, x culled static, ring kept moving)");
+        if (draw_features(options.out_dir + file, frame.bgr, cap.str(), fe.tracks().cur_px, keep, frame.detections,
+                          frame.moving))
+          report->files.push_back(options.out_dir + file);
+      }
       const auto t2 = std::chrono::steady_clock::now();
       const FrameStats st = fe.estimate(keep);
       run.front_end_ms += track_ms + detail::ms_since(t2);
@@ -132,19 +146,6 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       run.tracks += st.tracks;
       run.kept += st.kept;
       run.inliers += st.inliers;
-      if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
-      if (draw && k == draw_strategy && fe.tracks().size() > 0) {
-        source.load_colour(&frame);
-        char file[64];
-        std::snprintf(file, sizeof file, "/%s_frame%04d.png", name.c_str(), i);
-        std::ostringstream cap;
-        cap << name << " frame " << i << ", " << specs[k].name << ": " << st.kept << " kept of " << st.tracks
-            << " (green kept, red culled" << (frame.moving.empty() ? "" : "; red x: culled static, yellow ring: kept moving")
-            << ")";
-        if (draw_features(options.out_dir + file, frame.bgr, cap.str(), fe.tracks().cur_px, keep, frame.detections,
-                          frame.moving))
-          report->files.push_back(options.out_dir + file);
-      }
       if (options.print_progress && ((i + 1) % options.progress_every == 0 || i + 1 == n)) {
         std::printf("[%s] frame %4d/%d  %-20s tracks %4zu kept %4zu inliers %4zu%s\n", name.c_str(), i + 1, n,
                     specs[k].name.c_str(), st.tracks, st.kept, st.inliers, st.fallback ? "  (constant-velocity fallback)" : "");
@@ -191,6 +192,8 @@ inline void evaluate(const eval::Trajectory<double>& truth, SequenceReport* repo
     }
   }
   if (!options.write_outputs) return;
+  const std::string truth_file = options.out_dir + "/" + report->name + "_groundtruth.txt";
+  if (eval::write_tum_trajectory(truth_file, truth).ok()) report->files.push_back(truth_file);
   std::vector<Vec3<double>> truth_xyz;
   for (const auto& p : truth.poses) truth_xyz.push_back(p.t);
   std::vector<std::string> names;
