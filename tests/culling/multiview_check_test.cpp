@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -98,6 +99,50 @@ TYPED_TEST(MultiViewTest, RegionGrowingLabelsCurrentFeaturesOnTheWalkingPerson) 
   // bounded by that band; recall covers both movers' visible faces.
   EXPECT_GE(pr.precision, 0.8) << "tp " << pr.tp << " fp " << pr.fp;
   EXPECT_GE(pr.recall, 0.85) << "tp " << pr.tp << " fn " << pr.fn;
+}
+
+TYPED_TEST(MultiViewTest, ScanlineRegionGrowingMatchesPixelwiseFloodFill) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto scene = test::make_culling_scene<T>(config);
+  const auto kf = test::make_scene_keyframe<T>(config, kFramesBack, 800);
+  MultiViewOptions<T> options;
+  const auto r = check_multiview(kf.keypoints, kf.depth_m, kf.cam_from_world, scene.cam_from_world,
+                                 scene.depth_view(), scene.camera, options);
+  ASSERT_GT(r.num_dynamic, 0u);
+  Mask fast;
+  std::vector<std::uint32_t> stack;
+  const std::size_t n_fast = grow_multiview_regions(r, scene.depth_view(), options, &fast, &stack);
+  // Oracle: plain 4-neighbour breadth-first fill with the documented joining rule.
+  const int W = scene.width, H = scene.height;
+  Mask ref(W, H);
+  std::size_t n_ref = 0;
+  for (std::size_t i = 0; i < r.labels.size(); ++i) {
+    if (r.labels[i] != FeatureLabel::Dynamic) continue;
+    const int su = int(std::lround(double(r.projected[i].x()))), sv = int(std::lround(double(r.projected[i].y())));
+    if (ref.test(su, sv)) continue;
+    const double seed = double(r.measured_depth_m[i]);
+    std::vector<std::pair<int, int>> queue{{su, sv}};
+    ref.pixels[static_cast<std::size_t>(sv * W + su)] = 1;
+    ++n_ref;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int x = queue[q].first, y = queue[q].second;
+      const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+      for (int k = 0; k < 4; ++k) {
+        if (nx[k] < 0 || ny[k] < 0 || nx[k] >= W || ny[k] >= H || ref.test(nx[k], ny[k])) continue;
+        const double d = double(scene.depth[static_cast<std::size_t>(ny[k] * W + nx[k])]);
+        if (!(d > 0) || std::abs(d - seed) > double(options.region_depth_tolerance_m)) continue;
+        ref.pixels[static_cast<std::size_t>(ny[k] * W + nx[k])] = 1;
+        ++n_ref;
+        queue.emplace_back(nx[k], ny[k]);
+      }
+    }
+  }
+  // Equal up to pixels exactly at the tolerance (float rounding of the raw-unit bounds).
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < ref.pixels.size(); ++i) differ += (ref.pixels[i] != 0) != (fast.pixels[i] != 0);
+  EXPECT_LE(differ, n_ref / 1000) << "fast " << n_fast << " ref " << n_ref;
+  EXPECT_EQ(n_fast, fast.count());
 }
 
 TYPED_TEST(MultiViewTest, Uint16TumDepthGivesTheSameLabels) {

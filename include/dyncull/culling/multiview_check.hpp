@@ -226,37 +226,55 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
   std::uint8_t* m = mask->pixels.data();
   std::size_t set = 0;
   const T tol = options.region_depth_tolerance_m;
+  const double units = static_cast<double>(depth.units_per_metre);
   for (std::size_t i = 0; i < result.labels.size(); ++i) {
     if (result.labels[i] != FeatureLabel::Dynamic) continue;
     const int su = static_cast<int>(std::lround(result.projected[i].x()));
     const int sv = static_cast<int>(std::lround(result.projected[i].y()));
     if (!depth.in_bounds(su, sv)) continue;
-    const T seed_d = result.measured_depth_m[i];
     const std::size_t seed_idx = static_cast<std::size_t>(sv) * static_cast<std::size_t>(w) + static_cast<std::size_t>(su);
     if (m[seed_idx]) continue;  // already inside a grown region
+    // The joining test in raw units, with the view's valid range folded in: no division per pixel.
+    const double seed_d = static_cast<double>(result.measured_depth_m[i]);
+    const double lo_m = std::max({seed_d - static_cast<double>(tol), static_cast<double>(depth.min_m), 1e-9});
+    const double hi_m = std::min(seed_d + static_cast<double>(tol), static_cast<double>(depth.max_m));
+    const double lo = lo_m * units, hi = hi_m * units;
+    // Scanline fill (4-connected): each stack entry is a seed pixel of a run; runs are filled left and
+    // right, and the rows above and below are scanned once per run. Same region as a pixel-wise fill.
+    auto inside = [&](int x, int y) {
+      const double r = static_cast<double>(depth.row(y)[x]);
+      return !m[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] && r >= lo && r <= hi;
+    };
+    const std::size_t cap = options.max_region_pixels > 0 ? options.max_region_pixels : static_cast<std::size_t>(-1);
     std::size_t region = 0;
     stack->clear();
     stack->push_back(static_cast<std::uint32_t>(seed_idx));
-    m[seed_idx] = 1;
-    ++set;
-    ++region;
-    while (!stack->empty()) {
+    bool first = true;
+    while (!stack->empty() && region < cap) {
       const std::uint32_t idx = stack->back();
       stack->pop_back();
-      const int x = static_cast<int>(idx % static_cast<std::uint32_t>(w)), y = static_cast<int>(idx / static_cast<std::uint32_t>(w));
-      const int nx[4] = {x - 1, x + 1, x, x};
-      const int ny[4] = {y, y, y - 1, y + 1};
-      for (int k = 0; k < 4; ++k) {
-        if (!depth.in_bounds(nx[k], ny[k])) continue;
-        const std::size_t nidx = static_cast<std::size_t>(ny[k]) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx[k]);
-        if (m[nidx]) continue;
-        const T d = T(depth.depth_m(nx[k], ny[k]));
-        if (!(d > T(0)) || std::abs(d - seed_d) >= tol) continue;
-        if (options.max_region_pixels > 0 && region >= options.max_region_pixels) continue;
-        m[nidx] = 1;
-        ++set;
-        ++region;
-        stack->push_back(static_cast<std::uint32_t>(nidx));
+      const int y = static_cast<int>(idx / static_cast<std::uint32_t>(w));
+      const int x = static_cast<int>(idx - static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(w));
+      if (!first && !inside(x, y)) continue;  // the seed itself is taken whatever its raw value
+      first = false;
+      int x0 = x, x1 = x;
+      while (x0 > 0 && inside(x0 - 1, y)) --x0;
+      while (x1 + 1 < w && inside(x1 + 1, y)) ++x1;
+      std::uint8_t* mrow = m + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+      for (int xx = x0; xx <= x1; ++xx) mrow[xx] = 1;
+      const std::size_t run = static_cast<std::size_t>(x1 - x0 + 1);
+      set += run;
+      region += run;
+      for (int ny = y - 1; ny <= y + 1; ny += 2) {
+        if (ny < 0 || ny >= h) continue;
+        bool in_run = false;
+        for (int xx = x0; xx <= x1; ++xx) {
+          const bool ok = inside(xx, ny);
+          if (ok && !in_run)
+            stack->push_back(static_cast<std::uint32_t>(static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) +
+                                                        static_cast<std::size_t>(xx)));
+          in_run = ok;
+        }
       }
     }
   }
