@@ -1,10 +1,14 @@
 /// @file culling.hpp
-/// The culling strategies the dynamic_vo demo compares: no culling and each dyncull preset
-/// (culling/presets.hpp), applied to the current frame's tracked features before PnP.
+/// The culling strategies the dynamic_vo demo compares: no culling, each dyncull preset
+/// (culling/presets.hpp, run by culling/pipeline.hpp's cull_frame) and a truth oracle on the sim,
+/// applied to the current frame's tracked features before PnP.
 #pragma once
 
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/types.hpp"
+#include "dyncull/culling/pipeline.hpp"
+#include "dyncull/culling/presets.hpp"
+#include "dyncull/opencv/views.hpp"
 
 #include "frontend.hpp"
 #include "sources.hpp"
@@ -24,47 +28,78 @@ struct StrategySpec {
   bool needs_detections = false;  ///< cannot run without detector boxes
   bool recommended = false;       ///< the library's recommended default preset
   bool oracle = false;            ///< culls by the sim's per-pixel truth: the bound no culling can beat
+  PipelineOptions<float> pipeline{};
 };
 
-/// "none" first (the reference of the improvement column), then the presets.
+/// "none" first (the reference of the improvement column), then the presets, then the oracle.
 inline std::vector<StrategySpec> all_strategies() {
   std::vector<StrategySpec> out;
-  out.push_back(StrategySpec{"none", "no culling: every tracked feature goes to PnP-RANSAC", false, false, false, false});
-  out.push_back(StrategySpec{"oracle", "culls exactly the features on moving surfaces (sim truth): the best any culling can do",
-                             true, false, false, true});
+  auto add = [&](const char* name, const char* description, bool culls, bool dets, bool rec, bool oracle,
+                 PipelineOptions<float> o) {
+    out.push_back(StrategySpec{name, description, culls, dets, rec, oracle, o});
+  };
+  add("none", "no culling: every tracked feature goes to PnP-RANSAC", false, false, false, false,
+      presets::none<float>());
+  add("dld_slam", "000: depth mask in boxes + dynamic probability", true, true, false, false, presets::dld_slam<float>());
+  add("rtd_slam", "001: motion levels, box culling, multi-view check", true, true, false, false,
+      presets::rtd_slam<float>());
+  add("zhu_2024", "002: static/dynamic box rule", true, true, false, false, presets::zhu_2024<float>());
+  add("dfd_slam", "003: epipolar check + 3x3 sub-box refinement", true, false, false, false, presets::dfd_slam<float>());
+  add("zhang_2023", "004: high/medium/low logical discrimination", true, true, false, false,
+      presets::zhang_2023<float>());
+  add("recommended", "dyncull's recommended preset (box rule + depth band + epipolar/sub-box + multi-view + guard)",
+      true, true, true, false, presets::recommended<float>());
+  add("oracle", "culls exactly the features on moving surfaces (sim truth): the best any culling can do", true, false,
+      false, true, presets::none<float>());
   return out;
 }
 
 /// Per-strategy culling state carried frame to frame.
 class Culler {
  public:
-  Culler(const StrategySpec& spec, const PinholeCamera<double>& camera) : spec_(spec), camera_(camera) {}
+  /// Multi-view references are stored every this many frames (at the motion-model pose).
+  static constexpr int kReferenceEvery = 5;
 
-  /// keep[i] != 0 for the tracks PnP may use.
-  void cull(const SequenceFrame& frame, const Tracks& tracks, const Rigid3<double>& prev_world_from_cam,
+  Culler(const StrategySpec& spec, const PinholeCamera<double>& camera)
+      : spec_(spec), camera_(camera.cast<float>()) {}
+
+  /// keep[i] != 0 for the tracks PnP may use. `predicted_world_from_cam`: the motion-model pose.
+  void cull(const SequenceFrame& frame, const Tracks& tracks, const Rigid3<double>& predicted_world_from_cam,
             std::vector<std::uint8_t>* keep) {
-    (void)prev_world_from_cam;
     keep->assign(tracks.size(), 1);
-    if (spec_.oracle && !frame.moving.empty()) {
+    ++frame_index_;
+    if (!spec_.culls) return;
+    if (spec_.oracle) {
+      if (frame.moving.empty()) return;
       for (std::size_t i = 0; i < tracks.size(); ++i) {
         const int u = cvRound(tracks.cur_px[i].x), v = cvRound(tracks.cur_px[i].y);
         if (u >= 0 && v >= 0 && u < frame.moving.cols && v < frame.moving.rows && frame.moving.at<std::uint8_t>(v, u))
           (*keep)[i] = 0;
       }
+      return;
     }
-  }
-
-  /// Called after the pose of the frame is known (keyframe bookkeeping of multi-view checks).
-  void after_pose(const SequenceFrame& frame, const Tracks& tracks, const Rigid3<double>& world_from_cam, bool keyframe) {
-    (void)frame;
-    (void)tracks;
-    (void)world_from_cam;
-    (void)keyframe;
+    ids_.assign(tracks.ids.begin(), tracks.ids.end());
+    pose_ = predicted_world_from_cam.inverse().cast<float>();
+    CullingFrame<float, std::vector<cv::Point2f>, std::vector<cv::Point2f>, float> f;
+    f.keypoints = &tracks.cur_px;
+    f.prev_keypoints = &tracks.prev_px;
+    f.track_ids = &ids_;
+    f.detections = &frame.detections;
+    f.depth = cv_adapter::depth_view_f32(frame.depth_m, 0.4f, 8.f);
+    f.camera = camera_;
+    f.cam_from_world = &pose_;
+    f.is_keyframe = frame_index_ % kReferenceEvery == 1;
+    const PipelineResult<float>& r = cull_frame(f, spec_.pipeline, &state_);
+    if (r.keep.size() == tracks.size()) *keep = r.keep;
   }
 
  private:
   StrategySpec spec_;
-  PinholeCamera<double> camera_;
+  PinholeCamera<float> camera_;
+  PipelineState<float> state_;
+  std::vector<std::int64_t> ids_;
+  Rigid3<float> pose_;
+  int frame_index_ = 0;
 };
 
 }  // namespace vo

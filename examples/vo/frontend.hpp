@@ -202,6 +202,9 @@ class FrontEnd {
     return stats;
   }
 
+  /// Constant-velocity prediction of the next frame's pose (valid between estimate() and track()).
+  Rigid3<double> predicted_world_from_cam() const { return world_from_cam_ * velocity_; }
+
   /// Estimated pose of the current frame (world = first frame's camera).
   const Rigid3<double>& world_from_cam() const { return world_from_cam_; }
   const PinholeCamera<double>& camera() const { return camera_; }
