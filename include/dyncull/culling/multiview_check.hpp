@@ -3,6 +3,7 @@
 /// their depth, moved by the relative pose and projected; d_proj - d' > tau_d marks a moving surface at x'.
 #pragma once
 
+#include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/mask.hpp"
@@ -216,12 +217,17 @@ MultiViewResult<T> check_multiview(const C& ref_points, const D& ref_depths_m, c
 /// Grows the dynamic seeds x' of `result` over the current depth image (4-neighbour flood fill, pixels
 /// within region_depth_tolerance_m of the seed's measured depth d'), OR-ing into `mask` (same size as the
 /// depth image; resized and cleared when its size differs). DynaSLAM does the same before dilating.
-/// `stack` is caller-owned scratch, reused across frames. Returns the number of pixels set.
+/// `stack` is caller-owned scratch, reused across frames. `roi` (optional) limits seeds and growth to
+/// a pixel rectangle (the pipeline passes the region of the features it still has to decide).
+/// Returns the number of pixels set.
 template <class Raw, class T>
 std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const DepthView<Raw>& depth,
-                                   const MultiViewOptions<T>& options, Mask* mask, std::vector<std::uint32_t>* stack) {
+                                   const MultiViewOptions<T>& options, Mask* mask, std::vector<std::uint32_t>* stack,
+                                   const PixelRect* roi = nullptr) {
   if (depth.empty()) return 0;
   const int w = depth.width, h = depth.height;
+  const int rc0 = roi ? std::max(0, roi->c0) : 0, rr0 = roi ? std::max(0, roi->r0) : 0;
+  const int rc1 = roi ? std::min(w, roi->c1) : w, rr1 = roi ? std::min(h, roi->r1) : h;
   if (mask->width != w || mask->height != h) mask->reset(w, h, 0);
   std::uint8_t* m = mask->pixels.data();
   std::size_t set = 0;
@@ -231,7 +237,7 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
     if (result.labels[i] != FeatureLabel::Dynamic) continue;
     const int su = static_cast<int>(std::lround(result.projected[i].x()));
     const int sv = static_cast<int>(std::lround(result.projected[i].y()));
-    if (!depth.in_bounds(su, sv)) continue;
+    if (su < rc0 || sv < rr0 || su >= rc1 || sv >= rr1) continue;
     const std::size_t seed_idx = static_cast<std::size_t>(sv) * static_cast<std::size_t>(w) + static_cast<std::size_t>(su);
     if (m[seed_idx]) continue;  // already inside a grown region
     // The joining test in raw units, with the view's valid range folded in: no division per pixel.
@@ -258,15 +264,15 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
       if (!first && !inside(x, y)) continue;  // the seed itself is taken whatever its raw value
       first = false;
       int x0 = x, x1 = x;
-      while (x0 > 0 && inside(x0 - 1, y)) --x0;
-      while (x1 + 1 < w && inside(x1 + 1, y)) ++x1;
+      while (x0 > rc0 && inside(x0 - 1, y)) --x0;
+      while (x1 + 1 < rc1 && inside(x1 + 1, y)) ++x1;
       std::uint8_t* mrow = m + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
       for (int xx = x0; xx <= x1; ++xx) mrow[xx] = 1;
       const std::size_t run = static_cast<std::size_t>(x1 - x0 + 1);
       set += run;
       region += run;
       for (int ny = y - 1; ny <= y + 1; ny += 2) {
-        if (ny < 0 || ny >= h) continue;
+        if (ny < rr0 || ny >= rr1) continue;
         bool in_run = false;
         for (int xx = x0; xx <= x1; ++xx) {
           const bool ok = inside(xx, ny);

@@ -399,7 +399,26 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       r.multiview.reason = "no keyframe stored yet";
     } else if (frame.depth.empty()) {
       r.multiview.reason = "no depth image";
+    } else if (!options.multiview_overrides_static &&
+               std::none_of(s.sem_labels.begin(), s.sem_labels.end(),
+                            [](FeatureLabel l) { return l == FeatureLabel::Candidate; })) {
+      r.multiview.reason = "no candidate features to verify (multiview_overrides_static is off)";
     } else {
+      // Growth only where labels are still open: all the image, or around the candidates.
+      PixelRect roi{0, 0, frame.depth.width, frame.depth.height};
+      if (!options.multiview_overrides_static) {
+        roi = PixelRect{frame.depth.width, frame.depth.height, 0, 0};
+        for (std::size_t i = 0; i < n; ++i) {
+          int u = 0, v = 0;
+          if (s.sem_labels[i] != FeatureLabel::Candidate ||
+              !detail::keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
+            continue;
+          roi.c0 = std::min(roi.c0, u);
+          roi.r0 = std::min(roi.r0, v);
+          roi.c1 = std::max(roi.c1, u + 1);
+          roi.r1 = std::max(roi.r1, v + 1);
+        }
+      }
       s.ref_index.resize(std::max<std::size_t>(1, options.max_reference_keyframes));
       const std::size_t k = s.keyframes.select_references(*frame.cam_from_world, options.max_reference_keyframes,
                                                           s.ref_index.data());
@@ -414,7 +433,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
                         options.multiview, &s.multiview);
         if (s.multiview.num_checked == 0) continue;
         ++checked;
-        grow_multiview_regions(s.multiview, frame.depth, options.multiview, &s.multiview_mask, &s.flood_stack);
+        grow_multiview_regions(s.multiview, frame.depth, options.multiview, &s.multiview_mask, &s.flood_stack, &roi);
       }
       if (checked == 0) {
         r.multiview.status = Status::TooFewPoints;
