@@ -1,0 +1,147 @@
+// Smoke and unit tests of the dynamic_vo demo's pieces (examples/vo/*.hpp): the VO with and without
+// culling on a short synthetic walking sequence, the label counting, and the TUM directory reader.
+#include <gtest/gtest.h>
+
+#ifdef DYNCULL_HAS_OPENCV
+
+#include "../../examples/vo/runner.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace dyncull;
+
+const vo::StrategySpec* find_spec(const std::vector<vo::StrategySpec>& all, bool recommended) {
+  for (const auto& s : all)
+    if (recommended ? s.recommended : !s.culls) return &s;
+  return nullptr;
+}
+
+// 30 frames of the sim's xyz walking sequence: the recommended preset must track more accurately
+// than no culling (measured: 4.3 mm vs 8.5 mm) and label most moving features (measured precision
+// 0.66, recall 0.75: below the project's 0.9 target, see docs/results.md; the bounds here guard
+// against regressions, not the target).
+TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
+  const auto all = vo::all_strategies();
+  const vo::StrategySpec* none = find_spec(all, false);
+  const vo::StrategySpec* preset = find_spec(all, true);
+  ASSERT_NE(none, nullptr);
+  ASSERT_NE(preset, nullptr) << "no recommended preset in vo::all_strategies()";
+
+  sim::SceneOptions so;
+  so.motion = sim::CameraMotion::Xyz;
+  so.num_frames = 30;
+  vo::SimSource source(so);
+  vo::RunnerOptions ro;
+  ro.max_frames = 30;
+  ro.write_outputs = false;
+  ro.print_progress = false;
+  vo::SequenceReport report;
+  std::string error;
+  ASSERT_TRUE(vo::run_sequence("xyz", source, {*none, *preset}, ro, &report, &error)) << error;
+  vo::evaluate_against_recorded_truth(&report, ro);
+  ASSERT_EQ(report.runs.size(), 2u);
+  const vo::StrategyRun& a = report.runs[0];
+  const vo::StrategyRun& b = report.runs[1];
+  ASSERT_TRUE(a.has_ate) << a.ate_note;
+  ASSERT_TRUE(b.has_ate) << b.ate_note;
+  EXPECT_EQ(a.ate_pairs, 30u);
+  EXPECT_LT(b.ate_rmse_m, a.ate_rmse_m) << "culled " << b.ate_rmse_m << " m vs none " << a.ate_rmse_m << " m";
+  EXPECT_GT(b.labels.precision(), 0.5);
+  EXPECT_GT(b.labels.recall(), 0.5);
+  // No culling never culls: its counts have no positives at all.
+  EXPECT_EQ(a.labels.true_positive + a.labels.false_positive, 0u);
+}
+
+// A static camera must stay put: every frame's estimate within a few centimetres of the truth.
+TEST(DynamicVo, StaticCameraStaysStillWithCulling) {
+  const auto all = vo::all_strategies();
+  const vo::StrategySpec* preset = find_spec(all, true);
+  ASSERT_NE(preset, nullptr);
+  sim::SceneOptions so;
+  so.motion = sim::CameraMotion::Static;
+  so.num_frames = 20;
+  vo::SimSource source(so);
+  vo::RunnerOptions ro;
+  ro.max_frames = 20;
+  ro.write_outputs = false;
+  ro.print_progress = false;
+  vo::SequenceReport report;
+  std::string error;
+  ASSERT_TRUE(vo::run_sequence("static", source, {*preset}, ro, &report, &error)) << error;
+  ASSERT_EQ(report.runs[0].estimate.size(), 20u);
+  for (std::size_t i = 0; i < 20; ++i) {
+    const double d = (report.runs[0].estimate.poses[i].t - report.truth.poses[i].t).norm();
+    EXPECT_LT(d, 0.05) << "frame " << i;
+  }
+}
+
+TEST(DynamicVo, LabelCountsAgainstTruth) {
+  cv::Mat moving(10, 10, CV_8UC1, cv::Scalar(0));
+  moving(cv::Rect(0, 0, 5, 10)).setTo(1);  // left half moves
+  std::vector<cv::Point2f> px = {{1, 1}, {2, 2}, {7, 7}, {8, 8}, {1, 8}, {50, 50}};
+  std::vector<std::uint8_t> keep = {0, 0, 0, 1, 1, 0};  // last one is outside: not counted
+  std::vector<Detection<float>> boxes = {Detection<float>{Box<float>{6, 6, 9, 9}, 0, 1.f}};
+  vo::LabelCounts c;
+  vo::count_labels(px, keep, moving, boxes, &c);
+  EXPECT_EQ(c.true_positive, 2u);
+  EXPECT_EQ(c.false_positive, 1u);
+  EXPECT_EQ(c.false_negative, 1u);
+  EXPECT_EQ(c.true_negative, 1u);
+  EXPECT_EQ(c.static_in_box, 2u);
+  EXPECT_EQ(c.static_in_box_kept, 1u);
+  EXPECT_DOUBLE_EQ(c.precision(), 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(c.recall(), 2.0 / 3.0);
+  vo::LabelCounts empty;
+  EXPECT_TRUE(std::isnan(empty.precision()));
+}
+
+// rgb.txt / depth.txt association (nearest within 0.02 s), depth scale 5000 and YOLO detections.
+TEST(DynamicVo, TumSourceReadsDirectory) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "dyncull_dynamic_vo_test_tum";
+  std::filesystem::create_directories(dir / "rgb");
+  std::filesystem::create_directories(dir / "depth");
+  cv::Mat rgb(48, 64, CV_8UC3, cv::Scalar(10, 20, 30));
+  cv::Mat depth(48, 64, CV_16UC1, cv::Scalar(5000));  // 1 m
+  ASSERT_TRUE(cv::imwrite((dir / "rgb/1.000000.png").string(), rgb));
+  ASSERT_TRUE(cv::imwrite((dir / "rgb/2.000000.png").string(), rgb));
+  ASSERT_TRUE(cv::imwrite((dir / "depth/1.010000.png").string(), depth));
+  ASSERT_TRUE(cv::imwrite((dir / "depth/2.500000.png").string(), depth));
+  std::ofstream(dir / "rgb.txt") << "# color images\n1.000000 rgb/1.000000.png\n2.000000 rgb/2.000000.png\n";
+  std::ofstream(dir / "depth.txt") << "# depth maps\n1.010000 depth/1.010000.png\n2.500000 depth/2.500000.png\n";
+  std::ofstream(dir / "dets.txt") << "1.000000 0 0.5 0.5 0.25 0.5 0.9\n1.000000 0 nan 0.5 0.25 0.5 0.9\n";
+
+  vo::TumSource src;
+  std::string error;
+  PinholeCamera<double> cam{50, 50, 31.5, 23.5, 64, 48};
+  ASSERT_TRUE(src.open(dir.string(), (dir / "dets.txt").string(), cam, &error)) << error;
+  EXPECT_EQ(src.size(), 1);  // the second RGB image has no depth within 0.02 s
+  EXPECT_TRUE(src.has_detections());
+  vo::SequenceFrame f;
+  ASSERT_TRUE(src.load(0, &f, &error)) << error;
+  EXPECT_DOUBLE_EQ(f.timestamp, 1.0);
+  EXPECT_EQ(f.gray.type(), CV_8UC1);
+  EXPECT_FLOAT_EQ(f.depth_m.at<float>(5, 5), 1.0f);
+  ASSERT_EQ(f.detections.size(), 1u);  // the NaN box is rejected
+  EXPECT_EQ(f.detections[0].class_id, 0);
+  EXPECT_NEAR(f.detections[0].box.centre().x(), 32.0, 1.0);
+
+  vo::TumSource missing;
+  EXPECT_FALSE(missing.open((dir / "nope").string(), "", cam, &error));
+  EXPECT_NE(error.find("rgb.txt"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+
+#else
+TEST(DynamicVo, NeedsOpenCv) { GTEST_SKIP() << "dynamic_vo needs the OpenCV adapter (OpenCV 4 not found)"; }
+#endif
