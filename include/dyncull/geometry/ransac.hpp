@@ -373,6 +373,9 @@ class RansacRunner {
 ///   bool refit(const std::uint32_t* inliers, std::size_t n, Model* model) const;
 ///   optional: bool is_sample_good(const std::uint32_t* sample) const;
 ///   optional: void residuals_sq(const Model& m, std::size_t begin, std::size_t end, Scalar* out) const;
+///   optional: void residuals_sq(const Model& m, const std::uint32_t* idx, std::size_t n, Scalar* out) const;
+/// The range overload enables early bail-out while scoring, the indexed one a 32-point pre-test of each
+/// hypothesis. LO runs for new bests with at least max(2 kSampleSize, n / 10) inliers, and once at the end.
 /// Residuals are squared; NaN residuals count as outliers. Deterministic for options.seed.
 template <class Estimator>
 RansacResult<typename Estimator::Model> ransac(const Estimator& estimator, const RansacOptions& options) {
