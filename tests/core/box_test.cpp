@@ -11,7 +11,7 @@ namespace {
 template <class T>
 class BoxTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(BoxTest, Scalars);
+TYPED_TEST_SUITE(BoxTest, Scalars, );
 
 TYPED_TEST(BoxTest, PixelRectInsideUsesPixelCentres) {
   using T = TypeParam;

@@ -9,7 +9,7 @@ namespace {
 template <class T>
 class CameraTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(CameraTest, Scalars);
+TYPED_TEST_SUITE(CameraTest, Scalars, );
 
 TYPED_TEST(CameraTest, ProjectBackprojectRoundTrip) {
   using T = TypeParam;

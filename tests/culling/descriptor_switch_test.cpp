@@ -187,7 +187,7 @@ TEST(MatchHamming, AgreesWithOpenCvBfMatcher) {
 template <class T>
 class MatchL2Test : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(MatchL2Test, Scalars);
+TYPED_TEST_SUITE(MatchL2Test, Scalars, );
 
 template <class T>
 std::vector<T> random_floats(std::size_t n, std::uint64_t seed) {

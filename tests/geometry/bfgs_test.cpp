@@ -11,7 +11,7 @@ namespace {
 template <class T>
 class BfgsTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(BfgsTest, Scalars);
+TYPED_TEST_SUITE(BfgsTest, Scalars, );
 
 template <class T>
 struct Rosenbrock {
