@@ -5,7 +5,7 @@
 ///
 /// API:
 ///   std::vector<std::uint8_t> keep = make_keep_mask(labels, KeepPolicy::DropDynamic);
-///   CompactResult c = compact_parallel(keep, keypoints, RowsView{desc.data, 32, desc.step}, depths, right_u);
+///   CompactResult c = compact_parallel(keep, keypoints, RowsView{desc.data, 32, desc.step, n}, depths, right_u);
 ///   DynamicRegionPredicate<float> inside(boxes, object_mask, /*scale_factor*/ 1.2f, /*levels*/ 8);
 ///   inside(x_level, y_level, level) -> bool;
 ///   rasterise_dynamic_regions(boxes, object_masks, out, MaskConvention::DynamicIs255);
