@@ -1,6 +1,7 @@
 /// @file dyncull.hpp
-/// Umbrella header for dyncull's core modules (standard library + Eigen only). The OpenCV and
-/// Ceres adapters are included separately: dyncull/opencv/..., dyncull/ceres/....
+/// Umbrella header for dyncull's core modules (standard library + Eigen only): core, geometry,
+/// culling, eval and sim. Including single headers compiles faster; the OpenCV and Ceres adapters
+/// are included separately: dyncull/opencv/..., dyncull/ceres/....
 #pragma once
 
 #include "dyncull/core/box.hpp"
@@ -11,3 +12,44 @@
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
+
+#include "dyncull/geometry/bfgs.hpp"
+#include "dyncull/geometry/epipolar.hpp"
+#include "dyncull/geometry/fundamental.hpp"
+#include "dyncull/geometry/icp.hpp"
+#include "dyncull/geometry/kdtree.hpp"
+#include "dyncull/geometry/pnp.hpp"
+#include "dyncull/geometry/projection.hpp"
+#include "dyncull/geometry/ransac.hpp"
+#include "dyncull/geometry/rigid.hpp"
+#include "dyncull/geometry/rotation_centre.hpp"
+
+#include "dyncull/culling/box_rule.hpp"
+#include "dyncull/culling/box_tracker.hpp"
+#include "dyncull/culling/depth_mask.hpp"
+#include "dyncull/culling/descriptor_switch.hpp"
+#include "dyncull/culling/detections.hpp"
+#include "dyncull/culling/dynamic_probability.hpp"
+#include "dyncull/culling/keep_mask.hpp"
+#include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/motion_levels.hpp"
+#include "dyncull/culling/moving_consistency.hpp"
+#include "dyncull/culling/multiview_check.hpp"
+#include "dyncull/culling/pipeline.hpp"
+#include "dyncull/culling/presets.hpp"
+#include "dyncull/culling/subbox_refine.hpp"
+
+#include "dyncull/eval/ate.hpp"
+#include "dyncull/eval/labels.hpp"
+#include "dyncull/eval/report.hpp"
+#include "dyncull/eval/rpe.hpp"
+#include "dyncull/eval/statistics.hpp"
+#include "dyncull/eval/trajectory.hpp"
+
+#include "dyncull/sim/actors.hpp"
+#include "dyncull/sim/depth_noise.hpp"
+#include "dyncull/sim/primitives.hpp"
+#include "dyncull/sim/scene.hpp"
+#include "dyncull/sim/texture.hpp"
+#include "dyncull/sim/trajectory.hpp"
+#include "dyncull/sim/truth.hpp"
