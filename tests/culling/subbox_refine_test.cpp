@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <vector>
 
 namespace dyncull {
@@ -199,6 +201,30 @@ TEST(SubBoxDilation, MatchesBruteForce) {
   std::vector<std::uint16_t> scratch;
   dilate_square(m.view(), PixelRect{0, 0, W, H}, R, &scratch);
   EXPECT_EQ(m.pixels, ref.pixels);
+}
+
+// Sub-rectangles, radii larger than the rectangle, and one scratch buffer reused across sizes: inside
+// the ROI the result is the dilation of the ROI's own pixels; outside it nothing changes.
+TEST(SubBoxDilation, RoiAndLargeRadiiMatchBruteForce) {
+  const int W = 80, H = 60;
+  Random rng(11);
+  std::vector<std::uint16_t> scratch;
+  for (const PixelRect roi : {PixelRect{0, 0, W, H}, PixelRect{10, 7, 53, 41}, PixelRect{70, 50, 80, 60}}) {
+    for (const int R : {1, 4, 15, 40}) {
+      Mask m(W, H);
+      for (auto& p : m.pixels) p = rng.uniform() < 0.02 ? 1 : 0;
+      Mask ref = m;
+      for (int y = roi.r0; y < roi.r1; ++y)
+        for (int x = roi.c0; x < roi.c1; ++x) {
+          bool any = false;
+          for (int yy = std::max(roi.r0, y - R); yy < std::min(roi.r1, y + R + 1); ++yy)
+            for (int xx = std::max(roi.c0, x - R); xx < std::min(roi.c1, x + R + 1); ++xx) any = any || m.test(xx, yy);
+          ref.pixels[static_cast<std::size_t>(y * W + x)] = any ? 255 : 0;
+        }
+      dilate_square(m.view(), roi, R, &scratch);
+      EXPECT_EQ(m.pixels, ref.pixels) << "roi " << roi.c0 << "," << roi.r0 << " radius " << R;
+    }
+  }
 }
 
 }  // namespace

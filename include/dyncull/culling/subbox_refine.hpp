@@ -215,7 +215,8 @@ SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geomet
 }
 
 /// Square (Chebyshev) binary dilation of `mask` inside `roi` by `radius` pixels, two separable passes
-/// with running counts: cost O(roi area), independent of the radius. `scratch` is reused.
+/// with running counts: cost O(roi area), independent of the radius. Both passes walk rows, so the
+/// vertical one is a contiguous, vectorisable add/subtract of whole rows. `scratch` is reused.
 inline void dilate_square(MaskView mask, PixelRect roi, int radius, std::vector<std::uint16_t>* scratch) {
   if (mask.empty() || radius <= 0) return;
   roi.c0 = std::max(roi.c0, 0);
@@ -224,29 +225,48 @@ inline void dilate_square(MaskView mask, PixelRect roi, int radius, std::vector<
   roi.r1 = std::min(roi.r1, mask.height);
   if (roi.empty()) return;
   const int w = roi.width(), h = roi.height();
-  scratch->assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
+  const std::size_t uw = static_cast<std::size_t>(w);
+  // Layout (uint16 words): h rows of horizontal results (0/1), one row of vertical window counts, then
+  // an OR-doubling row buffer of w + 2r + 1 bytes (reached through a byte pointer: char may alias).
+  const std::size_t span = uw + 2 * static_cast<std::size_t>(radius) + 1;
+  const std::size_t need = uw * (static_cast<std::size_t>(h) + 1) + (span + 1) / 2 + 1;
+  if (scratch->size() < need) scratch->resize(need);
   std::uint16_t* tmp = scratch->data();
-  // Horizontal: tmp = number of set pixels within [x - r, x + r] (saturating is unnecessary: <= 2r+1).
+  std::uint16_t* count = tmp + uw * static_cast<std::size_t>(h);
+  std::uint8_t* orbuf = reinterpret_cast<std::uint8_t*>(count + uw);
+  // Horizontal: tmp[x] = OR of row[x - r .. x + r]. The padded row is OR-doubled in place (after the
+  // pass with step s, orbuf[i] = OR of 2s original bytes from i), log2(2r + 1) vectorised passes; the
+  // window is then the OR of two overlapping power-of-two runs.
+  std::size_t run = 1;
+  while (run * 2 <= 2 * static_cast<std::size_t>(radius) + 1) run *= 2;
+  const std::size_t second = 2 * static_cast<std::size_t>(radius) + 1 - run;
   for (int y = 0; y < h; ++y) {
     const std::uint8_t* row = mask.row(roi.r0 + y) + roi.c0;
-    std::uint16_t* t = tmp + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-    int count = 0;
-    for (int x = 0; x < std::min(radius, w); ++x) count += row[x] != 0;
-    for (int x = 0; x < w; ++x) {
-      if (x + radius < w) count += row[x + radius] != 0;
-      if (x - radius - 1 >= 0) count -= row[x - radius - 1] != 0;
-      t[x] = static_cast<std::uint16_t>(count > 0);
-    }
+    std::uint16_t* t = tmp + static_cast<std::size_t>(y) * uw;
+    std::fill(orbuf, orbuf + radius, std::uint8_t(0));
+    for (std::size_t x = 0; x < uw; ++x) orbuf[static_cast<std::size_t>(radius) + x] = row[x] != 0;
+    std::fill(orbuf + radius + w, orbuf + span, std::uint8_t(0));
+    for (std::size_t step = 1; step < run; step *= 2)
+      for (std::size_t i = 0; i + step < span; ++i) orbuf[i] = static_cast<std::uint8_t>(orbuf[i] | orbuf[i + step]);
+    for (std::size_t x = 0; x < uw; ++x) t[x] = static_cast<std::uint16_t>(orbuf[x] | orbuf[x + second]);
   }
-  // Vertical, written back into the mask.
-  for (int x = 0; x < w; ++x) {
-    int count = 0;
-    for (int y = 0; y < std::min(radius, h); ++y) count += tmp[static_cast<std::size_t>(y) * w + x];
-    for (int y = 0; y < h; ++y) {
-      if (y + radius < h) count += tmp[static_cast<std::size_t>(y + radius) * w + x];
-      if (y - radius - 1 >= 0) count -= tmp[static_cast<std::size_t>(y - radius - 1) * w + x];
-      mask.row(roi.r0 + y)[roi.c0 + x] = static_cast<std::uint8_t>(count > 0 ? 255 : 0);
+  // Vertical: count[x] = set tmp rows within [y - r, y + r] (at most 2r + 1 <= 65535 for sane radii).
+  std::fill(count, count + uw, std::uint16_t(0));
+  for (int y = 0; y < std::min(radius, h); ++y) {
+    const std::uint16_t* t = tmp + static_cast<std::size_t>(y) * uw;
+    for (std::size_t x = 0; x < uw; ++x) count[x] = static_cast<std::uint16_t>(count[x] + t[x]);
+  }
+  for (int y = 0; y < h; ++y) {
+    if (y + radius < h) {
+      const std::uint16_t* add = tmp + static_cast<std::size_t>(y + radius) * uw;
+      for (std::size_t x = 0; x < uw; ++x) count[x] = static_cast<std::uint16_t>(count[x] + add[x]);
     }
+    if (y - radius - 1 >= 0) {
+      const std::uint16_t* sub = tmp + static_cast<std::size_t>(y - radius - 1) * uw;
+      for (std::size_t x = 0; x < uw; ++x) count[x] = static_cast<std::uint16_t>(count[x] - sub[x]);
+    }
+    std::uint8_t* out = mask.row(roi.r0 + y) + roi.c0;
+    for (std::size_t x = 0; x < uw; ++x) out[x] = static_cast<std::uint8_t>(count[x] ? 255 : 0);
   }
 }
 
@@ -289,11 +309,15 @@ std::size_t subbox_mask(const SubBoxResult<T>& result, const Boxes& boxes, const
     }
   }
   if (bound.empty()) return 0;
-  const int rad = options.dilation_radius_px;
-  dilate_square(mask, PixelRect{bound.c0 - rad, bound.r0 - rad, bound.c1 + rad, bound.r1 + rad}, rad, scratch);
-  std::size_t set = 0;
-  for (int y = 0; y < mask.height; ++y)
-    for (int x = 0; x < mask.width; ++x) set += mask.row(y)[x] != 0;
+  const int rad = std::max(0, options.dilation_radius_px);
+  const PixelRect grown{std::max(0, bound.c0 - rad), std::max(0, bound.r0 - rad), std::min(mask.width, bound.c1 + rad),
+                        std::min(mask.height, bound.r1 + rad)};
+  dilate_square(mask, grown, rad, scratch);
+  std::size_t set = 0;  // nothing is set outside the grown bound
+  for (int y = grown.r0; y < grown.r1; ++y) {
+    const std::uint8_t* row = mask.row(y);
+    for (int x = grown.c0; x < grown.c1; ++x) set += row[x] != 0;
+  }
   return set;
 }
 
