@@ -145,6 +145,49 @@ TYPED_TEST(MultiViewTest, ScanlineRegionGrowingMatchesPixelwiseFloodFill) {
   EXPECT_EQ(n_fast, fast.count());
 }
 
+// The integer fast path (TUM uint16, bounds rounded inwards to raw units) against a breadth-first fill
+// that converts every raw value to metres: exactly the same pixels.
+TYPED_TEST(MultiViewTest, Uint16RegionGrowingMatchesPixelwiseFloodFill) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto scene = test::make_culling_scene<T>(config);
+  const auto kf = test::make_scene_keyframe<T>(config, kFramesBack, 800);
+  const auto raw = scene.depth_tum();
+  const auto view = tum_depth_view(raw.data(), scene.width, scene.height);
+  MultiViewOptions<T> options;
+  const auto r = check_multiview(kf.keypoints, kf.depth_m, kf.cam_from_world, scene.cam_from_world, view,
+                                 scene.camera, options);
+  ASSERT_GT(r.num_dynamic, 0u);
+  Mask fast;
+  std::vector<std::uint32_t> stack;
+  const std::size_t n_fast = grow_multiview_regions(r, view, options, &fast, &stack);
+  const int W = scene.width, H = scene.height;
+  Mask ref(W, H);
+  for (std::size_t i = 0; i < r.labels.size(); ++i) {
+    if (r.labels[i] != FeatureLabel::Dynamic) continue;
+    const int su = int(std::lround(double(r.projected[i].x()))), sv = int(std::lround(double(r.projected[i].y())));
+    if (ref.test(su, sv)) continue;
+    const double seed = double(r.measured_depth_m[i]);
+    const double tol = double(options.region_depth_tolerance_m);
+    std::vector<std::pair<int, int>> queue{{su, sv}};
+    ref.pixels[static_cast<std::size_t>(sv * W + su)] = 1;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int x = queue[q].first, y = queue[q].second;
+      const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+      for (int k = 0; k < 4; ++k) {
+        if (nx[k] < 0 || ny[k] < 0 || nx[k] >= W || ny[k] >= H || ref.test(nx[k], ny[k])) continue;
+        const double units = double(raw[static_cast<std::size_t>(ny[k] * W + nx[k])]);
+        // Same joining rule in metres: lo <= d <= hi, with the bounds in raw units as the header defines.
+        if (!(units > 0) || units < std::max(seed - tol, 1e-9) * 5000.0 || units > (seed + tol) * 5000.0) continue;
+        ref.pixels[static_cast<std::size_t>(ny[k] * W + nx[k])] = 1;
+        queue.emplace_back(nx[k], ny[k]);
+      }
+    }
+  }
+  EXPECT_EQ(fast.pixels, ref.pixels) << "fast " << n_fast << " ref " << ref.count();
+  EXPECT_EQ(n_fast, fast.count());
+}
+
 TYPED_TEST(MultiViewTest, Uint16TumDepthGivesTheSameLabels) {
   using T = TypeParam;
   SceneConfig config;

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -99,6 +100,25 @@ T closest_depth_in_window(const DepthView<Raw>& depth, int u, int v, int radius,
   }
   return best;
 }
+
+/// [lo, hi] in raw depth units. For integer depth (TUM uint16) the bounds are rounded inwards once, so
+/// the per-pixel test is two integer compares; float depth compares in double as given (NaN fails).
+template <class Raw, bool Integral = std::is_integral<Raw>::value>
+struct RawDepthRange {
+  double lo, hi;
+  RawDepthRange(double l, double h) : lo(l), hi(h) {}
+  bool contains(Raw r) const { return static_cast<double>(r) >= lo && static_cast<double>(r) <= hi; }
+};
+template <class Raw>
+struct RawDepthRange<Raw, true> {
+  long long lo, hi;
+  RawDepthRange(double l, double h) {
+    const double top = static_cast<double>(std::numeric_limits<Raw>::max());
+    lo = static_cast<long long>(std::ceil(std::min(std::max(l, 0.0), top + 1)));
+    hi = static_cast<long long>(std::floor(std::min(std::max(h, -1.0), top)));
+  }
+  bool contains(Raw r) const { return static_cast<long long>(r) >= lo && static_cast<long long>(r) <= hi; }
+};
 
 }  // namespace detail
 
@@ -244,12 +264,24 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
     const double seed_d = static_cast<double>(result.measured_depth_m[i]);
     const double lo_m = std::max({seed_d - static_cast<double>(tol), static_cast<double>(depth.min_m), 1e-9});
     const double hi_m = std::min(seed_d + static_cast<double>(tol), static_cast<double>(depth.max_m));
-    const double lo = lo_m * units, hi = hi_m * units;
+    const detail::RawDepthRange<Raw> range(lo_m * units, hi_m * units);
     // Scanline fill (4-connected): each stack entry is a seed pixel of a run; runs are filled left and
     // right, and the rows above and below are scanned once per run. Same region as a pixel-wise fill.
     auto inside = [&](int x, int y) {
-      const double r = static_cast<double>(depth.row(y)[x]);
-      return !m[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] && r >= lo && r <= hi;
+      return !m[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] &&
+             range.contains(depth.row(y)[x]);
+    };
+    // Row form for the scans of the rows above and below a run (the bulk of the tests).
+    auto scan_row = [&](int ny, int x0, int x1) {
+      const Raw* drow = depth.row(ny);
+      const std::uint8_t* mrow = m + static_cast<std::size_t>(ny) * static_cast<std::size_t>(w);
+      const std::uint32_t base = static_cast<std::uint32_t>(static_cast<std::size_t>(ny) * static_cast<std::size_t>(w));
+      bool in_run = false;
+      for (int xx = x0; xx <= x1; ++xx) {
+        const bool ok = !mrow[xx] && range.contains(drow[xx]);
+        if (ok && !in_run) stack->push_back(base + static_cast<std::uint32_t>(xx));
+        in_run = ok;
+      }
     };
     const std::size_t cap = options.max_region_pixels > 0 ? options.max_region_pixels : static_cast<std::size_t>(-1);
     std::size_t region = 0;
@@ -271,17 +303,8 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
       const std::size_t run = static_cast<std::size_t>(x1 - x0 + 1);
       set += run;
       region += run;
-      for (int ny = y - 1; ny <= y + 1; ny += 2) {
-        if (ny < rr0 || ny >= rr1) continue;
-        bool in_run = false;
-        for (int xx = x0; xx <= x1; ++xx) {
-          const bool ok = inside(xx, ny);
-          if (ok && !in_run)
-            stack->push_back(static_cast<std::uint32_t>(static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) +
-                                                        static_cast<std::size_t>(xx)));
-          in_run = ok;
-        }
-      }
+      if (y - 1 >= rr0) scan_row(y - 1, x0, x1);
+      if (y + 1 < rr1) scan_row(y + 1, x0, x1);
     }
   }
   return set;
