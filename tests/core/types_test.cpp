@@ -8,7 +8,7 @@ namespace {
 template <class T>
 class RigidTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RigidTest, Scalars);
+TYPED_TEST_SUITE(RigidTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 TYPED_TEST(RigidTest, InverseComposesToIdentity) {
   using T = TypeParam;
