@@ -122,7 +122,27 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
   // Shift by the first pair: the one-pass moments then stay well conditioned for data far from the origin.
   AlignmentAccumulator<T> acc(src.col(0), dst.col(0));
   if (weights == nullptr) {
-    for (Eigen::Index i = 0; i < n; ++i) acc.add(src.col(i), dst.col(i));
+    // The 16 moments live in local scalars, not in `acc`: stores into acc's members may alias the
+    // input (same scalar type), which made g++ -O2 reload and store all of them for every pair.
+    const T sx = acc.s0(0), sy = acc.s0(1), sz = acc.s0(2), dx = acc.d0(0), dy = acc.d0(1), dz = acc.d0(2);
+    T s_x = 0, s_y = 0, s_z = 0, d_x = 0, d_y = 0, d_z = 0, ss = 0;
+    T m00 = 0, m01 = 0, m02 = 0, m10 = 0, m11 = 0, m12 = 0, m20 = 0, m21 = 0, m22 = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const T a0 = src(0, i) - sx, a1 = src(1, i) - sy, a2 = src(2, i) - sz;
+      const T b0 = dst(0, i) - dx, b1 = dst(1, i) - dy, b2 = dst(2, i) - dz;
+      s_x += a0; s_y += a1; s_z += a2;
+      d_x += b0; d_y += b1; d_z += b2;
+      ss += a0 * a0 + a1 * a1 + a2 * a2;
+      m00 += b0 * a0; m01 += b0 * a1; m02 += b0 * a2;
+      m10 += b1 * a0; m11 += b1 * a1; m12 += b1 * a2;
+      m20 += b2 * a0; m21 += b2 * a1; m22 += b2 * a2;
+    }
+    acc.sum_s = Vec3<T>(s_x, s_y, s_z);
+    acc.sum_d = Vec3<T>(d_x, d_y, d_z);
+    acc.sum_ds << m00, m01, m02, m10, m11, m12, m20, m21, m22;
+    acc.sum_ss = ss;
+    acc.sum_w = static_cast<T>(n);
+    acc.used = static_cast<std::size_t>(n);
   } else {
     for (Eigen::Index i = 0; i < n; ++i) {
       const T w = weights[i];
