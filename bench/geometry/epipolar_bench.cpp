@@ -32,6 +32,7 @@ struct Data {
   std::vector<Eigen::Vector2f> p1f, p2f;
 #ifdef DYNCULL_HAS_OPENCV
   std::vector<cv::Point2f> cv1, cv2;
+  std::vector<cv::Point2d> cv1d, cv2d;
 #endif
 };
 
@@ -49,6 +50,8 @@ const Data& data(int n) {
 #ifdef DYNCULL_HAS_OPENCV
       d.cv1.emplace_back(float(d.truth.points1[i].x()), float(d.truth.points1[i].y()));
       d.cv2.emplace_back(float(d.truth.points2[i].x()), float(d.truth.points2[i].y()));
+      d.cv1d.emplace_back(d.truth.points1[i].x(), d.truth.points1[i].y());
+      d.cv2d.emplace_back(d.truth.points2[i].x(), d.truth.points2[i].y());
 #endif
     }
     built = n;
@@ -156,6 +159,25 @@ void BM_OpenCV_Epilines_Loop(benchmark::State& state) {
   flagged(state, d, out);
 }
 BENCHMARK(BM_OpenCV_Epilines_Loop)->Arg(1000)->Unit(benchmark::kMicrosecond);
+/// The same peer on double points (OpenCV then computes the lines in double): the like-for-like
+/// reference for our double kernel.
+void BM_OpenCV_Epilines_Loop_Double(benchmark::State& state) {
+  const Data& d = data(int(state.range(0)));
+  cv::Mat F(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) F.at<double>(r, c) = d.truth.F(r, c);
+  std::vector<cv::Vec3d> lines;
+  std::vector<double> out(d.cv1d.size());
+  for (auto _ : state) {
+    cv::computeCorrespondEpilines(d.cv1d, 1, F, lines);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = std::abs(lines[i][0] * d.cv2d[i].x + lines[i][1] * d.cv2d[i].y + lines[i][2]);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  flagged(state, d, out);
+}
+BENCHMARK(BM_OpenCV_Epilines_Loop_Double)->Arg(1000)->Unit(benchmark::kMicrosecond);
 #endif
 
 }  // namespace
