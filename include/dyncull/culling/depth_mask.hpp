@@ -84,9 +84,12 @@ struct DepthMaskOptions {
   /// pixel cannot be trusted, and Kinect holes cluster at object boundaries.
   bool mask_missing_depth = true;
   /// Histogram fallback (rule not applicable): bins of this width from 0 to histogram_max_m,
-  /// over every histogram_stride_px-th row and column (a statistic: 1/4 of the pixels suffice).
+  /// over every histogram_stride_px-th row and column. 0 (default) = auto: the smallest stride that
+  /// samples at most histogram_target_samples pixels (it is a statistic; a 300 x 200 box uses every
+  /// 3rd row and column, small boxes every pixel), so the fallback costs about one pass over the box.
   double histogram_bin_m = 0.1;
-  int histogram_stride_px = 2;
+  int histogram_stride_px = 0;
+  int histogram_target_samples = 4096;
   double histogram_max_m = 12.0;
   /// A bin is occupied when it holds at least this fraction of the box's valid pixels.
   double histogram_occupied_fraction = 0.002;
@@ -387,20 +390,40 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     // Histogram fallback: the foreground cluster that holds d_c (or the nearest big cluster).
     const double bin_raw = std::max(o.histogram_bin_m, 1e-3) * upm;
     const int nb = std::max(1, static_cast<int>(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3))));
-    // One extra bin collects invalid pixels, so the scatter loop has no branch.
-    std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb) + 1, 0u);
-    const int step = std::max(1, o.histogram_stride_px);
+    // One extra bin collects invalid pixels, so the scatter loop has no branch. Neighbouring pixels
+    // mostly fall in the same bin, so a single histogram serialises on its own increments (store to
+    // load forwarding); four interleaved copies, summed afterwards, let them overlap.
+    const std::size_t nh = static_cast<std::size_t>(nb) + 1;
+    std::vector<std::uint32_t> hist4(4 * nh, 0u);
+    int step = o.histogram_stride_px;
+    if (step <= 0) {
+      const double per_sample = static_cast<double>(rc.area()) / std::max(1, o.histogram_target_samples);
+      step = std::max(1, static_cast<int>(std::ceil(std::sqrt(per_sample))));
+    }
     const float inv_bin = static_cast<float>(1.0 / bin_raw);
     const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
+    auto bin_of = [&](Raw r) {
+      const float f = static_cast<float>(r);
+      const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
+      return static_cast<std::size_t>(ok ? std::min(nb - 1, static_cast<int>(f * inv_bin)) : nb);
+    };
+    std::uint32_t* h0 = hist4.data();
+    std::uint32_t* h1 = h0 + nh;
+    std::uint32_t* h2 = h1 + nh;
+    std::uint32_t* h3 = h2 + nh;
     for (int y = rc.r0; y < rc.r1; y += step) {
       const Raw* d = v.row(y);
-      for (int x = rc.c0; x < rc.c1; x += step) {
-        const float f = static_cast<float>(d[x]);
-        const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
-        const int b = ok ? std::min(nb - 1, static_cast<int>(f * inv_bin)) : nb;
-        ++hist[static_cast<std::size_t>(b)];
+      int x = rc.c0;
+      for (; x + 3 * step < rc.c1; x += 4 * step) {
+        ++h0[bin_of(d[x])];
+        ++h1[bin_of(d[x + step])];
+        ++h2[bin_of(d[x + 2 * step])];
+        ++h3[bin_of(d[x + 3 * step])];
       }
+      for (; x < rc.c1; x += step) ++h0[bin_of(d[x])];
     }
+    std::vector<std::uint32_t> hist(nh);
+    for (std::size_t b = 0; b < nh; ++b) hist[b] = h0[b] + h1[b] + h2[b] + h3[b];
     const std::size_t sampled = static_cast<std::size_t>((rc.height() + step - 1) / step) *
                                 static_cast<std::size_t>((rc.width() + step - 1) / step);
     const std::size_t valid = sampled - hist[static_cast<std::size_t>(nb)];
