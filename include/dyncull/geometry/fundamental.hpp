@@ -22,6 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace dyncull {
@@ -397,7 +398,7 @@ class FundamentalEstimator {
       const double c = point_x<double>(points2[i]), d = point_y<double>(points2[i]);
       if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(c) || !std::isfinite(d)) continue;
       ux1.push_back(a), uy1.push_back(b), ux2.push_back(c), uy2.push_back(d);
-      px1_.push_back(T(a)), py1_.push_back(T(b)), px2_.push_back(T(c)), py2_.push_back(T(d));
+      px1_.push_back(float(a)), py1_.push_back(float(b)), px2_.push_back(float(c)), py2_.push_back(float(d));
       index_.push_back(static_cast<std::uint32_t>(i));
     }
     const std::size_t m = index_.size();
@@ -429,9 +430,20 @@ class FundamentalEstimator {
   }
 
   void residuals_sq(const Model& F, T* out) const { residuals_sq(F, std::size_t{0}, px1_.size(), out); }
+  /// Hypotheses are scored with float Sampson distances whatever T is: pixel coordinates of a few
+  /// thousand px keep ~1e-4 px resolution in float, far below any inlier threshold, and float runs
+  /// twice as many lanes. Minimal solves and refits are in double (normalised coordinates) for every T.
   void residuals_sq(const Model& F, std::size_t begin, std::size_t end, T* out) const {
-    epipolar_distances_soa(F, px1_.data() + begin, py1_.data() + begin, px2_.data() + begin, py2_.data() + begin,
-                           end - begin, out, EpipolarDistance::SampsonSq);
+    const Mat3<float> Ff = F.template cast<float>();
+    if constexpr (std::is_same<T, float>::value) {
+      epipolar_distances_soa(Ff, px1_.data() + begin, py1_.data() + begin, px2_.data() + begin, py2_.data() + begin,
+                             end - begin, out, EpipolarDistance::SampsonSq);
+    } else {
+      if (scratch_.size() < end - begin) scratch_.resize(end - begin);  // grows once; reused afterwards
+      epipolar_distances_soa(Ff, px1_.data() + begin, py1_.data() + begin, px2_.data() + begin, py2_.data() + begin,
+                             end - begin, scratch_.data(), EpipolarDistance::SampsonSq);
+      for (std::size_t i = 0; i < end - begin; ++i) out[i] = static_cast<T>(scratch_[i]);
+    }
   }
 
   /// Residuals at given indices (RANSAC's probe pre-test): a scalar loop, n is small.
@@ -545,7 +557,8 @@ class FundamentalEstimator {
   bool weighted_;
   bool normalisable_ = false;
   detail::Normaliser n1_, n2_;
-  std::vector<T> px1_, py1_, px2_, py2_;         // pixels, for residuals
+  std::vector<float> px1_, py1_, px2_, py2_;     // pixels, for residuals (float: see residuals_sq)
+  mutable std::vector<float> scratch_;           // float residuals before widening to T (T = double)
   std::vector<double> nx1_, ny1_, nx2_, ny2_;    // Hartley-normalised, for the solvers
   std::vector<std::uint32_t> index_;
   mutable std::vector<double> weights_;          // refit scratch, sized once
