@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Compiles every public header on its own (self-contained, warning-free) with each available
-# compiler: g++ and clang++, -std=c++17 -Wall -Wextra -Wpedantic -Werror. Adapter headers are
-# checked only when their library is installed.
+# Compiles every public header on its own (self-contained, warning-free), -std=c++17 -Wall -Wextra
+# -Wpedantic -Werror, with clang++ by default (see below). Adapter headers are checked only when their
+# library is installed.
 #   scripts/check-headers.sh [GENERATED_INCLUDE_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -21,8 +21,16 @@ opencv_ok=0; ceres_ok=0
 [[ -d /usr/include/opencv4 ]] && opencv_ok=1 && flags+=(-isystem /usr/include/opencv4)
 [[ -f /usr/include/ceres/ceres.h ]] && ceres_ok=1
 
+# Default: clang++ alone (g++ when clang++ is missing). Self-containedness depends on the standard
+# library, which both share, not on the compiler; and both already compile every header with -Werror
+# through the test suite (g++ in the Release run, clang++ in the sanitizer run); one compiler here
+# saves ~90 s of the README test command on two cores.
+# DYNCULL_HEADER_COMPILERS="g++ clang++" checks with both.
 compilers=()
-for c in g++ clang++; do command -v "$c" >/dev/null && compilers+=("$c"); done
+for c in ${DYNCULL_HEADER_COMPILERS:-clang++}; do command -v "$c" >/dev/null && compilers+=("$c"); done
+if ((${#compilers[@]} == 0)); then
+  for c in g++ clang++; do command -v "$c" >/dev/null && { compilers+=("$c"); break; }; done
+fi
 
 headers=()
 while IFS= read -r h; do
