@@ -18,7 +18,8 @@ fi
 flags=(-std=c++17 -fsyntax-only -Wall -Wextra -Wpedantic -Werror -I"$root/include" -I"$generated"
        -isystem /usr/include/eigen3)
 opencv_ok=0; ceres_ok=0
-[[ -d /usr/include/opencv4 ]] && opencv_ok=1 && flags+=(-isystem /usr/include/opencv4)
+[[ -d /usr/include/opencv4 ]] && opencv_ok=1  # on the include path only for opencv/ headers, so a core
+                                               # header that reached for OpenCV would fail here
 [[ -f /usr/include/ceres/ceres.h ]] && ceres_ok=1
 
 # Default: clang++ alone (g++ when clang++ is missing). Self-containedness depends on the standard
@@ -44,7 +45,9 @@ done < <(cd "$root" && find include/dyncull -name '*.hpp' | sort)
 jobs_max=${DYNCULL_JOBS:-$(nproc)}
 check_one() {  # compiler header -> writes $tmp/<n>.fail with the errors on failure
   local c=$1 h=$2 n=$3
-  if ! echo "#include \"${h#include/}\"" | "$c" "${flags[@]}" -x c++ - 2>"$tmp/$n.err"; then
+  local extra=()
+  [[ "$h" == */opencv/* ]] && extra=(-isystem /usr/include/opencv4)
+  if ! echo "#include \"${h#include/}\"" | "$c" "${flags[@]}" "${extra[@]}" -x c++ - 2>"$tmp/$n.err"; then
     { echo "FAIL [$c] $h"; sed 's/^/    /' "$tmp/$n.err" | head -30; } >"$tmp/$n.fail"
   fi
 }
