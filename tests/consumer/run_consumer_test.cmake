@@ -19,3 +19,20 @@ execute_process(COMMAND "${SCRATCH_DIR}/build/consumer" RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the consumer ran but returned ${rc}")
 endif()
+
+# The same consumer with dyncull vendored through add_subdirectory (no install step).
+execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${SCRATCH_DIR}/build_subdir"
+                        -DCONSUMER_USE_SUBDIRECTORY=ON -DDYNCULL_SOURCE_DIR=${DYNCULL_SOURCE_DIR}
+                        -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "configuring the consumer with add_subdirectory(dyncull) failed (${rc})")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_subdir" RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "building the consumer with add_subdirectory(dyncull) failed (${rc})")
+endif()
+execute_process(COMMAND "${SCRATCH_DIR}/build_subdir/consumer" RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the add_subdirectory consumer ran but returned ${rc}")
+endif()
