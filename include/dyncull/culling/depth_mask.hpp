@@ -422,8 +422,8 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
       }
       for (; x < rc.c1; x += step) ++h0[bin_of(d[x])];
     }
-    std::vector<std::uint32_t> hist(nh);
-    for (std::size_t b = 0; b < nh; ++b) hist[b] = h0[b] + h1[b] + h2[b] + h3[b];
+    for (std::size_t b = 0; b < nh; ++b) h0[b] += h1[b] + h2[b] + h3[b];
+    const std::uint32_t* hist = h0;
     const std::size_t sampled = static_cast<std::size_t>((rc.height() + step - 1) / step) *
                                 static_cast<std::size_t>((rc.width() + step - 1) / step);
     const std::size_t valid = sampled - hist[static_cast<std::size_t>(nb)];
