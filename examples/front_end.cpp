@@ -46,7 +46,7 @@ int main() {
   frame.cam_from_world = &predicted_pose;  // a motion-model prediction is enough
   const auto& result = dyncull::cull_frame(frame, options, &state);
   const auto kept = dyncull::compact_parallel(result.keep, keys,
-      dyncull::RowsView{descriptors.data, descriptors.cols * descriptors.elemSize(), descriptors.step, 0u + descriptors.rows});
+      dyncull::RowsView{descriptors.data, descriptors.cols * descriptors.elemSize(), descriptors.step, std::size_t(descriptors.rows)});
   descriptors = descriptors.rowRange(0, static_cast<int>(kept.count));
   // --- README snippet ends ---
 
