@@ -36,7 +36,7 @@ struct MovingConsistencyOptions {
   /// Polish: refit F by the normalised 8-point algorithm on the tracks of the fit set whose eq. 3
   /// distance is below max_epipolar_distance_px, this many times (0 = RANSAC's F as is). Measured on
   /// the test scenes: the RANSAC model at small baselines is noticeably worse than a least-squares fit
-  /// on its own inliers (docs/parts/geometric-algorithms.md).
+  /// on its own inliers (docs/algorithms.md).
   int refit_iterations = 2;
 
   MovingConsistencyOptions() {

@@ -82,7 +82,7 @@ struct PipelineOptions {
   bool multiview_overrides_static = true;
   /// Run the sub-box refinement only when F was fitted on tracks outside the dynamic-class boxes
   /// (or no track lay inside one). An F fitted through a large mover absorbs its motion (measured in
-  /// docs/parts/geometric-algorithms.md), and the refinement would then clear the whole box.
+  /// docs/algorithms.md), and the refinement would then clear the whole box.
   bool subbox_requires_fit_outside_boxes = true;
 
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay

@@ -20,7 +20,7 @@
 namespace dyncull {
 
 /// Options of Algorithm 1. The paper gives no values for sigma1, sigma2 beyond "the majority"; the
-/// merge rule and the empty-sub-box rule are our choices (docs/parts/geometric-algorithms.md).
+/// merge rule and the empty-sub-box rule are our choices (docs/algorithms.md).
 template <class T>
 struct SubBoxOptions {
   int grid = 3;                 ///< grid x grid sub-boxes per box (paper: 3; at most 8)

@@ -41,7 +41,7 @@ inline const char* to_string(RobustLoss l) noexcept {
 }
 
 /// Options of estimate_rotation_centre. The paper gives none of these values; the defaults and their
-/// reasons are in docs/parts/rotation-algorithms.md.
+/// reasons are in docs/algorithms.md.
 struct RotationCentreOptions {
   RotationCentreSolver solver = RotationCentreSolver::NormalEquations;
   RobustLoss loss = RobustLoss::None;
