@@ -25,10 +25,11 @@ const vo::StrategySpec* find_spec(const std::vector<vo::StrategySpec>& all, bool
   return nullptr;
 }
 
-// 30 frames of the sim's xyz walking sequence: the recommended preset must track more accurately
-// than no culling (measured: 4.3 mm vs 8.5 mm) and label most moving features (measured precision
-// 0.66, recall 0.75: below the project's 0.9 target, see docs/results.md; the bounds here guard
-// against regressions, not the target).
+// 30 frames of the sim's xyz walking sequence, where the two slow walkers crossing close to the
+// camera pull the un-culled front end off (measured: 63 mm ATE after one second): the recommended
+// preset must cut that ATE by a clear margin (measured 17 mm, -73 %) and label most moving features
+// (measured precision 0.78, recall 0.96: precision is below the project's 0.9 target, see
+// docs/results.md; the bounds here guard against regressions, not the target).
 TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
   const auto all = vo::all_strategies();
   const vo::StrategySpec* none = find_spec(all, false);
@@ -54,9 +55,12 @@ TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
   ASSERT_TRUE(a.has_ate) << a.ate_note;
   ASSERT_TRUE(b.has_ate) << b.ate_note;
   EXPECT_EQ(a.ate_pairs, 30u);
-  EXPECT_LT(b.ate_rmse_m, a.ate_rmse_m) << "culled " << b.ate_rmse_m << " m vs none " << a.ate_rmse_m << " m";
-  EXPECT_GT(b.labels.precision(), 0.5);
-  EXPECT_GT(b.labels.recall(), 0.5);
+  // The scene is hard: without culling the walkers visibly pull the pose off.
+  EXPECT_GT(a.ate_rmse_m, 0.03) << "none " << a.ate_rmse_m << " m: the walkers no longer pull the front end off";
+  // Culling beats no culling by a clear margin, not by run-to-run noise.
+  EXPECT_LT(b.ate_rmse_m, 0.5 * a.ate_rmse_m) << "culled " << b.ate_rmse_m << " m vs none " << a.ate_rmse_m << " m";
+  EXPECT_GT(b.labels.precision(), 0.6);
+  EXPECT_GT(b.labels.recall(), 0.8);
   // No culling never culls: its counts have no positives at all.
   EXPECT_EQ(a.labels.true_positive + a.labels.false_positive, 0u);
 }

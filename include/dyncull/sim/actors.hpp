@@ -50,13 +50,14 @@ struct ActorOptions {
   int walking_people = 2;              ///< 0, 1 or 2 people walking an elliptic loop
   bool sitting_person = true;          ///< person on a chair moving head, torso and arms only
   bool pushed_chair = true;            ///< chair that slides once, pushed between push_start_s and push_end_s
-  double walking_speed_mps = 1.0;      ///< mean walking speed along the loop
-  Vec2<double> loop_centre_m{-0.1, 1.45};  ///< centre of the walking loop on the floor (world x, y)
-  Vec2<double> loop_semi_axes_m{0.9, 0.65};  ///< semi-axes of the loop; camera rests at y = -0.3
-  double walker_gap_rad = 3.141592653589793;  ///< phase of walker B behind walker A on the loop
+  double walking_speed_mps = 0.4;      ///< mean walking speed along the loop (slow, like TUM fr3/walking_*)
+  Vec2<double> loop_centre_m{0.0, 1.05};  ///< centre of the walking loop on the floor (world x, y)
+  Vec2<double> loop_semi_axes_m{0.8, 0.35};  ///< semi-axes of the loop; camera rests at y = -0.3
+  double walker_start_phase_rad = -2.4;  ///< walker A's loop phase at t = 0 (-pi/2 = nearest the camera)
+  double walker_gap_rad = 0.8;         ///< phase of walker B behind walker A on the loop (close: coherent motion)
   double push_start_s = 3.5;           ///< chair starts moving (seconds from the first frame)
   double push_end_s = 5.0;             ///< chair stops moving
-  double wall_contrast = 1.0;          ///< texture contrast of walls, floor, ceiling in [0, 1]; 0.7 = plainer, harder
+  double wall_contrast = 0.4;          ///< texture contrast of walls, floor, ceiling in [0, 1]; lower = plainer, harder
   double texture_scale = 1.0;          ///< multiplies every texture cell size (smaller = more corners)
 };
 
@@ -197,7 +198,8 @@ inline Rigid3<double> walker_pose(double t, int walker, const ActorOptions& opti
   const double mean_radius = std::sqrt(0.5 * (a * a + b * b));
   const double omega = options.walking_speed_mps / mean_radius;
   // Walker B follows walker A by walker_gap_rad on the loop; the seed shifts the start by up to ~0.3 rad.
-  const double phase0 = -options.walker_gap_rad * walker + 0.3 * static_cast<double>(seed % 97) / 97.0;
+  const double phase0 = options.walker_start_phase_rad - options.walker_gap_rad * walker +
+                        0.3 * static_cast<double>(seed % 97) / 97.0;
   const double phi = phase0 + omega * t;
   const Vec3<double> pos(options.loop_centre_m.x() + a * std::cos(phi), options.loop_centre_m.y() + b * std::sin(phi),
                          0.0);
