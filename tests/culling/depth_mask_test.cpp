@@ -130,6 +130,33 @@ TYPED_TEST(DepthMask, PointLabelsAgreeWithTheRaster) {
   EXPECT_EQ(a.labels, b.labels);
 }
 
+// Two people, the near one's box overlapping the far one's: box_bits names every box whose own mask
+// holds a point, box_index the first.
+TYPED_TEST(DepthMask, OverlappingBoxesReportEveryMaskHoldingAPoint) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(60, 60, 18, 40, 2.5);   // far person
+  s.person(95, 60, 18, 40, 1.2);   // near person, in front of the far one's right side
+  const std::vector<Box<double>> boxes = {{38, 15, 82, 105}, {73, 15, 117, 105}};
+  const std::vector<Vec2<float>> pts = {Vec2<float>(60, 60),    // far person only
+                                        Vec2<float>(80, 60),    // near person, in both boxes
+                                        Vec2<float>(100, 60),   // near person only
+                                        Vec2<float>(40, 17)};   // wall in the far box
+  DepthMaskOptions o;
+  o.mode = DepthMaskMode::Plain;
+  const DepthMaskResult r = depth_mask(s.view(), boxes, pts, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.box_bits.size(), pts.size());
+  EXPECT_EQ(r.box_bits[0], 1u);
+  // The near person is closer than the far box's threshold too: both masks hold it.
+  EXPECT_EQ(r.box_bits[1], 3u);
+  EXPECT_EQ(r.box_index[1], 0);
+  EXPECT_EQ(r.box_bits[2], 2u);
+  EXPECT_EQ(r.box_bits[3], 0u);
+  EXPECT_EQ(r.labels[3], FeatureLabel::Static);
+}
+
 TYPED_TEST(DepthMask, RuleNotApplicablePlainGivesCandidatesRobustFallsBackToHistogram) {
   using Raw = TypeParam;
   // The box is tight on the person: all four corners are on the person too (d_max - d_c = 0).

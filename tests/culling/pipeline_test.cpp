@@ -90,6 +90,35 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   }
 }
 
+// Recommended: a medium-level candidate is culled only on its own geometric evidence (flagged itself in a
+// dynamic sub-box, or by the multi-view check), never by its sub-box's vote alone; the pushed chair,
+// whose features are flagged, is still culled.
+TYPED_TEST(PipelineTest, CandidatesAreCulledOnTheirOwnEvidenceOnly) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  PipelineOptions<T> o = presets::recommended<T>();
+  ASSERT_FALSE(o.subbox_verifies_candidates);
+  PipelineState<T> state;
+  const auto& r = run(s, dets, o, &state, config);
+  ASSERT_TRUE(r.subbox.ran()) << r.subbox.reason;
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.8);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != SceneKind::Chair || r.labels[i] != FeatureLabel::Dynamic) continue;
+    if (r.reasons[i] == CullReason::SubBox) {
+      EXPECT_EQ(state.moving.labels[i], FeatureLabel::Dynamic) << "chair feature " << i << " culled without its own flag";
+    } else {
+      EXPECT_EQ(r.reasons[i], CullReason::MultiView) << "chair feature " << i;
+    }
+  }
+  // The sub-box vote alone (true) culls at least as many chair features.
+  o.subbox_verifies_candidates = true;
+  PipelineState<T> vote_state;
+  const auto& v = run(s, dets, o, &vote_state, config);
+  EXPECT_GE(dynamic_rate(s, v, SceneKind::Chair), dynamic_rate(s, r, SceneKind::Chair));
+}
+
 TYPED_TEST(PipelineTest, PaperPresetsReproduceTheirRules) {
   using T = TypeParam;
   SceneConfig config;

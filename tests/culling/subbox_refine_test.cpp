@@ -156,6 +156,49 @@ TYPED_TEST(SubBoxTest, EmptyAndInvalidBoxesAndObjectMask) {
   EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, bad).status, Status::InvalidInput);
 }
 
+// A walker's box overlapping a still chair's box: with per-box object bits the walker's dynamic
+// sub-boxes act only on the walker's own features, and only they vote.
+TYPED_TEST(SubBoxTest, OverlappingBoxesActOnTheirOwnObjectsOnly) {
+  using T = TypeParam;
+  std::vector<Vec2<T>> pts;
+  std::vector<FeatureLabel> geo;
+  std::vector<std::uint32_t> bits;
+  // Walker: two epipolar-dynamic features in each of the nine 30-px cells of box 0.
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 2; ++k) {
+        pts.emplace_back(T(30 * c + 5 + 10 * k), T(30 * r + 5 + 10 * k));
+        geo.push_back(FeatureLabel::Dynamic);
+        bits.push_back(1u);
+      }
+  // Chair: static features, two in the walker's last cell (the overlap) and two beyond it.
+  const std::size_t chair0 = pts.size();
+  for (const T v : {T(78), T(85), T(120), T(130)}) {
+    pts.emplace_back(v, v);
+    geo.push_back(FeatureLabel::Static);
+    bits.push_back(2u);
+  }
+  const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(89), T(89)}, Box<T>{T(70), T(70), T(150), T(150)}};
+  const std::vector<std::uint8_t> in_any(pts.size(), 1);
+
+  // One object flag for all boxes (the chair is in its own box's mask): the overlap is culled.
+  SubBoxOptions<T> o;
+  const auto flat = refine_subboxes(pts, geo.data(), boxes, o, in_any.data());
+  ASSERT_TRUE(flat.ok());
+  EXPECT_EQ(flat.labels[chair0], FeatureLabel::Dynamic);
+  EXPECT_EQ(flat.static_count[8], 2u);  // the chair votes in the walker's cell
+
+  // Per-box bits: the chair keeps its features; the walker is still dynamic everywhere.
+  o.object_mask_votes_only = true;
+  const auto own = refine_subboxes(pts, geo.data(), boxes, o, in_any.data(), bits.data());
+  ASSERT_TRUE(own.ok());
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    EXPECT_EQ(own.labels[i], i < chair0 ? FeatureLabel::Dynamic : FeatureLabel::Static) << "feature " << i;
+  EXPECT_EQ(own.dyn_count[8], 2u);
+  EXPECT_EQ(own.static_count[8], 0u);  // only the walker's own features vote in its box
+  EXPECT_EQ(own.votes[1].num_dynamic_cells, 0);
+}
+
 TYPED_TEST(SubBoxTest, RasterMaskIsObjectMaskInDynamicCellsDilated) {
   using T = TypeParam;
   const int W = 120, H = 90;

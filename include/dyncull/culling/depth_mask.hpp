@@ -126,6 +126,8 @@ struct DepthMaskResult {
   std::vector<FeatureLabel> labels;   ///< Dynamic in a mask, Candidate in a NotApplied box, else Static
   std::vector<CullReason> reasons;
   std::vector<std::int32_t> box_index;///< first box whose mask (or NotApplied box) holds the point, -1
+  /// Per point, bit b set when box b's mask holds it (boxes 0-31; overlapping boxes set several bits).
+  std::vector<std::uint32_t> box_bits;
   std::size_t num_static = 0, num_candidate = 0, num_dynamic = 0;
   std::size_t num_in_boxes = 0;       ///< points inside any box
   std::size_t num_mask_pixels = 0;
@@ -505,6 +507,7 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
   r.box_index.assign(n, -1);
+  r.box_bits.assign(n, 0u);
   if (depth.empty()) {
     r.status = Status::Skipped;
     r.reason = "no depth image";
@@ -552,10 +555,12 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
           r.box_index[i] = static_cast<std::int32_t>(b);
         }
       } else if (detail::band_contains(depth, range, bands[b], static_cast<int>(lu), static_cast<int>(lv))) {
-        r.labels[i] = FeatureLabel::Dynamic;
-        r.reasons[i] = CullReason::DepthMask;
-        r.box_index[i] = static_cast<std::int32_t>(b);
-        break;
+        if (r.labels[i] != FeatureLabel::Dynamic) {
+          r.labels[i] = FeatureLabel::Dynamic;
+          r.reasons[i] = CullReason::DepthMask;
+          r.box_index[i] = static_cast<std::int32_t>(b);
+        }
+        if (b < 32) r.box_bits[i] |= 1u << b;
       }
     }
     r.num_in_boxes += inside_any;

@@ -84,6 +84,10 @@ struct PipelineOptions {
   /// (or no track lay inside one). An F fitted through a large mover absorbs its motion (measured in
   /// docs/algorithms.md), and the refinement would then clear the whole box.
   bool subbox_requires_fit_outside_boxes = true;
+  /// Medium-level candidates (a chair) are culled by a dynamic sub-box of their region (true), or only
+  /// on their own evidence, their epipolar distance or the multi-view check (false): a chair under a
+  /// seated person or behind a walker otherwise inherits the person's sub-box vote.
+  bool subbox_verifies_candidates = true;
 
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
@@ -130,6 +134,7 @@ struct PipelineState {
   PipelineResult<T> result;
   // Scratch (internal).
   std::vector<Detection<T>> boxes, dyn_boxes;
+  std::vector<std::uint32_t> object_box_bits;  ///< per feature: the dynamic boxes whose depth mask holds it
   std::vector<std::int32_t> dyn_box_source;
   std::vector<FeatureLabel> sem_labels;
   std::vector<CullReason> sem_reasons;
@@ -300,6 +305,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       r.depth_mask.reason = dm.reason;
       if (dm.ok()) {
         r.depth_mask.num_dynamic = dm.num_dynamic;
+        s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
         for (std::size_t i = 0; i < n; ++i) {
           s.in_object[i] = dm.labels[i] != FeatureLabel::Static;
           if (dm.labels[i] == FeatureLabel::Dynamic && dm.reasons[i] == CullReason::InvalidInput) {
@@ -382,8 +388,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       r.subbox.reason = "F was fitted through the dynamic-class boxes (too few tracks outside them): "
                         "its epipolar evidence inside the boxes is not trusted";
     } else {
+      const bool masks = options.use_depth_mask && r.depth_mask.ran();
       refine_subboxes(kp, s.moving.labels.data(), s.dyn_boxes, options.subbox, &s.subbox,
-                      options.use_depth_mask && r.depth_mask.ran() ? s.in_object.data() : nullptr);
+                      masks ? s.in_object.data() : nullptr, masks ? s.object_box_bits.data() : nullptr);
       r.subbox.status = s.subbox.status;
       r.subbox.reason = s.subbox.reason;
       r.subbox.num_dynamic = s.subbox.num_dynamic;
@@ -464,7 +471,12 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
     const bool geo_dyn = geo_ok && s.moving.labels[i] == FeatureLabel::Dynamic;
     bool geo_flagged = geo_dyn;
     if (subbox_ok) {
-      if (s.subbox.reasons[i] == CullReason::SubBox && (!sheltered || geo_dyn)) {
+      if (lab == FeatureLabel::Candidate && !options.subbox_verifies_candidates) {
+        // Stays a candidate, verified below on its own evidence: flagged itself inside a dynamic sub-box,
+        // or by the multi-view check.
+        geo_flagged = geo_dyn && s.subbox.reasons[i] == CullReason::SubBox;
+        if (geo_flagged) why = CullReason::SubBox;
+      } else if (s.subbox.reasons[i] == CullReason::SubBox && (!sheltered || geo_dyn)) {
         lab = FeatureLabel::Dynamic;
         why = CullReason::SubBox;
         geo_flagged = true;

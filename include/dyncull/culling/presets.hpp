@@ -116,6 +116,8 @@ PipelineOptions<T> recommended() {
   o.use_moving_consistency = true;
   o.moving.fit_outside_boxes = true;
   o.use_subbox = true;
+  o.subbox.object_mask_votes_only = true;
+  o.subbox_verifies_candidates = false;
   o.use_multiview = true;
   o.multiview_overrides_static = false;  // outside boxes a depth jump is more often a sensor edge
   // A person at 2-3 m covers about 20k pixels at 640x480; a seed on a static occlusion edge would

@@ -36,6 +36,10 @@ struct SubBoxOptions {
   /// Features outside every box keep their geometric label (there is no semantic evidence against it);
   /// false: they become static (trust only boxed objects).
   bool keep_geometric_outside_boxes = true;
+  /// When an object mask is given, only features inside it vote: the floor and wall behind a person
+  /// otherwise outvote the person in the border sub-boxes, and a walker crossing a chair's box makes
+  /// the chair's sub-boxes dynamic. false: every labelled feature in the rectangle votes (the paper).
+  bool object_mask_votes_only = false;
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
 };
 
@@ -78,6 +82,12 @@ int subbox_cell(const Box<T>& b, int grid, T x, T y) {
   cy = std::min(std::max(cy, 0), grid - 1);
   return cy * grid + cx;
 }
+
+/// Whether feature i belongs to box b's object (no mask given: every feature does).
+inline bool subbox_in_object(const std::uint8_t* in_object, const std::uint32_t* box_bits, std::size_t i, std::size_t b) {
+  if (box_bits && b < 32) return ((box_bits[i] >> b) & 1u) != 0;
+  return !in_object || in_object[i] != 0;
+}
 }  // namespace detail
 
 /// Runs Algorithm 1 on every box, writing into `out` (buffers reused across frames).
@@ -85,10 +95,13 @@ int subbox_cell(const Box<T>& b, int grid, T x, T y) {
 /// not counted); boxes: container of Box<T> or Detection<T> (the boxes to refine, e.g. person boxes);
 /// in_object_mask: optional per-feature flag (object mask of 000 §3.3): a feature in a dynamic sub-box
 /// is Dynamic only if also in the object mask, as the paper keeps "the mask" inside dynamic sub-boxes.
+/// object_box_bits: optional per-feature bit set (bit b: in box b's own object mask, as
+/// DepthMaskResult::box_bits): box b then acts only on its own object's features, so a chair that a
+/// walker's box overlaps is not culled by the walker's sub-box (boxes from the 33rd on use in_object_mask).
 template <class T, class Points, class Boxes>
 void refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
-                     const std::uint8_t* in_object_mask = nullptr) {
+                     const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::refine_subboxes: points must hold points (see PointTraits)");
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -123,6 +136,7 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
     std::uint32_t* dc = r.dyn_count.data() + b * cells_per_box;
     std::uint32_t* sc = r.static_count.data() + b * cells_per_box;
     for (std::size_t i = 0; i < n; ++i) {
+      if (options.object_mask_votes_only && !detail::subbox_in_object(in_object_mask, object_box_bits, i, b)) continue;
       const int c = detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
       if (c < 0) continue;
       if (geometric[i] == FeatureLabel::Dynamic) ++dc[c];
@@ -183,13 +197,14 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
       const int c = detail::subbox_cell(box, g, x, y);
       if (c < 0) continue;
       in_box = true;
-      in_dynamic = r.cells[b * cells_per_box + static_cast<std::size_t>(c)] != 0;
+      in_dynamic = r.cells[b * cells_per_box + static_cast<std::size_t>(c)] != 0 &&
+                   detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
     }
     const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
     if (!std::isfinite(x) || !std::isfinite(y)) {
       r.labels[i] = FeatureLabel::Dynamic;  // never trust a non-finite feature as static
       r.reasons[i] = CullReason::InvalidInput;
-    } else if (in_dynamic && (!in_object_mask || in_object_mask[i])) {
+    } else if (in_dynamic) {
       r.labels[i] = FeatureLabel::Dynamic;
       r.reasons[i] = CullReason::SubBox;
       r.num_added += !geo_dyn;
@@ -208,9 +223,10 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
 /// Convenience overload returning a fresh result.
 template <class T, class Points, class Boxes>
 SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
-                                const SubBoxOptions<T>& options = {}, const std::uint8_t* in_object_mask = nullptr) {
+                                const SubBoxOptions<T>& options = {}, const std::uint8_t* in_object_mask = nullptr,
+                                const std::uint32_t* object_box_bits = nullptr) {
   SubBoxResult<T> r;
-  refine_subboxes(points, geometric, boxes, options, &r, in_object_mask);
+  refine_subboxes(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   return r;
 }
 
