@@ -31,6 +31,7 @@ struct Args {
   std::string tum, detections;
   std::vector<std::string> strategies;  // empty: no culling + every preset
   bool list = false;
+  bool diagnose = false;
 };
 
 void usage(const char* argv0) {
@@ -48,7 +49,9 @@ void usage(const char* argv0) {
       "  --strategies LIST   subset of strategies, comma separated (default: none + every preset; --list)\n"
       "  --list              print the strategies and exit\n"
       "  --out DIR           output directory (default ./dynamic_vo_out)\n"
-      "  --quick             fewer frames, for smoke tests\n",
+      "  --quick             fewer frames, for smoke tests\n"
+      "  --diagnose          also print, per strategy, where its labels come from (sim instance, truth,\n"
+      "                      decision, deciding stage)\n",
       argv0);
 }
 
@@ -100,6 +103,8 @@ bool parse_args(int argc, char** argv, Args* a) {
       if (!value(&a->detections)) return false;
     } else if (arg == "--quick") {
       a->quick = true;
+    } else if (arg == "--diagnose") {
+      a->diagnose = true;
     } else if (arg == "--list") {
       a->list = true;
     } else {
@@ -163,6 +168,7 @@ int main(int argc, char** argv) {
   vo::RunnerOptions ro;
   ro.out_dir = args.out;
   ro.max_frames = args.frames;
+  ro.diagnose = args.diagnose;
   std::vector<vo::SequenceReport> reports;
   const auto t0 = std::chrono::steady_clock::now();
 
@@ -215,6 +221,13 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) cmd << (i ? " " : "") << argv[i];
   const std::string table = vo::format_table(reports, cmd.str(), seconds);
   std::printf("\n%s", table.c_str());
+  if (args.diagnose) {
+    for (const auto& r : reports)
+      for (const auto& run : r.runs)
+        if (run.spec.culls)
+          std::printf("\n%s / %s: instance truth decision reason count\n%s", r.name.c_str(), run.spec.name.c_str(),
+                      run.breakdown.format().c_str());
+  }
   const std::string md = args.out + "/results.md";
   std::ofstream(md) << table;
   std::printf("\nwrote %s\n", md.c_str());

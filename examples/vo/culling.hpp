@@ -67,6 +67,7 @@ class Culler {
   void cull(const SequenceFrame& frame, const Tracks& tracks, const Rigid3<double>& predicted_world_from_cam,
             std::vector<std::uint8_t>* keep) {
     keep->assign(tracks.size(), 1);
+    reasons_.assign(tracks.size(), CullReason::None);
     ++frame_index_;
     if (!spec_.culls) return;
     if (spec_.oracle) {
@@ -90,14 +91,21 @@ class Culler {
     f.cam_from_world = &pose_;
     f.is_keyframe = frame_index_ % kReferenceEvery == 1;
     const PipelineResult<float>& r = cull_frame(f, spec_.pipeline, &state_);
-    if (r.keep.size() == tracks.size()) *keep = r.keep;
+    if (r.keep.size() == tracks.size()) {
+      *keep = r.keep;
+      reasons_ = r.reasons;
+    }
   }
+
+  /// Why each track of the last cull() was labelled (None for the oracle and no culling).
+  const std::vector<CullReason>& reasons() const { return reasons_; }
 
  private:
   StrategySpec spec_;
   PinholeCamera<float> camera_;
   PipelineState<float> state_;
   std::vector<std::int64_t> ids_;
+  std::vector<CullReason> reasons_;
   Rigid3<float> pose_;
   int frame_index_ = 0;
 };

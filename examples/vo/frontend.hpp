@@ -255,8 +255,10 @@ class FrontEnd {
     tracks_.pnp_inlier.resize(n);
   }
 
-  /// The current frame becomes the keyframe: its PnP inliers are re-anchored on its own depth
-  /// (fresh 3-D points stop drift from old depth), the rest of the budget is new ORB corners.
+  /// The current frame becomes the keyframe: its PnP inliers keep the 3-D points they were created
+  /// with, like ORB-SLAM's map points (re-anchoring them on this frame's depth at this frame's
+  /// estimated pose adds each keyframe's pose error to the points: ATE of the oracle culling on 150 xyz
+  /// frames 2.9 cm re-anchored, 1.3 cm kept), and the rest of the budget is new ORB corners.
   void make_keyframe(FrameStats& stats) {
     stats.keyframe = true;
     keyframe_world_from_cam_ = world_from_cam_;
@@ -265,12 +267,9 @@ class FrontEnd {
     for (std::size_t i = 0; i < tracks_.size(); ++i) {
       if (have_inliers && !tracks_.pnp_inlier[i]) continue;
       if (!have_inliers) continue;  // after a PnP failure no track is trusted
-      const cv::Point2f p = tracks_.cur_px[i];
-      const float z = usable_depth(p.x, p.y);
-      if (z <= 0.f) continue;
       tracks_.ids[n] = tracks_.ids[i];
-      tracks_.cur_px[n] = p;
-      tracks_.world[n] = world_from_cam_.apply(camera_.backproject(Vec2<double>(p.x, p.y), static_cast<double>(z)));
+      tracks_.cur_px[n] = tracks_.cur_px[i];
+      tracks_.world[n] = tracks_.world[i];
       ++n;
     }
     tracks_.ids.resize(n);

@@ -6,6 +6,7 @@
 
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/types.hpp"
+#include "dyncull/culling/labels.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -17,6 +18,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -78,6 +80,45 @@ inline void count_labels(const std::vector<cv::Point2f>& px, const std::vector<s
     }
   }
 }
+
+/// Where the labels of one strategy come from: counts per (sim instance, truth, decision, reason), so a
+/// low precision or recall can be traced to the actor and the stage (dynamic_vo --diagnose).
+struct LabelBreakdown {
+  static constexpr int kInstances = 8, kReasons = 12;
+  std::array<std::size_t, kInstances * 2 * 2 * kReasons> counts{};
+
+  std::size_t& at(int instance, bool moving, bool culled, CullReason reason) {
+    const int inst = instance < 0 || instance >= kInstances ? kInstances - 1 : instance;
+    const int why = std::min(static_cast<int>(reason), kReasons - 1);
+    return counts[static_cast<std::size_t>(((inst * 2 + moving) * 2 + culled) * kReasons + why)];
+  }
+  void add(const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep,
+           const std::vector<CullReason>& reasons, const cv::Mat& moving, const cv::Mat& instance) {
+    if (moving.empty() || instance.empty() || instance.type() != CV_16UC1) return;
+    for (std::size_t i = 0; i < px.size(); ++i) {
+      const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
+      if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
+      const CullReason why = i < reasons.size() ? reasons[i] : CullReason::None;
+      ++at(instance.at<std::uint16_t>(v, u), moving.at<std::uint8_t>(v, u) != 0, i < keep.size() && keep[i] == 0, why);
+    }
+  }
+  /// One line per non-empty cell: "instance truth decision reason count".
+  std::string format() const {
+    static const char* names[kInstances] = {"background", "walker_a", "walker_b", "sitting_person",
+                                            "pushed_chair", "sitting_chair", "tv", "other"};
+    std::ostringstream o;
+    for (int inst = 0; inst < kInstances; ++inst)
+      for (int mv = 0; mv < 2; ++mv)
+        for (int cu = 0; cu < 2; ++cu)
+          for (int why = 0; why < kReasons; ++why) {
+            const std::size_t c = counts[static_cast<std::size_t>(((inst * 2 + mv) * 2 + cu) * kReasons + why)];
+            if (c == 0) continue;
+            o << "    " << names[inst] << (mv ? " moving " : " static ") << (cu ? "culled " : "kept   ")
+              << to_string(static_cast<CullReason>(why)) << " " << c << "\n";
+          }
+    return o.str();
+  }
+};
 
 /// A distinct colour per strategy (BGR), ground truth is black.
 inline cv::Scalar strategy_colour(std::size_t i) {

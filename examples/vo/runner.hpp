@@ -32,6 +32,7 @@ struct RunnerOptions {
   int frames_to_draw = 3;        ///< frames with kept/culled features written as PNG (0: none)
   bool write_outputs = true;     ///< PNGs and TUM trajectory files (tests turn this off)
   bool print_progress = true;
+  bool diagnose = false;         ///< per-instance / per-reason label breakdown (needs sim truth)
   FrontEndOptions front_end;
 };
 
@@ -40,6 +41,7 @@ struct StrategyRun {
   StrategySpec spec;
   eval::Trajectory<double> estimate;
   LabelCounts labels;
+  LabelBreakdown breakdown;  ///< filled when RunnerOptions::diagnose
   double cull_ms = 0, front_end_ms = 0;  ///< totals over the frames
   std::size_t frames = 0, fallbacks = 0, keyframes = 0, tracks = 0, kept = 0, inliers = 0;
   // Evaluation.
@@ -123,6 +125,7 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
       const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
       if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
+      if (options.diagnose) run.breakdown.add(fe.tracks().cur_px, keep, cullers[k].reasons(), frame.moving, frame.instance);
       if (draw && k == draw_strategy && fe.tracks().size() > 0) {
         source.load_colour(&frame);
         char file[64];
