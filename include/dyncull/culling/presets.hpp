@@ -100,7 +100,9 @@ PipelineOptions<T> zhang_2023() {
 /// (000), verified per region by the epipolar check fitted outside boxes with a 0.5 px in-box threshold
 /// (003 + SG-SLAM) and the evidence-aware sub-box vote (keeps a seated person's still legs), the
 /// multi-view check when a pose is available (001; catches motion along epipolar lines), medium-level
-/// objects culled only when geometry sees them move, a tracker for missed boxes, and the survivor guard.
+/// objects culled only when geometry sees them move (their own flags, not their sub-box's vote), each
+/// box's sub-boxes voted by and acting on its own depth-mask object only, a tracker for missed boxes,
+/// and the survivor guard.
 /// The probability (000) is left out: its M term is the epipolar evidence already used, and its S
 /// term duplicates the box rule.
 template <class T>
