@@ -89,6 +89,50 @@ TYPED_TEST(DepthMask, PlainRuleSeparatesPersonFromWall) {
       }
 }
 
+// A chair 0.9 m in front of a person, inside the person's box: 000's one-sided band (everything nearer
+// than d_c + eps) takes the chair in; near_margin_m = 0.5 leaves it out and keeps the person whole.
+TYPED_TEST(DepthMask, NearMarginLeavesOutWhatStandsInFrontOfTheObject) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(80, 60, 20, 40, 2.5);
+  for (int v = 80; v <= 100; ++v)  // the chair, over the person's legs (not person truth)
+    for (int u = 60; u <= 100; ++u) {
+      s.depth[v * W + u] = Scene<Raw>::raw(1.6);
+      s.truth[v * W + u] = 0;
+    }
+  s.hole(70, 30, 72, 32);  // a Kinect hole on the person: still masked (mask_missing_depth)
+  const Box<double> box{55, 15, 105, 105};
+  DepthMaskOptions o;  // robust, one-sided (paper) band
+  Mask one_sided(W, H), two_sided(W, H);
+  const DepthMaskBoxInfo a = depth_mask_box(s.view(), box, o, one_sided.view());
+  ASSERT_TRUE(a.ok()) << a.reason;
+  EXPECT_TRUE(a.rule_applies);
+  EXPECT_NEAR(a.d_c_m, 2.5, 1e-6);
+  EXPECT_TRUE(one_sided.test(80, 90));   // chair pixel taken in by the one-sided band
+  o.near_margin_m = 0.5;
+  const DepthMaskBoxInfo b = depth_mask_box(s.view(), box, o, two_sided.view());
+  ASSERT_TRUE(b.ok()) << b.reason;
+  EXPECT_FALSE(two_sided.test(80, 90));  // chair left out
+  EXPECT_TRUE(two_sided.test(80, 50));   // person kept
+  EXPECT_TRUE(two_sided.test(71, 31));   // hole kept
+  EXPECT_FALSE(two_sided.test(56, 16));  // wall left out
+  EXPECT_LT(box_iou(s, one_sided, box), 0.8);
+  EXPECT_GT(box_iou(s, two_sided, box), 0.99);
+  // Point labels follow the raster.
+  const std::vector<Box<double>> boxes{box};
+  const std::vector<Vec2<float>> pts{{80.f, 90.f}, {80.f, 50.f}};
+  const DepthMaskResult r = depth_mask(s.view(), boxes, pts, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.labels[0], FeatureLabel::Static);
+  EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);
+  // The plain rule ignores the option (paper behaviour).
+  o.mode = DepthMaskMode::Plain;
+  Mask plain(W, H);
+  depth_mask_box(s.view(), box, o, plain.view());
+  EXPECT_TRUE(plain.test(80, 90));
+}
+
 TYPED_TEST(DepthMask, PointLabelsAgreeWithTheRaster) {
   using Raw = TypeParam;
   Scene<Raw> s;

@@ -125,6 +125,51 @@ TYPED_TEST(EpipolarTyped, BatchMatchesScalarOracleAcrossBlockBoundaries) {
   }
 }
 
+// Packed (x, y) containers take a fused one-pass path for eq. 3; it must give what the SoA kernel gives,
+// in the SIMD body and the tail, for NaN input and for undefined lines (X = Y = 0).
+TYPED_TEST(EpipolarTyped, PackedPathMatchesSoaKernel) {
+  using T = TypeParam;
+  TwoViewOptions o;
+  o.num_points = 11;  // two SIMD blocks of 4 floats / five of 2 doubles, then a tail
+  const auto d = make_two_view<T>(o);
+  std::vector<Vec2<T>> a = d.points1, b = d.points2;
+  a[1].x() = std::numeric_limits<T>::quiet_NaN();
+  b[6].y() = std::numeric_limits<T>::infinity();
+  a[10].y() = std::numeric_limits<T>::quiet_NaN();
+  auto soa = [](const Mat3<T>& F, const std::vector<Vec2<T>>& p, const std::vector<Vec2<T>>& q) {
+    std::vector<T> x1, y1, x2, y2, out(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      x1.push_back(p[i].x()), y1.push_back(p[i].y()), x2.push_back(q[i].x()), y2.push_back(q[i].y());
+    }
+    epipolar_distances_soa(F, x1.data(), y1.data(), x2.data(), y2.data(), p.size(), out.data());
+    return out;
+  };
+  Mat3<T> line_at_infinity = Mat3<T>::Zero();
+  line_at_infinity(2, 2) = T(1);
+  for (const Mat3<T>& F : {d.F, line_at_infinity}) {
+    std::vector<T> packed;
+    ASSERT_EQ(epipolar_distances(F, a, b, &packed), Status::Ok);
+    const std::vector<T> ref = soa(F, a, b);
+    ASSERT_EQ(packed.size(), ref.size());
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      if (std::isnan(ref[i])) {
+        EXPECT_TRUE(std::isnan(packed[i])) << i;
+      } else if (std::isinf(ref[i])) {
+        EXPECT_EQ(packed[i], ref[i]) << i;
+      } else {
+        EXPECT_NEAR(packed[i], ref[i], 4 * std::numeric_limits<T>::epsilon() * (T(1) + ref[i])) << i;
+      }
+    }
+  }
+  // The points that must be NaN are.
+  std::vector<T> out;
+  ASSERT_EQ(epipolar_distances(d.F, a, b, &out), Status::Ok);
+  EXPECT_TRUE(std::isnan(out[1]));
+  EXPECT_TRUE(std::isnan(out[10]));
+  EXPECT_FALSE(std::isfinite(out[6]));
+  EXPECT_TRUE(std::isfinite(out[0]) && std::isfinite(out[9]));
+}
+
 TYPED_TEST(EpipolarTyped, LabelsMatchThresholdedDistances) {
   using T = TypeParam;
   TwoViewOptions o;  // 1000 points, 30 % outliers >= 3 px off their line, 0.5 px noise

@@ -99,6 +99,10 @@ struct DepthMaskOptions {
   double max_object_depth_extent_m = 1.5;
   /// Below this fraction of box pixels with depth the whole box is masked.
   double min_valid_fraction = 0.05;
+  /// Two-sided band (robust mode, Seed000 form): when > 0, pixels nearer than d_c - near_margin_m are
+  /// left out too. 000's band is one-sided (everything in front of the object is masked), which
+  /// takes in a chair or the floor between the camera and a person; 0 (default) keeps the paper's rule.
+  double near_margin_m = 0.0;
 
   std::uint8_t mask_value = 255;
 };
@@ -383,6 +387,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
 
   const double e = eps_raw(o.eps_m);
   info.rule_applies = dc > 0 && dmax - dc > e;
+  if (robust && o.near_margin_m > 0 && dc > 0) band->lo = std::max(range.lo, dc - eps_raw(o.near_margin_m));
   if (info.rule_applies) {
     set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
   } else if (!robust) {
