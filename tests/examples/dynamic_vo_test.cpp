@@ -25,11 +25,12 @@ const vo::StrategySpec* find_spec(const std::vector<vo::StrategySpec>& all, bool
   return nullptr;
 }
 
-// 30 frames of the sim's xyz walking sequence, where the two slow walkers crossing close to the
-// camera pull the un-culled front end off (measured: 63 mm ATE after one second): the recommended
-// preset must cut that ATE by a clear margin (measured 17 mm, -73 %) and label most moving features
-// (measured precision 0.78, recall 0.96: precision is below the project's 0.9 target, see
-// docs/results.md; the bounds here guard against regressions, not the target).
+// 45 frames of the sim's xyz walking sequence, where the two slow walkers crossing close to the
+// camera pull the un-culled front end off (measured: 110 mm ATE after 1.5 s; after 1 s only 26 mm since
+// the front end re-tracks features from the keyframe image): the recommended preset must cut that ATE
+// by a clear margin (measured 14.5 mm, -87 %) and label most moving features (measured precision 0.87,
+// recall 0.97; over 300 frames precision is below the project's 0.9 target, see docs/results.md; the
+// bounds here guard against regressions, not the target).
 TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
   const auto all = vo::all_strategies();
   const vo::StrategySpec* none = find_spec(all, false);
@@ -39,10 +40,10 @@ TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
 
   sim::SceneOptions so;
   so.motion = sim::CameraMotion::Xyz;
-  so.num_frames = 30;
+  so.num_frames = 45;
   vo::SimSource source(so);
   vo::RunnerOptions ro;
-  ro.max_frames = 30;
+  ro.max_frames = 45;
   ro.write_outputs = false;
   ro.print_progress = false;
   vo::SequenceReport report;
@@ -54,7 +55,7 @@ TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
   const vo::StrategyRun& b = report.runs[1];
   ASSERT_TRUE(a.has_ate) << a.ate_note;
   ASSERT_TRUE(b.has_ate) << b.ate_note;
-  EXPECT_EQ(a.ate_pairs, 30u);
+  EXPECT_EQ(a.ate_pairs, 45u);
   // The scene is hard: without culling the walkers visibly pull the pose off.
   EXPECT_GT(a.ate_rmse_m, 0.03) << "none " << a.ate_rmse_m << " m: the walkers no longer pull the front end off";
   // Culling beats no culling by a clear margin, not by run-to-run noise.
