@@ -139,7 +139,10 @@ TYPED_TEST(EpipolarTyped, PackedPathMatchesSoaKernel) {
   auto soa = [](const Mat3<T>& F, const std::vector<Vec2<T>>& p, const std::vector<Vec2<T>>& q) {
     std::vector<T> x1, y1, x2, y2, out(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
-      x1.push_back(p[i].x()), y1.push_back(p[i].y()), x2.push_back(q[i].x()), y2.push_back(q[i].y());
+      x1.push_back(p[i].x());
+      y1.push_back(p[i].y());
+      x2.push_back(q[i].x());
+      y2.push_back(q[i].y());
     }
     epipolar_distances_soa(F, x1.data(), y1.data(), x2.data(), y2.data(), p.size(), out.data());
     return out;
