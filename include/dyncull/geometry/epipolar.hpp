@@ -232,8 +232,8 @@ void load_block(const C& points, std::size_t begin, std::size_t len, T* x, T* y)
 }
 
 /// Seed 003 eq. 3 straight from packed (x, y) pairs, in one pass: the block copy of for_each_soa_block
-/// cost as much as the arithmetic in double (1000 points: 4.9 -> 3.0 us at -O3, 7.8 -> 3.0 us at -O2).
-/// Same operations in the same order as epipolar_distances_soa, so the values are bit-identical.
+/// cost as much as the arithmetic (double, 1000 points: 0.62x -> 0.40x of OpenCV's epilines + distance
+/// at -O3, docs/benchmarks.md). Same operations in the same order as epipolar_distances_soa (tested equal).
 template <class T>
 void point_to_line_packed(const Mat3<T>& F, const T* xy1, const T* xy2, std::size_t n, T* out) {
   std::size_t i = 0;
