@@ -79,6 +79,27 @@ struct Tracks {
   std::vector<std::uint8_t> pnp_inlier;    ///< set by estimate()
 
   std::size_t size() const { return ids.size(); }
+  /// Keeps the tracks i with keep(i), in order, in every array (keep may read index i of any array).
+  template <class Keep>
+  void keep_if(Keep&& keep) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < size(); ++i) {
+      if (!keep(i)) continue;
+      ids[n] = ids[i];
+      prev_px[n] = prev_px[i];
+      cur_px[n] = cur_px[i];
+      kf_px[n] = kf_px[i];
+      world[n] = world[i];
+      pnp_inlier[n] = pnp_inlier[i];
+      ++n;
+    }
+    ids.resize(n);
+    prev_px.resize(n);
+    cur_px.resize(n);
+    kf_px.resize(n);
+    world.resize(n);
+    pnp_inlier.resize(n);
+  }
   void clear() {
     ids.clear();
     prev_px.clear();
@@ -115,24 +136,12 @@ class FrontEnd {
                              cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03));
     const float b = static_cast<float>(options_.border_px) * 0.5f;
     const float umax = static_cast<float>(frame.gray.cols) - 1.f - b, vmax = static_cast<float>(frame.gray.rows) - 1.f - b;
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    tracks_.keep_if([&](std::size_t i) {
       const cv::Point2f p = tracks_.cur_px[i];
-      if (!status[i] || !(p.x >= b && p.y >= b && p.x <= umax && p.y <= vmax)) continue;
-      tracks_.ids[n] = tracks_.ids[i];
-      tracks_.prev_px[n] = tracks_.prev_px[i];
-      tracks_.cur_px[n] = p;
-      tracks_.kf_px[n] = tracks_.kf_px[i];
-      tracks_.world[n] = tracks_.world[i];
-      ++n;
-    }
-    tracks_.ids.resize(n);
-    tracks_.prev_px.resize(n);
-    tracks_.cur_px.resize(n);
-    tracks_.kf_px.resize(n);
-    tracks_.world.resize(n);
-    tracks_.pnp_inlier.assign(n, 0);
-    if (options_.refine_against_keyframe && n > 0 && !kf_gray_.empty()) {
+      return status[i] && p.x >= b && p.y >= b && p.x <= umax && p.y <= vmax;
+    });
+    tracks_.pnp_inlier.assign(tracks_.size(), 0);
+    if (options_.refine_against_keyframe && tracks_.size() > 0 && !kf_gray_.empty()) {
       // LK models a translated patch: across a large rotation from the keyframe (rpy) the keyframe
       // patch no longer matches and the refinement would bias the tracks, so it is skipped there.
       const Rigid3<double> kf_from_pred = keyframe_world_from_cam_.inverse() * predicted_world_from_cam();
@@ -250,27 +259,13 @@ class FrontEnd {
   /// this they accumulate until the next keyframe and can form a coherent wrong consensus.
   void drop_outlier_tracks(const Rigid3<double>& cam_from_world) {
     const double max_sq = options_.track_max_error_px * options_.track_max_error_px;
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    tracks_.keep_if([&](std::size_t i) {
       const Vec3<double> pc = cam_from_world.apply(tracks_.world[i]);
-      if (!(pc.z() > 0)) continue;
+      if (!(pc.z() > 0)) return false;
       const Vec2<double> q = camera_.project(pc);
       const double du = q.x() - tracks_.cur_px[i].x, dv = q.y() - tracks_.cur_px[i].y;
-      if (!(du * du + dv * dv <= max_sq)) continue;
-      tracks_.ids[n] = tracks_.ids[i];
-      tracks_.prev_px[n] = tracks_.prev_px[i];
-      tracks_.cur_px[n] = tracks_.cur_px[i];
-      tracks_.kf_px[n] = tracks_.kf_px[i];
-      tracks_.world[n] = tracks_.world[i];
-      tracks_.pnp_inlier[n] = tracks_.pnp_inlier[i];
-      ++n;
-    }
-    tracks_.ids.resize(n);
-    tracks_.prev_px.resize(n);
-    tracks_.cur_px.resize(n);
-    tracks_.kf_px.resize(n);
-    tracks_.world.resize(n);
-    tracks_.pnp_inlier.resize(n);
+      return du * du + dv * dv <= max_sq;
+    });
   }
 
   /// The current frame becomes the keyframe: its PnP inliers keep the 3-D points they were created
@@ -280,21 +275,11 @@ class FrontEnd {
   void make_keyframe(FrameStats& stats) {
     stats.keyframe = true;
     keyframe_world_from_cam_ = world_from_cam_;
-    std::size_t n = 0;
+    // After a PnP failure (no inliers) no track is trusted.
     const bool have_inliers = stats.inliers > 0;
-    for (std::size_t i = 0; i < tracks_.size(); ++i) {
-      if (have_inliers && !tracks_.pnp_inlier[i]) continue;
-      if (!have_inliers) continue;  // after a PnP failure no track is trusted
-      tracks_.ids[n] = tracks_.ids[i];
-      tracks_.cur_px[n] = tracks_.cur_px[i];
-      tracks_.world[n] = tracks_.world[i];
-      ++n;
-    }
-    tracks_.ids.resize(n);
-    tracks_.cur_px.resize(n);
-    tracks_.world.resize(n);
+    tracks_.keep_if([&](std::size_t i) { return have_inliers && tracks_.pnp_inlier[i] != 0; });
 
-    const int budget = options_.max_features - static_cast<int>(n);
+    const int budget = options_.max_features - static_cast<int>(tracks_.size());
     if (budget > 0) detect_new(budget);
     tracks_.prev_px = tracks_.cur_px;
     tracks_.kf_px = tracks_.cur_px;
