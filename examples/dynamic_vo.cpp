@@ -10,6 +10,7 @@
 #include "vo/sources.hpp"
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -26,6 +27,7 @@ struct Args {
   int frames = 300;
   bool frames_set = false;
   std::vector<std::string> sequences = {"static", "xyz", "rpy", "halfsphere"};
+  std::vector<std::uint64_t> seeds = {1};  // scene seeds (SceneOptions::seed); several: median summary
   std::string out = "dynamic_vo_out";
   bool quick = false;
   std::string tum, detections;
@@ -42,6 +44,8 @@ void usage(const char* argv0) {
       "options:\n"
       "  --frames N          frames per sequence (default 300; --quick: 60)\n"
       "  --sequences LIST    synthetic sequences, comma separated: static,xyz,rpy,halfsphere (default all)\n"
+      "  --seeds LIST        scene seeds, comma separated (default 1). With several, every sequence runs once\n"
+      "                      per seed and a summary gives the median ATE and the pooled labels per strategy\n"
       "  --tum DIR           run on a TUM RGB-D directory (rgb.txt, depth.txt, optional groundtruth.txt)\n"
       "                      instead of the synthetic sequences\n"
       "  --detections PATH   YOLO detections for --tum: a directory of <rgb stem>.txt files or one file of\n"
@@ -92,6 +96,22 @@ bool parse_args(int argc, char** argv, Args* a) {
     } else if (arg == "--sequences") {
       if (!value(&v)) return false;
       a->sequences = split(v);
+    } else if (arg == "--seeds") {
+      if (!value(&v)) return false;
+      a->seeds.clear();
+      for (const std::string& item : split(v)) {
+        char* end = nullptr;
+        const unsigned long long seed = std::strtoull(item.c_str(), &end, 10);
+        if (end == item.c_str() || *end != '\0' || item[0] == '-') {
+          std::fprintf(stderr, "dynamic_vo: --seeds needs non-negative integers, got '%s'\n", item.c_str());
+          return false;
+        }
+        a->seeds.push_back(static_cast<std::uint64_t>(seed));
+      }
+      if (a->seeds.empty()) {
+        std::fprintf(stderr, "dynamic_vo: --seeds needs at least one seed\n");
+        return false;
+      }
     } else if (arg == "--strategies") {
       if (!value(&v)) return false;
       a->strategies = split(v);
@@ -203,23 +223,34 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "dynamic_vo: unknown sequence '%s' (static, xyz, rpy, halfsphere)\n", seq.c_str());
         return 2;
       }
-      so.num_frames = args.frames;
-      vo::SimSource source(so);
-      vo::SequenceReport rep;
-      std::string error;
-      if (!vo::run_sequence(seq, source, chosen, ro, &rep, &error)) {
-        std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
-        return 1;
+    }
+    for (const std::string& seq : args.sequences) {
+      for (const std::uint64_t seed : args.seeds) {
+        sim::SceneOptions so;
+        motion_from_name(seq, &so.motion);
+        so.num_frames = args.frames;
+        so.seed = seed;
+        vo::SimSource source(so);
+        vo::SequenceReport rep;
+        rep.sequence = seq;
+        rep.seed = seed;
+        std::string error;
+        const std::string name = args.seeds.size() > 1 ? seq + "-s" + std::to_string(seed) : seq;
+        if (!vo::run_sequence(name, source, chosen, ro, &rep, &error)) {
+          std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
+          return 1;
+        }
+        vo::evaluate_against_recorded_truth(&rep, ro);
+        reports.push_back(std::move(rep));
       }
-      vo::evaluate_against_recorded_truth(&rep, ro);
-      reports.push_back(std::move(rep));
     }
   }
 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream cmd;
   for (int i = 0; i < argc; ++i) cmd << (i ? " " : "") << argv[i];
-  const std::string table = vo::format_table(reports, cmd.str(), seconds);
+  std::string table = vo::format_table(reports, cmd.str(), seconds);
+  if (args.tum.empty() && args.seeds.size() > 1) table += "\n" + vo::format_seed_summary(reports);
   std::printf("\n%s", table.c_str());
   if (args.diagnose) {
     for (const auto& r : reports)
