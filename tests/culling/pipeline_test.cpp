@@ -252,6 +252,88 @@ TYPED_TEST(PipelineTest, SurvivorGuardSoftensGeometricCullsFirst) {
   }
 }
 
+// A static chair standing in front of a walker, inside the walker's box: the walker's one-sided depth
+// band ("closer than d_c + eps") holds the chair too. With assign_overlaps_by_depth the chair's features
+// go to the chair's box (d_c nearest their depth) and become medium-level candidates, kept without
+// geometric evidence; the walker's own features stay culled. Off: the walker's label takes the chair.
+TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
+  using T = TypeParam;
+  const int W = 320, H = 240;
+  std::vector<float> depth(static_cast<std::size_t>(W * H), 4.0f);  // back wall
+  auto fill = [&](int c0, int r0, int c1, int r1, float d) {
+    for (int v = r0; v < r1; ++v)
+      for (int u = c0; u < c1; ++u) depth[static_cast<std::size_t>(v * W + u)] = d;
+  };
+  fill(110, 40, 190, 220, 2.5f);   // walker
+  fill(120, 150, 200, 230, 1.9f);  // chair, 0.6 m in front of the walker, covering its legs
+  std::vector<Detection<T>> dets = {Detection<T>{Box<T>{T(100), T(30), T(200), T(230)}, 0, T(0.9)},    // person
+                                    Detection<T>{Box<T>{T(115), T(145), T(205), T(235)}, 56, T(0.9)}};  // chair
+  std::vector<Vec2<T>> kp;
+  std::vector<int> kind;  // 0 walker, 1 chair, 2 wall inside the person box
+  for (int v = 50; v < 140; v += 10)
+    for (int u = 120; u < 185; u += 10) {
+      kp.emplace_back(T(u), T(v));
+      kind.push_back(0);
+    }
+  for (int v = 160; v < 225; v += 10)
+    for (int u = 125; u < 195; u += 10) {
+      kp.emplace_back(T(u), T(v));
+      kind.push_back(1);
+    }
+  kp.emplace_back(T(104), T(60));
+  kind.push_back(2);
+  for (int u = 10; u < 300; u += 7) {  // wall features outside the boxes, so the guard stays quiet
+    kp.emplace_back(T(u), T(10));
+    kind.push_back(2);
+  }
+  PinholeCamera<T> camera;
+  camera.cx = T(159.5);
+  camera.cy = T(119.5);
+  camera.width = W;
+  camera.height = H;
+
+  PipelineOptions<T> o = presets::none<T>();
+  o.use_detection_filter = false;
+  o.use_box_rule = true;
+  o.box_rule.medium_as_candidate = true;
+  o.use_depth_mask = true;
+  o.depth_mask.mode = DepthMaskMode::Robust;
+  o.candidates = CandidatePolicy::Verify;  // no tracks: nothing verifies the candidates
+  CullingFrame<T, std::vector<Vec2<T>>> frame;
+  frame.keypoints = &kp;
+  frame.detections = &dets;
+  frame.depth = DepthView<float>{depth.data(), W, H, 0, 1.f, 0.f, 1e30f};
+  frame.camera = camera;
+
+  auto rates = [&](const PipelineResult<T>& r, int k) {
+    std::size_t n = 0, d = 0;
+    for (std::size_t i = 0; i < kp.size(); ++i)
+      if (kind[i] == k) {
+        ++n;
+        d += r.labels[i] == FeatureLabel::Dynamic;
+      }
+    return double(d) / double(n);
+  };
+  PipelineState<T> off_state;
+  const PipelineResult<T>& off = cull_frame(frame, o, &off_state);
+  ASSERT_TRUE(off.depth_mask.ran()) << off.depth_mask.reason;
+  EXPECT_EQ(rates(off, 0), 1.0);
+  EXPECT_GT(rates(off, 1), 0.9) << "premise: the walker's band holds the chair in front of it";
+  EXPECT_EQ(rates(off, 2), 0.0);
+
+  o.assign_overlaps_by_depth = true;
+  PipelineState<T> on_state;
+  const PipelineResult<T>& on = cull_frame(frame, o, &on_state);
+  ASSERT_TRUE(on.depth_mask.ran()) << on.depth_mask.reason;
+  EXPECT_EQ(rates(on, 0), 1.0);
+  EXPECT_EQ(rates(on, 1), 0.0);
+  EXPECT_EQ(rates(on, 2), 0.0);
+  for (std::size_t i = 0; i < kp.size(); ++i) {
+    if (kind[i] != 1) continue;
+    EXPECT_EQ(on_state.object_box_bits[i], 2u) << "chair feature " << i << " keeps only the chair's mask bit";
+  }
+}
+
 TYPED_TEST(PipelineTest, StateBuffersAreReusedAcrossFrames) {
   using T = TypeParam;
   SceneConfig config;

@@ -89,6 +89,14 @@ struct PipelineOptions {
   /// seated person or behind a walker otherwise inherits the person's sub-box vote.
   bool subbox_verifies_candidates = true;
 
+  /// A feature held by the depth masks of several dynamic-class boxes (a chair in front of a walker,
+  /// a walker passing a chair) belongs to the one whose object depth d_c is nearest its own depth, and
+  /// takes that box's level: a static chair's features are then candidates verified on their own
+  /// evidence instead of inheriting the walker's label and sub-box vote. The same applies to a
+  /// feature in a person's box but only in a chair's mask. false: the box rule's label (highest level
+  /// of the rectangles holding it) stands.
+  bool assign_overlaps_by_depth = false;
+
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
   /// all culling. ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
@@ -190,6 +198,53 @@ bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u,
   *u = static_cast<int>(std::lround(x));
   *v = static_cast<int>(std::lround(y));
   return *u >= 0 && *v >= 0 && *u < w && *v < h;
+}
+
+/// PipelineOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
+/// masks hold them, keeps one mask bit (the box with d_c nearest the feature's depth; ties and missing
+/// depth: the highest level, then the first box) and sets the semantic label from that box's level.
+template <class T, class Keypoints, class Raw>
+void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, const DepthMaskResult& dm,
+                              const std::vector<Detection<T>>& dyn_boxes, const MotionLevelTable& levels,
+                              std::vector<std::uint32_t>* bits, std::vector<FeatureLabel>* labels,
+                              std::vector<CullReason>* reasons) {
+  const std::size_t n = bits->size();
+  const std::size_t nb = std::min<std::size_t>({dyn_boxes.size(), dm.boxes.size(), 32});
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t b = (*bits)[i];
+    const CullReason why = (*reasons)[i];
+    // Only the box rule's own labels are re-decided (not a low-level override or invalid input).
+    if (b == 0 || !(why == CullReason::HighLevelBox || why == CullReason::MediumLevelBox || why == CullReason::DepthMask))
+      continue;
+    int u = 0, v = 0;
+    float d = 0.f;
+    if (keypoint_in_image<T>(kp, i, depth.width, depth.height, &u, &v)) d = depth.depth_m(u, v);
+    std::size_t best = nb;
+    double best_gap = 0;
+    MotionLevel best_level = MotionLevel::Ignore;
+    for (std::size_t k = 0; k < nb; ++k) {
+      if (!(b & (std::uint32_t(1) << k))) continue;
+      const MotionLevel lv = levels.level(dyn_boxes[k].class_id);
+      const double dc = dm.boxes[k].d_c_m;
+      const double gap = d > 0.f && dc > 0 ? std::abs(static_cast<double>(d) - dc) : 0.0;
+      const bool better = best == nb || gap < best_gap ||
+                          (gap == best_gap && lv == MotionLevel::High && best_level != MotionLevel::High);
+      if (better) {
+        best = k;
+        best_gap = gap;
+        best_level = lv;
+      }
+    }
+    if (best == nb) continue;
+    (*bits)[i] = std::uint32_t(1) << best;
+    if (best_level == MotionLevel::High && (*labels)[i] != FeatureLabel::Dynamic) {
+      (*labels)[i] = FeatureLabel::Dynamic;
+      (*reasons)[i] = CullReason::HighLevelBox;
+    } else if (best_level == MotionLevel::Medium && (*labels)[i] == FeatureLabel::Dynamic) {
+      (*labels)[i] = FeatureLabel::Candidate;
+      (*reasons)[i] = CullReason::MediumLevelBox;
+    }
+  }
 }
 }  // namespace detail
 
@@ -306,6 +361,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       if (dm.ok()) {
         r.depth_mask.num_dynamic = dm.num_dynamic;
         s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
+        if (options.assign_overlaps_by_depth && options.use_box_rule)
+          detail::assign_overlaps_by_depth(kp, frame.depth, dm, s.dyn_boxes, options.levels, &s.object_box_bits,
+                                           &s.sem_labels, &s.sem_reasons);
         for (std::size_t i = 0; i < n; ++i) {
           s.in_object[i] = dm.labels[i] != FeatureLabel::Static;
           if (dm.labels[i] == FeatureLabel::Dynamic && dm.reasons[i] == CullReason::InvalidInput) {
