@@ -28,6 +28,9 @@ struct StrategySpec {
   bool needs_detections = false;  ///< cannot run without detector boxes
   bool recommended = false;       ///< the library's recommended default preset
   bool oracle = false;            ///< culls by the sim's per-pixel truth: the bound no culling can beat
+  /// Epipolar evidence between the keyframe and the current frame (Tracks::kf_px) instead of the previous
+  /// frame: what the recommended preset expects (presets.hpp). The papers' presets use the previous frame.
+  bool tracks_from_keyframe = false;
   PipelineOptions<float> pipeline{};
 };
 
@@ -36,7 +39,7 @@ inline std::vector<StrategySpec> all_strategies() {
   std::vector<StrategySpec> out;
   auto add = [&](const char* name, const char* description, bool culls, bool dets, bool rec, bool oracle,
                  PipelineOptions<float> o) {
-    out.push_back(StrategySpec{name, description, culls, dets, rec, oracle, o});
+    out.push_back(StrategySpec{name, description, culls, dets, rec, oracle, rec, o});
   };
   add("none", "no culling: every tracked feature goes to PnP-RANSAC", false, false, false, false,
       presets::none<float>());
@@ -47,7 +50,7 @@ inline std::vector<StrategySpec> all_strategies() {
   add("dfd_slam", "003: epipolar check + 3x3 sub-box refinement", true, false, false, false, presets::dfd_slam<float>());
   add("zhang_2023", "004: high/medium/low logical discrimination", true, true, false, false,
       presets::zhang_2023<float>());
-  add("recommended", "dyncull's recommended preset (box rule + depth band + epipolar/sub-box + multi-view + guard)",
+  add("recommended", "dyncull's recommended preset (box rule + depth band + epipolar vs keyframe / sub-box + guard)",
       true, true, true, false, presets::recommended<float>());
   add("oracle", "culls exactly the features on moving surfaces (sim truth): the best any culling can do", true, false,
       false, true, presets::none<float>());
@@ -83,7 +86,7 @@ class Culler {
     pose_ = predicted_world_from_cam.inverse().cast<float>();
     CullingFrame<float, std::vector<cv::Point2f>, std::vector<cv::Point2f>, float> f;
     f.keypoints = &tracks.cur_px;
-    f.prev_keypoints = &tracks.prev_px;
+    f.prev_keypoints = spec_.tracks_from_keyframe ? &tracks.kf_px : &tracks.prev_px;
     f.track_ids = &ids_;
     f.detections = &frame.detections;
     f.depth = cv_adapter::depth_view_f32(frame.depth_m, 0.4f, 8.f);

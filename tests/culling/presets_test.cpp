@@ -40,11 +40,12 @@ TEST(Presets, EachPaperRunsItsStrategies) {
 
 TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   const auto o = presets::recommended<float>();
-  EXPECT_TRUE(o.use_box_rule && o.use_depth_mask && o.use_moving_consistency && o.use_subbox && o.use_multiview &&
-              o.use_box_tracker && o.use_detection_filter && o.survivor_guard);
+  EXPECT_TRUE(o.use_box_rule && o.use_depth_mask && o.use_moving_consistency && o.use_subbox &&
+              o.use_box_tracker && o.use_detection_filter && o.survivor_guard && o.assign_overlaps_by_depth);
   EXPECT_FALSE(o.use_probability);
+  EXPECT_FALSE(o.use_multiview);
   EXPECT_TRUE(o.moving.fit_outside_boxes);
-  EXPECT_FLOAT_EQ(o.moving.max_epipolar_distance_in_boxes_px, 0.5f);
+  EXPECT_FLOAT_EQ(o.moving.max_epipolar_distance_in_boxes_px, 1.0f);  // tracks against the keyframe
   EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
   EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
   EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);

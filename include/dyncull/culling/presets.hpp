@@ -97,14 +97,18 @@ PipelineOptions<T> zhang_2023() {
 }
 
 /// Recommended: the box rule with the low-level override (002/004), limited to the object's depth band
-/// (000), verified per region by the epipolar check fitted outside boxes with a 0.5 px in-box threshold
-/// (003 + SG-SLAM) and the evidence-aware sub-box vote (keeps a seated person's still legs), the
-/// multi-view check when a pose is available (001; catches motion along epipolar lines), medium-level
-/// objects culled only when geometry sees them move (their own flags, not their sub-box's vote), each
-/// box's sub-boxes voted by and acting on its own depth-mask object only, a tracker for missed boxes,
-/// and the survivor guard.
-/// The probability (000) is left out: its M term is the epipolar evidence already used, and its S
-/// term duplicates the box rule.
+/// (000), each feature in overlapping masks given to the object nearest its depth, verified per region
+/// by the epipolar check fitted outside boxes (003 + SG-SLAM) and the evidence-aware sub-box vote (keeps
+/// a seated person's still legs), medium-level objects culled only when their own features are flagged,
+/// each box's sub-boxes voted by and acting on its own depth-mask object only, a tracker for missed
+/// boxes, and the survivor guard.
+/// Tracks: give as prev_keypoints the features' positions in a reference frame a few frames back (the
+/// front end's keyframe), not the previous frame: slow movers (a seated person) build up a measurable
+/// epipolar distance only over several frames, hence the 1 px in-box threshold (0.5 px suits
+/// frame-to-frame tracks). Measured on the dynamic_vo sim, seeds 1-3: docs/results.md.
+/// Left out: the probability (000; its M term is the epipolar evidence already used, its S term
+/// duplicates the box rule) and the multi-view check (001): with static features protected it only
+/// verifies candidates, and on the sim it mostly culled static chairs next to walkers.
 template <class T>
 PipelineOptions<T> recommended() {
   PipelineOptions<T> o;
@@ -117,13 +121,16 @@ PipelineOptions<T> recommended() {
   o.use_probability = false;
   o.use_moving_consistency = true;
   o.moving.fit_outside_boxes = true;
+  o.moving.max_epipolar_distance_in_boxes_px = T(1);
+  o.assign_overlaps_by_depth = true;
   o.use_subbox = true;
   o.subbox.object_mask_votes_only = true;
   o.subbox_verifies_candidates = false;
-  o.use_multiview = true;
-  o.multiview_overrides_static = false;  // outside boxes a depth jump is more often a sensor edge
-  // A person at 2-3 m covers about 20k pixels at 640x480; a seed on a static occlusion edge would
-  // otherwise flood a whole wall (most of the multi-view cost, measured in the pipeline bench).
+  o.use_multiview = false;
+  // When switched on: outside boxes a depth jump is more often a sensor edge, and a person at 2-3 m
+  // covers about 20k pixels at 640x480; a seed on a static occlusion edge would otherwise flood a whole
+  // wall (most of the multi-view cost, measured in the pipeline bench).
+  o.multiview_overrides_static = false;
   o.multiview.max_region_pixels = 20000;
   o.cull_geometric_outside_boxes = false;
   o.candidates = CandidatePolicy::Verify;
