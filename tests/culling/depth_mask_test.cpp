@@ -133,6 +133,55 @@ TYPED_TEST(DepthMask, NearMarginLeavesOutWhatStandsInFrontOfTheObject) {
   EXPECT_TRUE(plain.test(80, 90));
 }
 
+// A seated person (3.3 m) half hidden by a walker (1.5 m) standing over its box centre: 000's centre
+// sample measures the walker, and the seated person's band ("closer than d_c + eps") leaves the seated
+// person out. occluded_centre_search re-estimates that box's d_c from its pixels outside the walker's box.
+TYPED_TEST(DepthMask, OccludedCentreIsReestimatedOutsideTheOccludersBox) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.5);
+  s.person(60, 62, 30, 40, 3.3);             // seated person
+  for (int v = 10; v <= 115; ++v)            // walker, covering the seated person's centre
+    for (int u = 52; u <= 76; ++u) s.depth[v * W + u] = Scene<Raw>::raw(1.5);
+  const std::vector<Box<double>> boxes{Box<double>{28, 20, 92, 104},   // seated person
+                                       Box<double>{50, 8, 78, 117}};   // walker
+  const std::vector<Vec2<float>> pts{{40.f, 62.f},    // seated person, left of the walker
+                                     {85.f, 70.f},    // seated person, right of the walker
+                                     {31.f, 24.f},    // wall in the seated person's box
+                                     {64.f, 60.f}};   // walker
+  DepthMaskOptions o;
+  const DepthMaskResult paper = depth_mask(s.view(), boxes, pts, o);
+  ASSERT_TRUE(paper.ok()) << paper.reason;
+  EXPECT_NEAR(paper.boxes[0].d_c_m, 1.5, 1e-6) << "premise: the centre sample is on the walker";
+  EXPECT_EQ(paper.labels[0], FeatureLabel::Static);
+  EXPECT_EQ(paper.labels[1], FeatureLabel::Static);
+
+  o.occluded_centre_search = true;
+  Mask raster(W, H);
+  const DepthMaskResult r = depth_mask(s.view(), boxes, pts, o, raster.view());
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_NEAR(r.boxes[0].d_c_m, 3.3, 0.15);
+  EXPECT_FALSE(r.boxes[0].reason.empty());
+  EXPECT_NEAR(r.boxes[1].d_c_m, 1.5, 1e-6);  // the walker's own box is left alone
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);
+  EXPECT_EQ(r.box_bits[0], 1u);
+  EXPECT_EQ(r.labels[2], FeatureLabel::Static);  // wall behind stays out
+  EXPECT_EQ(r.labels[3], FeatureLabel::Dynamic);
+  EXPECT_TRUE(raster.test(40, 62));
+  EXPECT_FALSE(raster.test(31, 24));
+
+  // A box whose centre depth is its own object's (most of its unshared pixels) is not moved.
+  const std::vector<Box<double>> alone{Box<double>{28, 20, 92, 104}};
+  Scene<Raw> plain;
+  plain.fill(4.5);
+  plain.person(60, 62, 30, 40, 3.3);
+  const DepthMaskResult q = depth_mask(plain.view(), alone, pts, o);
+  ASSERT_TRUE(q.ok()) << q.reason;
+  EXPECT_NEAR(q.boxes[0].d_c_m, 3.3, 1e-6);
+  EXPECT_TRUE(q.boxes[0].reason.empty());
+}
+
 TYPED_TEST(DepthMask, PointLabelsAgreeWithTheRaster) {
   using Raw = TypeParam;
   Scene<Raw> s;

@@ -103,6 +103,15 @@ struct DepthMaskOptions {
   /// left out too. 000's band is one-sided (everything in front of the object is masked), which
   /// takes in a chair or the floor between the camera and a person; 0 (default) keeps the paper's rule.
   double near_margin_m = 0.0;
+  /// Occluded centre (robust mode, several boxes): when box b's centre lies in another box a and b's
+  /// d_c is a's object depth (a walker in front of a seated person), d_c measures the occluder and b's
+  /// band would leave b's own object out. Then b's d_c is re-estimated from b's pixels outside a: if
+  /// fewer than occluded_centre_max_fraction of them lie within eps of d_c, d_c becomes the fullest bin
+  /// of the nearest window of 3 histogram bins behind the occluder that holds at least
+  /// occluded_cluster_fraction of them. false (default): 000's centre sample.
+  bool occluded_centre_search = false;
+  double occluded_centre_max_fraction = 0.15;
+  double occluded_cluster_fraction = 0.15;
 
   std::uint8_t mask_value = 255;
 };
@@ -471,6 +480,67 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
   return info;
 }
 
+/// DepthMaskOptions::occluded_centre_search for box b against box a (both planned). Returns true and
+/// moves b's threshold when b's centre depth belongs to a's object.
+template <class Raw>
+bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range, const DepthMaskOptions& o,
+                            const DepthMaskBoxInfo& a, DepthMaskBoxInfo* b, DepthBand* band) {
+  const PixelRect& rb = b->rect;
+  const PixelRect& ra = a.rect;
+  const int cu = (rb.c0 + rb.c1 - 1) / 2, cv = (rb.r0 + rb.r1 - 1) / 2;
+  if (!(cu >= ra.c0 && cu < ra.c1 && cv >= ra.r0 && cv < ra.r1)) return false;
+  if (!(a.d_c_m > 0 && b->d_c_m > 0) || std::abs(a.d_c_m - b->d_c_m) > o.eps_m) return false;
+  // Samples of b outside a, about 4096 of them, in a histogram of 0.1 m bins up to histogram_max_m.
+  const double upm = static_cast<double>(v.units_per_metre);
+  const double bin_m = std::max(o.histogram_bin_m, 1e-3);
+  const int nb = std::max(3, static_cast<int>(std::ceil(o.histogram_max_m / bin_m)));
+  std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb), 0u);
+  const double per_sample = static_cast<double>(rb.area()) / std::max(1, o.histogram_target_samples);
+  const int step = std::max(1, static_cast<int>(std::ceil(std::sqrt(per_sample))));
+  std::size_t valid = 0, near_centre = 0;
+  for (int y = rb.r0; y < rb.r1; y += step) {
+    const Raw* d = v.row(y);
+    const bool row_in_a = y >= ra.r0 && y < ra.r1;
+    for (int x = rb.c0; x < rb.c1; x += step) {
+      if (row_in_a && x >= ra.c0 && x < ra.c1) continue;
+      if (!raw_valid(d[x], range)) continue;
+      const double m = static_cast<double>(d[x]) / upm;
+      ++valid;
+      near_centre += std::abs(m - b->d_c_m) <= o.eps_m;
+      ++hist[static_cast<std::size_t>(std::min(nb - 1, static_cast<int>(m / bin_m)))];
+    }
+  }
+  if (valid < 50 || static_cast<double>(near_centre) >= o.occluded_centre_max_fraction * static_cast<double>(valid))
+    return false;
+  const double need = o.occluded_cluster_fraction * static_cast<double>(valid);
+  const int first = std::min(nb - 3, static_cast<int>((a.d_c_m + o.eps_m) / bin_m) + 1);
+  for (int k = std::max(0, first); k + 2 < nb; ++k) {
+    const double in_window = static_cast<double>(hist[static_cast<std::size_t>(k)]) + hist[static_cast<std::size_t>(k + 1)] +
+                             hist[static_cast<std::size_t>(k + 2)];
+    if (in_window < need) continue;
+    int peak = k;  // the window's fullest bin
+    for (int j = k + 1; j <= k + 2; ++j)
+      if (hist[static_cast<std::size_t>(j)] > hist[static_cast<std::size_t>(peak)]) peak = j;
+    const double dc = (peak + 0.5) * bin_m;
+    const bool integral = std::is_integral<Raw>::value;
+    const double thr = integral ? std::round((dc + o.eps_m) * upm) : (dc + o.eps_m) * upm;
+    b->d_c_m = dc;
+    b->outcome = DepthMaskOutcome::RuleApplied;
+    b->rule_applies = true;
+    b->threshold_raw = thr;
+    b->threshold_m = thr / upm;
+    b->reason = "centre occluded by a nearer box: d_c from the box's pixels outside it";
+    band->none = false;
+    band->all = false;
+    band->hi = std::min(thr, range.hi + (integral ? 1.0 : 0.0));
+    if (!integral && thr > range.hi) band->hi = std::nextafter(range.hi, std::numeric_limits<double>::max());
+    if (integral) band->hi = std::ceil(band->hi);
+    b->masks_missing = band->missing;
+    return true;
+  }
+  return false;
+}
+
 template <class T> const Box<T>& as_box(const Box<T>& b) { return b; }
 template <class T> const Box<T>& as_box(const Detection<T>& d) { return d.box; }
 
@@ -529,9 +599,22 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
   std::size_t bad = 0;
   for (std::size_t b = 0; b < boxes.size(); ++b) {
     r.boxes.push_back(detail::plan_box(depth, range, detail::as_box(boxes[b]), options, &bands[b]));
-    DepthMaskBoxInfo& info = r.boxes.back();
-    if (!info.ok()) ++bad;
-    else if (!out.empty()) {
+    if (!r.boxes.back().ok()) ++bad;
+  }
+  if (options.occluded_centre_search && options.mode == DepthMaskMode::Robust &&
+      options.form == DepthThresholdForm::Seed000) {
+    for (std::size_t b = 0; b < r.boxes.size(); ++b) {
+      if (!r.boxes[b].ok() || r.boxes[b].outcome == DepthMaskOutcome::WholeBox) continue;
+      for (std::size_t a = 0; a < r.boxes.size(); ++a) {
+        if (a == b || !r.boxes[a].ok()) continue;
+        if (detail::replan_occluded_centre(depth, range, options, r.boxes[a], &r.boxes[b], &bands[b])) break;
+      }
+    }
+  }
+  if (!out.empty()) {
+    for (std::size_t b = 0; b < r.boxes.size(); ++b) {
+      DepthMaskBoxInfo& info = r.boxes[b];
+      if (!info.ok()) continue;
       info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, bands[b], options.mask_value, out);
       r.num_mask_pixels += info.num_mask_pixels;
     }
