@@ -34,6 +34,7 @@ struct Args {
   std::vector<std::string> strategies;  // empty: no culling + every preset
   bool list = false;
   bool diagnose = false;
+  int depth_edge_radius_px = vo::FrontEndOptions{}.depth_edge_radius_px;
 };
 
 void usage(const char* argv0) {
@@ -54,6 +55,8 @@ void usage(const char* argv0) {
       "  --list              print the strategies and exit\n"
       "  --out DIR           output directory (default ./dynamic_vo_out)\n"
       "  --quick             fewer frames, for smoke tests\n"
+      "  --depth-edge-radius N  front end: no new corner within N px of a depth step above 5 %% (default 1;\n"
+      "                      larger N drops corners whose LK window straddles an occlusion edge)\n"
       "  --diagnose          also print, per strategy, where its labels come from (sim instance, truth,\n"
       "                      decision, deciding stage)\n",
       argv0);
@@ -112,6 +115,15 @@ bool parse_args(int argc, char** argv, Args* a) {
         std::fprintf(stderr, "dynamic_vo: --seeds needs at least one seed\n");
         return false;
       }
+    } else if (arg == "--depth-edge-radius") {
+      if (!value(&v)) return false;
+      char* end = nullptr;
+      const long r = std::strtol(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || r < 1 || r > 32) {
+        std::fprintf(stderr, "dynamic_vo: --depth-edge-radius needs an integer in [1, 32], got '%s'\n", v.c_str());
+        return false;
+      }
+      a->depth_edge_radius_px = static_cast<int>(r);
     } else if (arg == "--strategies") {
       if (!value(&v)) return false;
       a->strategies = split(v);
@@ -189,6 +201,7 @@ int main(int argc, char** argv) {
   ro.out_dir = args.out;
   ro.max_frames = args.frames;
   ro.diagnose = args.diagnose;
+  ro.front_end.depth_edge_radius_px = args.depth_edge_radius_px;
   std::vector<vo::SequenceReport> reports;
   const auto t0 = std::chrono::steady_clock::now();
 
