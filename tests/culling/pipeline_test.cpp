@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -74,14 +75,16 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
   EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.9);
   EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2);  // 003 Figure 8: still legs kept
-  EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.8);         // medium level, verified by geometry
+  // Medium level, verified by geometry. Measured 0.68: a chair is mostly edges, and flags within 8 px of
+  // a depth edge are not evidence in this preset (0.84-0.91 without; EpipolarFlagsAtDepthEdgesAreNotEvidence).
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.6);
   EXPECT_LT(dynamic_rate(s, r, SceneKind::Tv), 0.05);           // low level, overlapping the person box
   EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.03);
   std::vector<std::uint8_t> predicted(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) predicted[i] = r.labels[i] == FeatureLabel::Dynamic;
   const auto p = test::precision_recall(predicted, s.truth_dynamic, s.size());
   EXPECT_GT(p.precision, 0.9);
-  EXPECT_GT(p.recall, 0.9);
+  EXPECT_GT(p.recall, 0.85);  // measured 0.894 (the chair above)
   EXPECT_EQ(r.num_static + r.num_dynamic, s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     EXPECT_EQ(r.keep[i], r.labels[i] == FeatureLabel::Static);
@@ -103,7 +106,7 @@ TYPED_TEST(PipelineTest, CandidatesAreCulledOnTheirOwnEvidenceOnly) {
   PipelineState<T> state;
   const auto& r = run(s, dets, o, &state, config);
   ASSERT_TRUE(r.subbox.ran()) << r.subbox.reason;
-  EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.8);
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.6);  // measured 0.68, see above
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] != SceneKind::Chair || r.labels[i] != FeatureLabel::Dynamic) continue;
     if (r.reasons[i] == CullReason::SubBox) {
@@ -334,6 +337,41 @@ TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
     if (kind[i] != 1) continue;
     EXPECT_EQ(on_state.object_box_bits[i], 2u) << "chair feature " << i << " keeps only the chair's mask bit";
   }
+}
+
+// edge_evidence_radius_px: epipolar flags of features near a depth step stop counting as evidence
+// (their moving-consistency label becomes Candidate), and only those; movers are still culled through
+// their boxes' sub-box votes.
+TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.edge_evidence_radius_px = 0;
+  PipelineState<T> off_state;
+  run(s, dets, o, &off_state, config);
+  const std::vector<FeatureLabel> off_geo = off_state.moving.labels;
+  o.edge_evidence_radius_px = 8;
+  PipelineState<T> on_state;
+  const auto& on = run(s, dets, o, &on_state, config);
+  ASSERT_TRUE(on.moving_consistency.ran()) << on.moving_consistency.reason;
+  const DepthView<float> depth = s.depth_view();
+  std::size_t discounted = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (off_geo[i] == on_state.moving.labels[i]) continue;
+    ++discounted;
+    EXPECT_EQ(off_geo[i], FeatureLabel::Dynamic) << i;
+    EXPECT_EQ(on_state.moving.labels[i], FeatureLabel::Candidate) << i;
+    const int u = static_cast<int>(std::lround(double(s.keypoints[i].x())));
+    const int v = static_cast<int>(std::lround(double(s.keypoints[i].y())));
+    EXPECT_TRUE(detail::near_depth_edge(depth, u, v, 8, 0.05)) << i;
+  }
+  EXPECT_GT(discounted, 0u) << "premise: some flagged features lie on depth edges (silhouettes)";
+  EXPECT_EQ(on_state.moving.num_dynamic, off_state.moving.num_dynamic);  // the stage's own count is untouched
+  EXPECT_EQ(on.moving_consistency.num_dynamic + discounted, off_state.result.moving_consistency.num_dynamic);
+  EXPECT_GT(dynamic_rate(s, on, SceneKind::WalkingPerson), 0.95);
+  EXPECT_LT(dynamic_rate(s, on, SceneKind::Room), 0.03);
 }
 
 TYPED_TEST(PipelineTest, StateBuffersAreReusedAcrossFrames) {

@@ -46,6 +46,7 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_FALSE(o.use_multiview);
   EXPECT_TRUE(o.moving.fit_outside_boxes);
   EXPECT_FLOAT_EQ(o.moving.max_epipolar_distance_in_boxes_px, 1.0f);  // tracks against the keyframe
+  EXPECT_EQ(o.edge_evidence_radius_px, 8);
   EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
   EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
   EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);

@@ -96,6 +96,12 @@ struct PipelineOptions {
   /// feature in a person's box but only in a chair's mask. false: the box rule's label (highest level
   /// of the rectangles holding it) stands.
   bool assign_overlaps_by_depth = false;
+  /// An epipolar flag of a feature with a depth step above edge_depth_step_ratio within this many
+  /// pixels (sampled every 2 px) is not evidence (its moving-consistency label becomes Candidate): an LK
+  /// window straddling an occlusion edge follows the contour, not a 3-D point, and is flagged although
+  /// its surface is static. 0 = off. Needs the depth image.
+  int edge_evidence_radius_px = 0;
+  double edge_depth_step_ratio = 0.05;
 
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
@@ -198,6 +204,28 @@ bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u,
   *u = static_cast<int>(std::lround(x));
   *v = static_cast<int>(std::lround(y));
   return *u >= 0 && *v >= 0 && *u < w && *v < h;
+}
+
+/// PipelineOptions::edge_evidence_radius_px: a depth step above `ratio` of the centre depth (or a pixel
+/// without depth) within `radius` of (u, v), sampled every 2 px beyond radius 2. A centre without depth
+/// is not an edge (nothing to compare with).
+template <class Raw>
+bool near_depth_edge(const DepthView<Raw>& depth, int u, int v, int radius, double ratio) {
+  const float z = depth.depth_m(u, v);
+  if (!(z > 0.f)) return false;
+  const int step = radius > 2 ? 2 : 1;
+  const float tol = static_cast<float>(ratio) * z;
+  for (int dy = -radius; dy <= radius; dy += step) {
+    const int y = v + dy;
+    if (y < 0 || y >= depth.height) continue;
+    for (int dx = -radius; dx <= radius; dx += step) {
+      const int x = u + dx;
+      if (x < 0 || x >= depth.width) continue;
+      const float zz = depth.depth_m(x, y);
+      if (!(zz > 0.f) || std::abs(zz - z) > tol) return true;
+    }
+  }
+  return false;
 }
 
 /// PipelineOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
@@ -399,6 +427,20 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
     }
   }
   const bool geo_ok = r.moving_consistency.ran();
+  if (geo_ok && options.edge_evidence_radius_px > 0 && !frame.depth.empty()) {
+    std::size_t discounted = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      int u = 0, v = 0;
+      if (s.moving.labels[i] != FeatureLabel::Dynamic ||
+          !detail::keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
+        continue;
+      if (detail::near_depth_edge(frame.depth, u, v, options.edge_evidence_radius_px, options.edge_depth_step_ratio)) {
+        s.moving.labels[i] = FeatureLabel::Candidate;
+        ++discounted;
+      }
+    }
+    r.moving_consistency.num_dynamic -= std::min(r.moving_consistency.num_dynamic, discounted);
+  }
 
   // 5. Dynamic probability for features in object masks (000 Algorithm 1).
   if (options.use_probability) {

@@ -98,7 +98,8 @@ PipelineOptions<T> zhang_2023() {
 
 /// Recommended: the box rule with the low-level override (002/004), limited to the object's depth band
 /// (000), each feature in overlapping masks given to the object nearest its depth, verified per region
-/// by the epipolar check fitted outside boxes (003 + SG-SLAM) and the evidence-aware sub-box vote (keeps
+/// by the epipolar check fitted outside boxes (003 + SG-SLAM; flags within 8 px of a depth edge are not
+/// evidence) and the evidence-aware sub-box vote (keeps
 /// a seated person's still legs), medium-level objects culled only when their own features are flagged,
 /// each box's sub-boxes voted by and acting on its own depth-mask object only, a tracker for missed
 /// boxes, and the survivor guard.
@@ -123,6 +124,7 @@ PipelineOptions<T> recommended() {
   o.moving.fit_outside_boxes = true;
   o.moving.max_epipolar_distance_in_boxes_px = T(1);
   o.assign_overlaps_by_depth = true;
+  o.edge_evidence_radius_px = 8;  // flags on occlusion edges are contour tracking, not motion
   o.use_subbox = true;
   o.subbox.object_mask_votes_only = true;
   o.subbox_verifies_candidates = false;
