@@ -36,10 +36,11 @@ struct FrontEndOptions {
   /// ... within this radius (sampled every 2 px beyond 2; 1 = the 3x3 neighbourhood). A corner whose LK
   /// window straddles an occlusion edge tracks the contour (a T-junction), not a 3-D point, and the
   /// epipolar check flags it although its surface is static. Measured on the sim (dynamic_vo --seeds
-  /// 1,2,3, recommended preset, xyz / rpy / halfsphere): label precision 0.68 / 0.92 / 0.66 at 1, 0.79 /
-  /// 0.95 / 0.73 at 6, 0.85 / 0.97 / 0.80 at 8, 0.93 / 0.98 / 0.85 at 10, recall 0.71-0.81 throughout; but
-  /// with fewer corners the VO itself gets weaker (no-culling and oracle ATE up on static and rpy, see
-  /// docs/results.md), so the default stays 1 and dynamic_vo --depth-edge-radius sets it.
+  /// 1,2,3, the recommended preset of commit d189c7e, xyz / rpy / halfsphere): label precision 0.68 /
+  /// 0.92 / 0.66 at 1, 0.79 / 0.95 / 0.73 at 6, 0.85 / 0.97 / 0.80 at 8, 0.93 / 0.98 / 0.85 at 10, recall
+  /// 0.71-0.81 throughout; but with fewer corners the VO itself gets weaker (no-culling and oracle ATE
+  /// up on static and rpy, docs/results.md), so the default stays 1, and the preset now discounts flags
+  /// on depth edges instead (PipelineOptions::edge_evidence_radius_px).
   int depth_edge_radius_px = 1;
   int lk_window_px = 21;              ///< LK window and pyramid depth (PRIOR_ART: 21 px, 3-5 levels)
   int lk_levels = 3;

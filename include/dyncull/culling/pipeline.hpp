@@ -427,6 +427,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
     }
   }
   const bool geo_ok = r.moving_consistency.ran();
+  // Flags on depth edges stop counting (edge_evidence_radius_px); s.moving keeps its own num_dynamic.
   if (geo_ok && options.edge_evidence_radius_px > 0 && !frame.depth.empty()) {
     std::size_t discounted = 0;
     for (std::size_t i = 0; i < n; ++i) {

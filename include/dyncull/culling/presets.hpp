@@ -99,10 +99,9 @@ PipelineOptions<T> zhang_2023() {
 /// Recommended: the box rule with the low-level override (002/004), limited to the object's depth band
 /// (000), each feature in overlapping masks given to the object nearest its depth, verified per region
 /// by the epipolar check fitted outside boxes (003 + SG-SLAM; flags within 8 px of a depth edge are not
-/// evidence) and the evidence-aware sub-box vote (keeps
-/// a seated person's still legs), medium-level objects culled only when their own features are flagged,
-/// each box's sub-boxes voted by and acting on its own depth-mask object only, a tracker for missed
-/// boxes, and the survivor guard.
+/// evidence) and the evidence-aware sub-box vote (keeps a seated person's still legs), medium-level
+/// objects culled only when their own features are flagged, each box's sub-boxes voted by and acting on
+/// its own depth-mask object only, a tracker for missed boxes, and the survivor guard.
 /// Tracks: give as prev_keypoints the features' positions in a reference frame a few frames back (the
 /// front end's keyframe), not the previous frame: slow movers (a seated person) build up a measurable
 /// epipolar distance only over several frames, hence the 1 px in-box threshold (0.5 px suits
