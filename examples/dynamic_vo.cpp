@@ -71,6 +71,18 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
+/// Integer option value in [lo, hi]; otherwise prints why and returns false.
+bool parse_int(const std::string& option, const std::string& v, long lo, long hi, int* out) {
+  char* end = nullptr;
+  const long n = std::strtol(v.c_str(), &end, 10);
+  if (end == v.c_str() || *end != '\0' || n < lo || n > hi) {
+    std::fprintf(stderr, "dynamic_vo: %s needs an integer in [%ld, %ld], got '%s'\n", option.c_str(), lo, hi, v.c_str());
+    return false;
+  }
+  *out = static_cast<int>(n);
+  return true;
+}
+
 bool parse_args(int argc, char** argv, Args* a) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -87,14 +99,7 @@ bool parse_args(int argc, char** argv, Args* a) {
       usage(argv[0]);
       std::exit(0);
     } else if (arg == "--frames") {
-      if (!value(&v)) return false;
-      char* end = nullptr;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (end == v.c_str() || *end != '\0' || n < 2 || n > 100000) {
-        std::fprintf(stderr, "dynamic_vo: --frames needs an integer in [2, 100000], got '%s'\n", v.c_str());
-        return false;
-      }
-      a->frames = static_cast<int>(n);
+      if (!value(&v) || !parse_int(arg, v, 2, 100000, &a->frames)) return false;
       a->frames_set = true;
     } else if (arg == "--sequences") {
       if (!value(&v)) return false;
@@ -116,14 +121,7 @@ bool parse_args(int argc, char** argv, Args* a) {
         return false;
       }
     } else if (arg == "--depth-edge-radius") {
-      if (!value(&v)) return false;
-      char* end = nullptr;
-      const long r = std::strtol(v.c_str(), &end, 10);
-      if (end == v.c_str() || *end != '\0' || r < 1 || r > 32) {
-        std::fprintf(stderr, "dynamic_vo: --depth-edge-radius needs an integer in [1, 32], got '%s'\n", v.c_str());
-        return false;
-      }
-      a->depth_edge_radius_px = static_cast<int>(r);
+      if (!value(&v) || !parse_int(arg, v, 1, 32, &a->depth_edge_radius_px)) return false;
     } else if (arg == "--strategies") {
       if (!value(&v)) return false;
       a->strategies = split(v);
