@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/depth.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/geometry/pnp.hpp"
@@ -245,25 +246,18 @@ class FrontEnd {
   const FrontEndOptions& options() const { return options_; }
 
  private:
-  /// Metric depth at a corner, or 0 when missing, out of range or on a depth edge.
+  /// Metric depth at a corner, or 0 when missing, out of range or near a depth edge.
   float usable_depth(float u, float v) const {
     const int x = static_cast<int>(std::lround(u)), y = static_cast<int>(std::lround(v));
     const cv::Mat& d = frame_.depth_m;
     const int r = std::max(1, options_.depth_edge_radius_px);
-    const int step = r > 2 ? 2 : 1;
     if (x < r || y < r || x >= d.cols - r || y >= d.rows - r) return 0.f;
     const float z = d.at<float>(y, x);
     if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) return 0.f;
     // Points on an occlusion edge back-project half on the object, half on the background, and their
     // LK window follows the contour (see depth_edge_radius_px).
-    for (int dy = -r; dy <= r; dy += step) {
-      const float* row = d.ptr<float>(y + dy);
-      for (int dx = -r; dx <= r; dx += step) {
-        const float zz = row[x + dx];
-        if (!(zz > 0.f) || std::abs(zz - z) > options_.max_depth_step_ratio * z) return 0.f;
-      }
-    }
-    return z;
+    const DepthView<float> view{d.ptr<float>(), d.cols, d.rows, static_cast<std::ptrdiff_t>(d.step1()), 1.f, 0.f, 1e30f};
+    return depth_step_near(view, x, y, r, options_.max_depth_step_ratio) ? 0.f : z;
   }
 
   /// Removes tracks whose 3-D point does not reproject near them: LK tracks dragged along by an

@@ -365,7 +365,7 @@ TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
     EXPECT_EQ(on_state.moving.labels[i], FeatureLabel::Candidate) << i;
     const int u = static_cast<int>(std::lround(double(s.keypoints[i].x())));
     const int v = static_cast<int>(std::lround(double(s.keypoints[i].y())));
-    EXPECT_TRUE(detail::near_depth_edge(depth, u, v, 8, 0.05)) << i;
+    EXPECT_TRUE(depth_step_near(depth, u, v, 8, 0.05)) << i;
   }
   EXPECT_GT(discounted, 0u) << "premise: some flagged features lie on depth edges (silhouettes)";
   EXPECT_EQ(on_state.moving.num_dynamic, off_state.moving.num_dynamic);  // the stage's own count is untouched

@@ -44,6 +44,29 @@ struct DepthView {
   double to_raw(double metres) const { return metres * static_cast<double>(units_per_metre); }
 };
 
+/// True when a pixel within `radius` of (u, v) (sampled every 2 px beyond radius 2; pixels outside the
+/// image are not looked at) has no depth or differs from the depth at (u, v) by more than `ratio` of it:
+/// (u, v) lies near an occlusion edge or a hole. A centre without depth is not near an edge (nothing to
+/// compare with). Used to distrust features whose tracking window straddles an edge.
+template <class Raw>
+bool depth_step_near(const DepthView<Raw>& depth, int u, int v, int radius, double ratio) {
+  const float z = depth.depth_m(u, v);
+  if (!(z > 0.f)) return false;
+  const int step = radius > 2 ? 2 : 1;
+  const float tol = static_cast<float>(ratio) * z;
+  for (int dy = -radius; dy <= radius; dy += step) {
+    const int y = v + dy;
+    if (y < 0 || y >= depth.height) continue;
+    for (int dx = -radius; dx <= radius; dx += step) {
+      const int x = u + dx;
+      if (x < 0 || x >= depth.width) continue;
+      const float zz = depth.depth_m(x, y);
+      if (!(zz > 0.f) || std::abs(zz - z) > tol) return true;
+    }
+  }
+  return false;
+}
+
 /// TUM convention: uint16, 5000 units per metre, 0 = no measurement.
 inline DepthView<std::uint16_t> tum_depth_view(const std::uint16_t* data, int width, int height,
                                                float min_m = 0.f, float max_m = 1e30f) {

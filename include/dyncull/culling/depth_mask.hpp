@@ -320,6 +320,20 @@ bool band_contains(const DepthView<Raw>& v, const RawRange<Raw>& range, const De
   return x >= band.lo && x < band.hi;
 }
 
+/// Exclusive upper threshold of a box's band in raw units (pixels nearer than it are in).
+template <class Raw>
+void set_band_threshold(const RawRange<Raw>& range, double thr_raw, double upm, DepthMaskOutcome outcome,
+                        DepthMaskBoxInfo* info, DepthBand* band) {
+  const bool integral = std::is_integral<Raw>::value;
+  info->outcome = outcome;
+  info->threshold_raw = thr_raw;
+  info->threshold_m = thr_raw / upm;
+  band->none = false;
+  band->hi = std::min(thr_raw, range.hi + (integral ? 1.0 : 0.0));
+  if (!integral && thr_raw > range.hi) band->hi = std::nextafter(range.hi, std::numeric_limits<double>::max());
+  if (integral) band->hi = std::ceil(band->hi);
+}
+
 /// Threshold and band of one box (no raster). Returns the info; `band` receives the predicate.
 template <class Raw, class T>
 DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>& box,
@@ -369,13 +383,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
   band->lo = range.lo;
 
   auto set_threshold = [&](double thr_raw, DepthMaskOutcome outcome) {
-    info.outcome = outcome;
-    info.threshold_raw = thr_raw;
-    info.threshold_m = thr_raw / upm;
-    band->none = false;
-    band->hi = std::min(thr_raw, range.hi + (integral ? 1.0 : 0.0));
-    if (!integral && thr_raw > range.hi) band->hi = std::nextafter(range.hi, std::numeric_limits<double>::max());
-    if (integral) band->hi = std::ceil(band->hi);
+    set_band_threshold(range, thr_raw, upm, outcome, &info, band);
   };
   auto whole_box = [&]() {
     info.outcome = DepthMaskOutcome::WholeBox;
@@ -525,16 +533,10 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
     const bool integral = std::is_integral<Raw>::value;
     const double thr = integral ? std::round((dc + o.eps_m) * upm) : (dc + o.eps_m) * upm;
     b->d_c_m = dc;
-    b->outcome = DepthMaskOutcome::RuleApplied;
     b->rule_applies = true;
-    b->threshold_raw = thr;
-    b->threshold_m = thr / upm;
     b->reason = "centre occluded by a nearer box: d_c from the box's pixels outside it";
-    band->none = false;
+    set_band_threshold(range, thr, upm, DepthMaskOutcome::RuleApplied, b, band);
     band->all = false;
-    band->hi = std::min(thr, range.hi + (integral ? 1.0 : 0.0));
-    if (!integral && thr > range.hi) band->hi = std::nextafter(range.hi, std::numeric_limits<double>::max());
-    if (integral) band->hi = std::ceil(band->hi);
     b->masks_missing = band->missing;
     return true;
   }

@@ -206,28 +206,6 @@ bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u,
   return *u >= 0 && *v >= 0 && *u < w && *v < h;
 }
 
-/// PipelineOptions::edge_evidence_radius_px: a depth step above `ratio` of the centre depth (or a pixel
-/// without depth) within `radius` of (u, v), sampled every 2 px beyond radius 2. A centre without depth
-/// is not an edge (nothing to compare with).
-template <class Raw>
-bool near_depth_edge(const DepthView<Raw>& depth, int u, int v, int radius, double ratio) {
-  const float z = depth.depth_m(u, v);
-  if (!(z > 0.f)) return false;
-  const int step = radius > 2 ? 2 : 1;
-  const float tol = static_cast<float>(ratio) * z;
-  for (int dy = -radius; dy <= radius; dy += step) {
-    const int y = v + dy;
-    if (y < 0 || y >= depth.height) continue;
-    for (int dx = -radius; dx <= radius; dx += step) {
-      const int x = u + dx;
-      if (x < 0 || x >= depth.width) continue;
-      const float zz = depth.depth_m(x, y);
-      if (!(zz > 0.f) || std::abs(zz - z) > tol) return true;
-    }
-  }
-  return false;
-}
-
 /// PipelineOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
 /// masks hold them, keeps one mask bit (the box with d_c nearest the feature's depth; ties and missing
 /// depth: the highest level, then the first box) and sets the semantic label from that box's level.
@@ -435,7 +413,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       if (s.moving.labels[i] != FeatureLabel::Dynamic ||
           !detail::keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
         continue;
-      if (detail::near_depth_edge(frame.depth, u, v, options.edge_evidence_radius_px, options.edge_depth_step_ratio)) {
+      if (depth_step_near(frame.depth, u, v, options.edge_evidence_radius_px, options.edge_depth_step_ratio)) {
         s.moving.labels[i] = FeatureLabel::Candidate;
         ++discounted;
       }
