@@ -56,6 +56,9 @@ struct CullingScene {
   std::vector<Vec2<T>> keypoints;       ///< current-frame positions (noisy)
   std::vector<Vec2<T>> prev_keypoints;  ///< previous-frame positions (noisy); see track_valid
   std::vector<std::uint8_t> track_valid;
+  /// Exact 3-D point (world) of each track's surface at the previous frame, as the previous frame's depth
+  /// would measure it (NaN where the track is invalid): the reprojection check's points_3d.
+  std::vector<Vec3<T>> prev_points_world;
   std::vector<T> depth_m;               ///< current depth of each feature (metres)
   std::vector<std::uint8_t> truth_dynamic;  ///< 1 when the surface moves in the world
   std::vector<SceneKind> kind;
@@ -277,6 +280,7 @@ CullingScene<T> make_culling_scene(const SceneConfig& config = {}) {
     s.keypoints.push_back(Vec2<T>(T(u + n * rng.normal()), T(v + n * rng.normal())));
     s.prev_keypoints.push_back(Vec2<T>(T(prev.x() + n * rng.normal()), T(prev.y() + n * rng.normal())));
     s.track_valid.push_back(valid ? 1 : 0);
+    s.prev_points_world.push_back(valid ? Vec3<T>(X_prev.cast<T>()) : Vec3<T>::Constant(std::numeric_limits<T>::quiet_NaN()));
     s.depth_m.push_back(T(d));
     s.truth_dynamic.push_back(vel.squaredNorm() > 0 ? 1 : 0);
     s.kind.push_back(world.kind_of(part));
