@@ -93,6 +93,82 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   }
 }
 
+// With each track's 3-D point given, the recommended preset's geometric evidence is the reprojection
+// residual (the epipolar labels are replaced where a point exists). Without points, or with points of the
+// wrong size, the stage says why and the epipolar labels stand, exactly as without the option.
+TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAreGiven) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  CullingFrame<T, std::vector<Vec2<T>>> frame;
+  frame.keypoints = &s.keypoints;
+  frame.prev_keypoints = &s.prev_keypoints;
+  frame.track_valid = s.track_valid.data();
+  frame.detections = &dets;
+  frame.depth = s.depth_view();
+  frame.camera = s.camera;
+  frame.cam_from_world = &s.cam_from_world;
+
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.use_reprojection = true;  // on in the preset itself (presets_test)
+  frame.points_3d = &s.prev_points_world;
+  PipelineState<T> state;
+  const PipelineResult<T> r = cull_frame(frame, o, &state);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_TRUE(r.reprojection.ran()) << r.reprojection.reason;
+  EXPECT_TRUE(r.moving_consistency.ran());
+  EXPECT_TRUE(r.subbox.ran()) << r.subbox.reason;
+  EXPECT_GT(r.reprojection.num_dynamic, 0u);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (state.reprojection.labels[i] == FeatureLabel::Candidate) continue;
+    // Replace: the geometric label is the reprojection one, unless the depth-edge rule demoted a flag.
+    const FeatureLabel g = state.moving.labels[i];
+    EXPECT_TRUE(g == state.reprojection.labels[i] ||
+                (g == FeatureLabel::Candidate && state.reprojection.labels[i] == FeatureLabel::Dynamic))
+        << i;
+  }
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.9);
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2);
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.6);
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::Tv), 0.05);
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.03);
+
+  // Either: a track is geometric-dynamic when either check flags it, so never fewer flags than Replace.
+  PipelineOptions<T> either = o;
+  either.reprojection_evidence = PipelineOptions<T>::Evidence::Either;
+  PipelineState<T> state_either;
+  const PipelineResult<T> re = cull_frame(frame, either, &state_either);
+  ASSERT_TRUE(re.reprojection.ran());
+  std::size_t flags_replace = 0, flags_either = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    flags_replace += state.moving.labels[i] == FeatureLabel::Dynamic;
+    flags_either += state_either.moving.labels[i] == FeatureLabel::Dynamic;
+  }
+  EXPECT_GE(flags_either, flags_replace);
+
+  // No points, then points of the wrong size: a reason each, and the labels of the epipolar-only preset.
+  PipelineOptions<T> epipolar_only = o;
+  epipolar_only.use_reprojection = false;
+  PipelineState<T> state_epi;
+  frame.points_3d = nullptr;
+  const std::vector<FeatureLabel> epi_labels = cull_frame(frame, epipolar_only, &state_epi).labels;
+  PipelineState<T> state_none;
+  const PipelineResult<T>& rn = cull_frame(frame, o, &state_none);
+  EXPECT_TRUE(rn.reprojection.enabled);
+  EXPECT_FALSE(rn.reprojection.ran());
+  EXPECT_NE(rn.reprojection.reason.find("points_3d"), std::string::npos) << rn.reprojection.reason;
+  EXPECT_EQ(rn.labels, epi_labels);
+  const std::vector<Vec3<T>> too_few(s.prev_points_world.begin(), s.prev_points_world.begin() + 5);
+  frame.points_3d = &too_few;
+  PipelineState<T> state_bad;
+  const PipelineResult<T>& rb = cull_frame(frame, o, &state_bad);
+  EXPECT_EQ(rb.reprojection.status, Status::InvalidInput);
+  EXPECT_FALSE(rb.reprojection.reason.empty());
+  EXPECT_EQ(rb.labels, epi_labels);
+}
+
 // Recommended: a medium-level candidate is culled only on its own geometric evidence (flagged itself in a
 // dynamic sub-box, or by the multi-view check), never by its sub-box's vote alone; the pushed chair,
 // whose features are flagged, is still culled.

@@ -18,6 +18,7 @@
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/motion_levels.hpp"
 #include "dyncull/culling/moving_consistency.hpp"
+#include "dyncull/culling/reprojection_check.hpp"
 #include "dyncull/culling/multiview_check.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 
@@ -58,6 +59,9 @@ struct PipelineOptions {
   bool use_depth_mask = false;        ///< 000 eq. 1-2: box culls limited to the object's depth band
   bool use_probability = false;       ///< 000 eq. 3-5 for features in object masks (needs tracks)
   bool use_moving_consistency = true; ///< 003 eq. 1-3 (needs tracks)
+  /// RGB-D reprojection check (reprojection_check.hpp; needs CullingFrame::points_3d): its labels join
+  /// the epipolar ones as the geometric evidence (see reprojection_evidence).
+  bool use_reprojection = false;
   bool use_subbox = true;             ///< 003 Algorithm 1 (needs the moving-consistency labels)
   bool use_multiview = false;         ///< 001 §III.A (needs the current pose and a keyframe)
 
@@ -70,6 +74,11 @@ struct PipelineOptions {
   /// Flow model of the probability's M term: Fundamental reuses the moving-consistency F when it ran.
   FlowModel probability_flow_model = FlowModel::Fundamental;
   MovingConsistencyOptions<T> moving{};
+  ReprojectionCheckOptions<T> reprojection{};
+  /// How the reprojection labels combine with the epipolar ones when both ran: Replace (the residual
+  /// sees the motion along the epipolar line too, so it alone decides) or Either (dynamic when either
+  /// check flags the track, static when one says static and the other does not flag it).
+  enum class Evidence { Replace, Either } reprojection_evidence = Evidence::Replace;
   SubBoxOptions<T> subbox{};
   MultiViewOptions<T> multiview{};
   std::size_t max_reference_keyframes = 2;  ///< keyframes checked per frame (DynaSLAM: 5)
@@ -131,7 +140,8 @@ struct PipelineResult {
   std::vector<CullReason> reasons;   ///< deciding strategy (None for untouched statics)
   std::vector<std::uint8_t> keep;    ///< 1 = static: apply to every parallel per-keypoint array
   std::size_t num_features = 0, num_static = 0, num_dynamic = 0;
-  StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, subbox, multiview;
+  StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, reprojection, subbox,
+      multiview;
   GuardAction guard = GuardAction::None;
   std::size_t guard_restored = 0;   ///< features the guard turned back to static
 };
@@ -157,6 +167,7 @@ struct PipelineState {
   std::vector<Vec2<T>> prob_prev;
   std::vector<T> keypoint_depth;
   MovingConsistencyResult<T> moving;
+  ReprojectionCheckResult<T> reprojection;
   SubBoxResult<T> subbox;
   MultiViewResult<T> multiview;
   Mask multiview_mask;
@@ -178,12 +189,16 @@ struct PipelineState {
 /// One frame as the front end has it. Keypoints: the caller's container (cv::KeyPoint, Eigen, ...);
 /// prev_keypoints: previous-frame positions parallel to keypoints (any point container), with
 /// track_valid (nullptr = all valid); nothing is copied out of them except into scratch buffers.
-template <class T, class Keypoints, class Prev = Keypoints, class Raw = float>
+/// points_3d: optional 3-D point of each track in one fixed frame (the map point, or the reference
+/// keyframe's back-projection in world or keyframe coordinates), parallel to keypoints, non-finite where
+/// there is none; used by the reprojection check.
+template <class T, class Keypoints, class Prev = Keypoints, class Raw = float, class Points3 = std::vector<Vec3<T>>>
 struct CullingFrame {
   const Keypoints* keypoints = nullptr;
   const Prev* prev_keypoints = nullptr;
   const std::uint8_t* track_valid = nullptr;
   const std::vector<std::int64_t>* track_ids = nullptr;  ///< for the probability's K term (optional)
+  const Points3* points_3d = nullptr;                     ///< for the reprojection check (optional)
   const std::vector<Detection<T>>* detections = nullptr;  ///< pixel boxes after NMS
   DepthView<Raw> depth{};
   PinholeCamera<T> camera{};
@@ -257,8 +272,8 @@ void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, 
 /// Runs the enabled strategies on one frame and returns the labels (a reference into `state`, valid
 /// until the next call). Never throws; bad or missing inputs skip the stages that need them, with a
 /// reason in the stage report.
-template <class T, class Keypoints, class Prev, class Raw>
-const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>& frame,
+template <class T, class Keypoints, class Prev, class Raw, class Points3>
+const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, Points3>& frame,
                                     const PipelineOptions<T>& options, PipelineState<T>* state) {
   static_assert(is_point_container_v<Keypoints>, "dyncull::cull_frame: keypoints must hold points (see PointTraits)");
   static_assert(is_point_container_v<Prev>, "dyncull::cull_frame: prev_keypoints must hold points");
@@ -270,7 +285,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
   r.guard = GuardAction::None;
   r.guard_restored = 0;
   for (StageReport* st : {&r.detections, &r.tracker, &r.box_rule, &r.depth_mask, &r.probability,
-                          &r.moving_consistency, &r.subbox, &r.multiview}) {
+                          &r.moving_consistency, &r.reprojection, &r.subbox, &r.multiview}) {
     st->status = Status::Skipped;
     st->reason.clear();
     st->num_dynamic = 0;
@@ -281,6 +296,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
   r.depth_mask.enabled = options.use_depth_mask;
   r.probability.enabled = options.use_probability;
   r.moving_consistency.enabled = options.use_moving_consistency;
+  r.reprojection.enabled = options.use_reprojection;
   r.subbox.enabled = options.use_subbox;
   r.multiview.enabled = options.use_multiview;
 
@@ -404,7 +420,35 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       r.moving_consistency.num_dynamic = s.moving.num_dynamic;
     }
   }
-  const bool geo_ok = r.moving_consistency.ran();
+  // 4b. Reprojection check (RGB-D): merged into s.moving.labels, the geometric evidence of the later stages.
+  if (options.use_reprojection) {
+    if (!frame.points_3d) {
+      r.reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
+    } else {
+      check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &s.reprojection, frame.track_valid,
+                         have_boxes ? s.in_dyn_box.data() : nullptr);
+      r.reprojection.status = s.reprojection.status;
+      r.reprojection.reason = s.reprojection.reason;
+      r.reprojection.num_dynamic = s.reprojection.num_dynamic;
+    }
+    if (r.reprojection.ran()) {
+      if (!r.moving_consistency.ran()) {
+        s.moving.labels = s.reprojection.labels;
+        s.moving.fitted_outside_boxes = s.reprojection.fitted_outside_boxes;
+      } else {
+        for (std::size_t i = 0; i < n; ++i) {
+          const FeatureLabel rl = s.reprojection.labels[i];
+          FeatureLabel& gl = s.moving.labels[i];
+          if (options.reprojection_evidence == PipelineOptions<T>::Evidence::Replace) {
+            if (rl != FeatureLabel::Candidate) gl = rl;
+          } else if (rl == FeatureLabel::Dynamic || gl == FeatureLabel::Candidate) {
+            gl = rl == FeatureLabel::Candidate ? gl : rl;
+          }
+        }
+      }
+    }
+  }
+  const bool geo_ok = r.moving_consistency.ran() || r.reprojection.ran();
   // Flags on depth edges stop counting (edge_evidence_radius_px); s.moving keeps its own num_dynamic.
   if (geo_ok && options.edge_evidence_radius_px > 0 && !frame.depth.empty()) {
     std::size_t discounted = 0;
@@ -436,7 +480,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
           s.prob_levels[i] = options.levels.level(s.boxes[static_cast<std::size_t>((*rule_box_index)[i])].class_id);
       }
       EgoMotion<T> ego;
-      if (options.probability_flow_model == FlowModel::Fundamental && geo_ok) {
+      if (options.probability_flow_model == FlowModel::Fundamental && r.moving_consistency.ran()) {
         ego.model = FlowModel::Fundamental;
         ego.matrix = s.moving.F;
       }
@@ -462,7 +506,8 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw>&
       r.subbox.reason = "needs the moving-consistency labels, which are unavailable this frame";
     } else if (!have_boxes) {
       r.subbox.reason = "no dynamic-class boxes";
-    } else if (options.subbox_requires_fit_outside_boxes && !s.moving.fitted_outside_boxes &&
+    } else if (options.subbox_requires_fit_outside_boxes &&
+               !(r.moving_consistency.ran() ? s.moving.fitted_outside_boxes : s.reprojection.fitted_outside_boxes) &&
                std::any_of(s.in_dyn_box.begin(), s.in_dyn_box.end(), [](std::uint8_t f) { return f != 0; })) {
       r.subbox.reason = "F was fitted through the dynamic-class boxes (too few tracks outside them): "
                         "its epipolar evidence inside the boxes is not trusted";
