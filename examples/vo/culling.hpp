@@ -28,8 +28,10 @@ struct StrategySpec {
   bool needs_detections = false;  ///< cannot run without detector boxes
   bool recommended = false;       ///< the library's recommended default preset
   bool oracle = false;            ///< culls by the sim's per-pixel truth: the bound no culling can beat
-  /// Epipolar evidence between the keyframe and the current frame (Tracks::kf_px) instead of the previous
-  /// frame: what the recommended preset expects (presets.hpp). The papers' presets use the previous frame.
+  /// Evidence against the keyframe: the epipolar check between its positions (Tracks::kf_px) and the
+  /// current frame instead of the previous frame, and the reprojection check of the points measured in
+  /// its depth (Tracks::kf_world). What the recommended preset expects (presets.hpp); the papers' presets
+  /// use the previous frame and no 3-D points.
   bool tracks_from_keyframe = false;
   PipelineOptions<float> pipeline{};
 };
@@ -84,9 +86,10 @@ class Culler {
     }
     ids_.assign(tracks.ids.begin(), tracks.ids.end());
     pose_ = predicted_world_from_cam.inverse().cast<float>();
-    CullingFrame<float, std::vector<cv::Point2f>, std::vector<cv::Point2f>, float> f;
+    CullingFrame<float, std::vector<cv::Point2f>, std::vector<cv::Point2f>, float, std::vector<Vec3<double>>> f;
     f.keypoints = &tracks.cur_px;
     f.prev_keypoints = spec_.tracks_from_keyframe ? &tracks.kf_px : &tracks.prev_px;
+    if (spec_.tracks_from_keyframe) f.points_3d = &tracks.kf_world;
     f.track_ids = &ids_;
     f.detections = &frame.detections;
     f.depth = cv_adapter::depth_view_f32(frame.depth_m, 0.4f, 8.f);

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,10 @@ struct Tracks {
   std::vector<cv::Point2f> cur_px;         ///< position in the current frame
   std::vector<cv::Point2f> kf_px;          ///< position in the current keyframe's image
   std::vector<Vec3<double>> world;         ///< 3-D point from its keyframe's depth, world frame
+  /// 3-D point from the current keyframe's depth at kf_px, world frame (NaN without depth there). Unlike
+  /// `world`, which a PnP inlier keeps from the keyframe that created it, this is re-measured at every
+  /// keyframe, so a chair that moved and stopped is consistent again from the next keyframe on.
+  std::vector<Vec3<double>> kf_world;
   std::vector<std::uint8_t> pnp_inlier;    ///< set by estimate()
 
   std::size_t size() const { return ids.size(); }
@@ -100,6 +105,7 @@ struct Tracks {
       cur_px[n] = cur_px[i];
       kf_px[n] = kf_px[i];
       world[n] = world[i];
+      kf_world[n] = kf_world[i];
       pnp_inlier[n] = pnp_inlier[i];
       ++n;
     }
@@ -108,6 +114,7 @@ struct Tracks {
     cur_px.resize(n);
     kf_px.resize(n);
     world.resize(n);
+    kf_world.resize(n);
     pnp_inlier.resize(n);
   }
   void clear() {
@@ -116,6 +123,7 @@ struct Tracks {
     cur_px.clear();
     kf_px.clear();
     world.clear();
+    kf_world.clear();
     pnp_inlier.clear();
   }
 };
@@ -289,6 +297,13 @@ class FrontEnd {
     if (budget > 0) detect_new(budget);
     tracks_.prev_px = tracks_.cur_px;
     tracks_.kf_px = tracks_.cur_px;
+    tracks_.kf_world.resize(tracks_.size());
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      const float z = usable_depth(tracks_.cur_px[i].x, tracks_.cur_px[i].y);
+      tracks_.kf_world[i] = z > 0.f ? world_from_cam_.apply(camera_.backproject(
+                                          Vec2<double>(tracks_.cur_px[i].x, tracks_.cur_px[i].y), static_cast<double>(z)))
+                                    : Vec3<double>::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
     frame_.gray.copyTo(kf_gray_);
     tracks_.pnp_inlier.assign(tracks_.size(), 0);
     keyframe_size_ = static_cast<double>(tracks_.size());

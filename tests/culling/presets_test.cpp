@@ -47,6 +47,11 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_TRUE(o.moving.fit_outside_boxes);
   EXPECT_FLOAT_EQ(o.moving.max_epipolar_distance_in_boxes_px, 1.0f);  // tracks against the keyframe
   EXPECT_EQ(o.edge_evidence_radius_px, 8);
+  // RGB-D evidence when the frame carries 3-D points: the reprojection residual replaces the epipolar one.
+  EXPECT_TRUE(o.use_reprojection);
+  EXPECT_EQ(o.reprojection_evidence, PipelineOptions<float>::Evidence::Replace);
+  EXPECT_FLOAT_EQ(o.reprojection.max_residual_in_boxes_px, 1.5f);
+  EXPECT_FLOAT_EQ(o.reprojection.uncertainty_sigmas, 0.f);
   EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
   EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
   EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);
@@ -60,6 +65,12 @@ TEST(Presets, DefaultsOfTheGeometricOptions) {
   EXPECT_DOUBLE_EQ(m.fundamental.ransac.confidence, 0.99);
   EXPECT_FALSE(m.fundamental.check_homography_degeneracy);
   EXPECT_EQ(m.min_tracks_outside_boxes, 20u);
+  const ReprojectionCheckOptions<double> p;
+  EXPECT_DOUBLE_EQ(p.max_residual_px, 3.0);
+  EXPECT_DOUBLE_EQ(p.pnp.ransac.max_residual, 2.0);
+  EXPECT_TRUE(p.fit_outside_boxes);
+  EXPECT_EQ(p.min_tracks_outside_boxes, 20u);
+  EXPECT_FALSE(presets::none<double>().use_reprojection);
   const SubBoxOptions<double> s;
   EXPECT_EQ(s.grid, 3);
   EXPECT_DOUBLE_EQ(s.sigma1, 0.5);

@@ -34,7 +34,7 @@ struct ReprojectionCheckOptions {
   /// Threshold inside dynamic-class boxes. Measured on the dynamic_vo sim at the front end's own pose: 2 px
   /// is exceeded by 4-7 % of the tracks on still chairs and a seated person's legs, against 77 % of the
   /// walkers' and 40 % of the swaying upper body's; 1.5 px (the default) trades a little of the first for
-  /// more of the second (docs/results.md).
+  /// more of the second (docs/algorithms.md).
   T max_residual_in_boxes_px = T(1.5);
   /// Fit the pose only on tracks outside dynamic boxes when at least min_tracks_outside_boxes remain.
   bool fit_outside_boxes = true;
@@ -44,8 +44,8 @@ struct ReprojectionCheckOptions {
   /// inliers, sigma their RMS residual, at least min_noise_px). When the tracks outside the boxes are few
   /// or all on one far wall, the pose is loose and a still object near the camera reprojects pixels
   /// away: its threshold grows instead of it being culled. Off by default: on the dynamic_vo sim, 1 sigma
-  /// kept a seated person's legs in such frames but lost 0.06-0.09 of the recall, mostly on walkers that
-  /// fill the view, which is when the pose is loosest (3 sigma: recall 0.29; docs/results.md).
+  /// kept a seated person's legs in such frames but lost 0.07-0.11 of the recall, mostly on walkers that
+  /// fill the view, which is when the pose is loosest (3 sigma: recall 0.29; docs/algorithms.md).
   T uncertainty_sigmas = T(0);
   T min_noise_px = T(0.5);
   std::size_t min_tracks = 15;  ///< fewer usable tracks: Skipped
