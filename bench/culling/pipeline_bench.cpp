@@ -40,7 +40,8 @@ const Data& data() {
   return d;
 }
 
-void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options) {
+/// with_points: each track's 3-D point at the previous frame (the recommended preset's RGB-D input).
+void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options, bool with_points = false) {
   const Data& d = data();
   PipelineState<float> st;
   st.keyframes.push(d.keyframe.cam_from_world, d.keyframe.keypoints, d.keyframe.depth_m);
@@ -52,6 +53,7 @@ void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options
   frame.depth = d.scene.depth_view();
   frame.camera = d.scene.camera;
   frame.cam_from_world = &d.scene.cam_from_world;
+  if (with_points) frame.points_3d = &d.scene.prev_points_world;
   std::size_t dyn = 0;
   for (auto _ : state) {
     const auto& r = cull_frame(frame, options, &st);
@@ -69,10 +71,17 @@ void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options
   state.counters["recall"] = pr.recall;
   state.counters["multiview_ran"] = r.multiview.ran();
   state.counters["subbox_ran"] = r.subbox.ran();
+  state.counters["reprojection_ran"] = r.reprojection.ran();
 }
 
 void BM_Pipeline_Recommended(benchmark::State& state) { run_pipeline(state, presets::recommended<float>()); }
 BENCHMARK(BM_Pipeline_Recommended)->Unit(benchmark::kMicrosecond);
+
+// The same preset given 3-D points: the reprojection check replaces the epipolar labels (both run).
+void BM_Pipeline_RecommendedWithPoints(benchmark::State& state) {
+  run_pipeline(state, presets::recommended<float>(), true);
+}
+BENCHMARK(BM_Pipeline_RecommendedWithPoints)->Unit(benchmark::kMicrosecond);
 
 // The multi-view check (left out of the recommended preset since session 5) verifying the candidates.
 void BM_Pipeline_RecommendedPlusMultiView(benchmark::State& state) {
