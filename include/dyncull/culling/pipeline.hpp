@@ -434,7 +434,6 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     if (r.reprojection.ran()) {
       if (!r.moving_consistency.ran()) {
         s.moving.labels = s.reprojection.labels;
-        s.moving.fitted_outside_boxes = s.reprojection.fitted_outside_boxes;
       } else {
         for (std::size_t i = 0; i < n; ++i) {
           const FeatureLabel rl = s.reprojection.labels[i];
@@ -449,6 +448,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     }
   }
   const bool geo_ok = r.moving_consistency.ran() || r.reprojection.ran();
+  // Every check whose labels are in the evidence fitted its model outside the dynamic-class boxes.
+  const bool geo_fit_outside_boxes = (!r.moving_consistency.ran() || s.moving.fitted_outside_boxes) &&
+                                     (!r.reprojection.ran() || s.reprojection.fitted_outside_boxes);
   // Flags on depth edges stop counting (edge_evidence_radius_px); s.moving keeps its own num_dynamic.
   if (geo_ok && options.edge_evidence_radius_px > 0 && !frame.depth.empty()) {
     std::size_t discounted = 0;
@@ -503,14 +505,13 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   // 6. Sub-box refinement of the dynamic-class boxes with the geometric labels.
   if (options.use_subbox) {
     if (!geo_ok) {
-      r.subbox.reason = "needs the moving-consistency labels, which are unavailable this frame";
+      r.subbox.reason = "needs geometric labels (moving consistency or reprojection), unavailable this frame";
     } else if (!have_boxes) {
       r.subbox.reason = "no dynamic-class boxes";
-    } else if (options.subbox_requires_fit_outside_boxes &&
-               !(r.moving_consistency.ran() ? s.moving.fitted_outside_boxes : s.reprojection.fitted_outside_boxes) &&
+    } else if (options.subbox_requires_fit_outside_boxes && !geo_fit_outside_boxes &&
                std::any_of(s.in_dyn_box.begin(), s.in_dyn_box.end(), [](std::uint8_t f) { return f != 0; })) {
-      r.subbox.reason = "F was fitted through the dynamic-class boxes (too few tracks outside them): "
-                        "its epipolar evidence inside the boxes is not trusted";
+      r.subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
+                        "its evidence inside the boxes is not trusted";
     } else {
       const bool masks = options.use_depth_mask && r.depth_mask.ran();
       refine_subboxes(kp, s.moving.labels.data(), s.dyn_boxes, options.subbox, &s.subbox,
