@@ -40,12 +40,9 @@ std::vector<Detection<T>> detections_of(const test::CullingScene<T>& s) {
   return out;
 }
 
-/// Runs one preset on the scene (keyframe 8 frames back stored for the multi-view check).
+/// The scene's frame as a front end would pass it (no 3-D points).
 template <class T>
-const PipelineResult<T>& run(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets,
-                             const PipelineOptions<T>& options, PipelineState<T>* state, const SceneConfig& config) {
-  const auto kf = test::make_scene_keyframe<T>(config, 8, 1500);
-  state->keyframes.push(kf.cam_from_world, kf.keypoints, kf.depth_m);
+CullingFrame<T, std::vector<Vec2<T>>> frame_of(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets) {
   CullingFrame<T, std::vector<Vec2<T>>> frame;
   frame.keypoints = &s.keypoints;
   frame.prev_keypoints = &s.prev_keypoints;
@@ -54,7 +51,16 @@ const PipelineResult<T>& run(const test::CullingScene<T>& s, const std::vector<D
   frame.depth = s.depth_view();
   frame.camera = s.camera;
   frame.cam_from_world = &s.cam_from_world;
-  return cull_frame(frame, options, state);
+  return frame;
+}
+
+/// Runs one preset on the scene (keyframe 8 frames back stored for the multi-view check).
+template <class T>
+const PipelineResult<T>& run(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets,
+                             const PipelineOptions<T>& options, PipelineState<T>* state, const SceneConfig& config) {
+  const auto kf = test::make_scene_keyframe<T>(config, 8, 1500);
+  state->keyframes.push(kf.cam_from_world, kf.keypoints, kf.depth_m);
+  return cull_frame(frame_of(s, dets), options, state);
 }
 
 // Thresholds below are the measured rates with a margin of about 5 points (float and double agree).
@@ -101,14 +107,7 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   SceneConfig config;
   const auto s = test::make_culling_scene<T>(config);
   const auto dets = detections_of(s);
-  CullingFrame<T, std::vector<Vec2<T>>> frame;
-  frame.keypoints = &s.keypoints;
-  frame.prev_keypoints = &s.prev_keypoints;
-  frame.track_valid = s.track_valid.data();
-  frame.detections = &dets;
-  frame.depth = s.depth_view();
-  frame.camera = s.camera;
-  frame.cam_from_world = &s.cam_from_world;
+  auto frame = frame_of(s, dets);
 
   PipelineOptions<T> o = presets::recommended<T>();
   o.use_reprojection = true;  // on in the preset itself (presets_test)
