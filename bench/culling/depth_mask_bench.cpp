@@ -1,5 +1,7 @@
 // Depth mask over a 200x300 box of a 640x480 uint16 depth image: one memory pass is the target.
 // Floor: memcpy of the box rows; peer: cv::inRange on the ROI (what an OpenCV port would write).
+// MissingDepth::Nearest (the default) adds two exact distance transforms over the box; its peer is the
+// same rule with cv::distanceTransform (DIST_L2, DIST_MASK_PRECISE) twice.
 #include "dyncull/culling/depth_mask.hpp"
 #include "dyncull/core/random.hpp"
 
@@ -10,6 +12,7 @@
 
 #ifdef DYNCULL_HAS_OPENCV
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #endif
 
 namespace {
@@ -37,11 +40,13 @@ std::vector<std::uint16_t> make_depth(bool corners_valid) {
   return d;
 }
 
-void run(benchmark::State& state, DepthMaskMode mode, bool corners_valid) {
+void run(benchmark::State& state, DepthMaskMode mode, bool corners_valid,
+         MissingDepth missing = MissingDepth::Nearest) {
   const std::vector<std::uint16_t> depth = make_depth(corners_valid);
   Mask mask(W, H);
   DepthMaskOptions o;
   o.mode = mode;
+  o.missing_depth = missing;
   std::size_t pixels = 0;
   for (auto _ : state) {
     const DepthMaskBoxInfo info = depth_mask_box(tum_depth_view(depth.data(), W, H), kBox, o, mask.view());
@@ -53,9 +58,13 @@ void run(benchmark::State& state, DepthMaskMode mode, bool corners_valid) {
 }
 void BM_DepthMask_Plain(benchmark::State& s) { run(s, DepthMaskMode::Plain, true); }
 void BM_DepthMask_Robust(benchmark::State& s) { run(s, DepthMaskMode::Robust, true); }
+void BM_DepthMask_RobustMissingInMask(benchmark::State& s) {
+  run(s, DepthMaskMode::Robust, true, MissingDepth::InMask);
+}
 void BM_DepthMask_RobustHistogramFallback(benchmark::State& s) { run(s, DepthMaskMode::Robust, false); }
 BENCHMARK(BM_DepthMask_Plain)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_DepthMask_Robust)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DepthMask_RobustMissingInMask)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_DepthMask_RobustHistogramFallback)->Unit(benchmark::kMicrosecond);
 
 void BM_DepthMask_MemcpyFloor(benchmark::State& state) {
@@ -93,5 +102,33 @@ void BM_DepthMask_OpenCVInRange(benchmark::State& state) {
   state.SetBytesProcessed(std::int64_t(state.iterations()) * 300 * 200 * 2);
 }
 BENCHMARK(BM_DepthMask_OpenCVInRange)->Unit(benchmark::kMicrosecond);
+
+// The Nearest rule written with OpenCV: the band with inRange, then the distance to the nearest in-band
+// and to the nearest measured out-of-band pixel (exact L2 transforms), and the comparison.
+void BM_DepthMask_OpenCVNearestFill(benchmark::State& state) {
+  std::vector<std::uint16_t> depth = make_depth(true);
+  const cv::Mat d(H, W, CV_16UC1, depth.data());
+  const cv::Rect roi(200, 100, 300, 200);
+  DepthMaskOptions o;
+  const DepthMaskBoxInfo info = depth_mask_box(tum_depth_view(depth.data(), W, H), kBox, o);
+  const double hi = info.threshold_raw - 1;
+  cv::Mat in_band, out_band, missing, dist_in, dist_out, mask;
+  int pixels = 0;
+  for (auto _ : state) {
+    const cv::Mat box = d(roi);
+    cv::inRange(box, cv::Scalar(1), cv::Scalar(hi), in_band);
+    cv::compare(box, cv::Scalar(hi), out_band, cv::CMP_GT);
+    cv::compare(box, cv::Scalar(0), missing, cv::CMP_EQ);
+    cv::distanceTransform(~in_band, dist_in, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    cv::distanceTransform(~out_band, dist_out, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    cv::compare(dist_in, dist_out, mask, cv::CMP_LE);
+    mask = in_band | (mask & missing);
+    benchmark::DoNotOptimize(mask.data);
+    pixels = cv::countNonZero(mask);
+  }
+  state.counters["mask_px"] = pixels;
+  state.SetBytesProcessed(std::int64_t(state.iterations()) * 300 * 200 * 2);
+}
+BENCHMARK(BM_DepthMask_OpenCVNearestFill)->Unit(benchmark::kMicrosecond);
 #endif
 }  // namespace

@@ -123,26 +123,34 @@ TEST_F(RealFrame, WholeBoxReferenceFigures) {
   }
 }
 
+// The robust default (pixels without depth decided by their nearest measured pixel) beats the whole box on
+// both people and the plain rule on the sitting one. Masking every pixel without depth (InMask, the default
+// before) fell short of the whole box on the standing person: 26.8k of its box pixels have no depth, 9.8k
+// of them background (the border band, the ceiling); it is printed alongside.
 TEST_F(RealFrame, RobustMaskBeatsWholeBoxAndPlainRule) {
-  const DepthMaskOptions o;  // defaults: robust, Seed000 form, eps 0.3 m
+  const Box<double> boxes[2] = {sitting_, standing_};
+  const char* names[2] = {"sitting person: ", "standing person:"};
+  const double whole_box_iou[2] = {0.5280939476061427, 0.8292415169660678};
+  for (int k = 0; k < 2; ++k) {
+    Counts nearest;
+    for (const MissingDepth policy : {MissingDepth::Nearest, MissingDepth::InMask}) {
+      DepthMaskOptions o;  // defaults: robust, Seed000 form, eps 0.3 m, MissingDepth::Nearest
+      o.missing_depth = policy;
+      Mask mask;
+      const DepthMaskBoxInfo info = run(boxes[k], o, &mask);
+      ASSERT_TRUE(info.ok()) << info.reason;
+      const Counts c = score(mask, boxes[k]);
+      std::printf("[ robust ] %s %s outcome=%s d_c=%.3f d_max=%.3f thr=%.3f  IoU %.4f (P %.3f R %.3f); whole box %.4f\n",
+                  names[k], policy == MissingDepth::Nearest ? "missing=nearest" : "missing=in mask",
+                  to_string(info.outcome), info.d_c_m, info.d_max_m, info.threshold_m, c.iou(), c.precision(),
+                  c.recall(), whole_box_iou[k]);
+      if (policy == MissingDepth::Nearest) nearest = c;
+    }
+    EXPECT_GT(nearest.iou(), whole_box_iou[k]) << names[k];
+  }
   Mask mask;
-  const DepthMaskBoxInfo sit = run(sitting_, o, &mask);
-  ASSERT_TRUE(sit.ok()) << sit.reason;
-  const Counts cs = score(mask, sitting_);
-  std::printf("[ robust ] sitting person:  outcome=%s d_c=%.3f d_max=%.3f thr=%.3f  IoU %.4f (P %.3f R %.3f); "
-              "whole box 0.5281, plain rule 0.6437\n",
-              to_string(sit.outcome), sit.d_c_m, sit.d_max_m, sit.threshold_m, cs.iou(), cs.precision(), cs.recall());
-  EXPECT_GT(cs.iou(), 0.6437436419125128) << "robust mask should beat the plain rule on the sitting person";
-
-  const DepthMaskBoxInfo st = run(standing_, o, &mask);
-  ASSERT_TRUE(st.ok()) << st.reason;
-  const Counts cst = score(mask, standing_);
-  std::printf("[ robust ] standing person: outcome=%s d_c=%.3f d_max=%.3f thr=%.3f  IoU %.4f (P %.3f R %.3f); "
-              "whole box 0.8292, plain rule not applicable\n",
-              to_string(st.outcome), st.d_c_m, st.d_max_m, st.threshold_m, cst.iou(), cst.precision(), cst.recall());
-  // A sensible mask: most of the person, far background removed.
-  EXPECT_GT(cst.recall(), 0.85);
-  EXPECT_GT(cst.precision(), 0.83);
+  run(sitting_, DepthMaskOptions{}, &mask);
+  EXPECT_GT(score(mask, sitting_).iou(), 0.6437436419125128) << "robust mask should beat the plain rule (sitting)";
 }
 
 // The two-sided band on the real frame (near_margin_m), figures printed for both people. What it shows

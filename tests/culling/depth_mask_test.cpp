@@ -304,13 +304,14 @@ TYPED_TEST(DepthMask, HolesAtCentreAndCornersAreBridgedByTheRobustMode) {
   const DepthMaskBoxInfo plain = depth_mask_box(s.view(), box, o);
   EXPECT_FALSE(plain.rule_applies);  // centre pixel has no depth
   o.mode = DepthMaskMode::Robust;
+  o.missing_depth = MissingDepth::InMask;
   Mask m(W, H);
   const DepthMaskBoxInfo robust = depth_mask_box(s.view(), box, o, m.view());
   EXPECT_TRUE(robust.rule_applies);
   EXPECT_NEAR(robust.d_c_m, 1.5, 1e-6);
   EXPECT_NEAR(robust.d_max_m, 4.0, 1e-6);
   EXPECT_TRUE(robust.masks_missing);
-  // Person pixels all masked; wall pixels with depth never; missing pixels masked (documented).
+  // Person pixels all masked; wall pixels with depth never; missing pixels masked (InMask).
   const PixelRect r = pixel_rect(box, W, H);
   for (int v = r.r0; v < r.r1; ++v)
     for (int u = r.c0; u < r.c1; ++u) {
@@ -321,11 +322,115 @@ TYPED_TEST(DepthMask, HolesAtCentreAndCornersAreBridgedByTheRobustMode) {
         EXPECT_EQ(m.test(u, v), s.truth[v * W + u] != 0) << u << "," << v;
       }
     }
-  o.mask_missing_depth = false;
+  o.missing_depth = MissingDepth::OutOfMask;
   m.reset(W, H);
-  depth_mask_box(s.view(), box, o, m.view());
+  EXPECT_FALSE(depth_mask_box(s.view(), box, o, m.view()).masks_missing);
   EXPECT_FALSE(m.test(139, 59));
   EXPECT_TRUE(m.test(139, 70));
+  // Nearest (default): the hole on the person is the person's; the border bands are the wall's, also
+  // beside the person's widest row (x = 154), where the wall column x = 155 is nearer.
+  o.missing_depth = MissingDepth::Nearest;
+  m.reset(W, H);
+  const DepthMaskBoxInfo nearest = depth_mask_box(s.view(), box, o, m.view());
+  EXPECT_FALSE(nearest.masks_missing);
+  EXPECT_TRUE(m.test(139, 59));
+  EXPECT_FALSE(m.test(130, 1));
+  EXPECT_FALSE(m.test(W - 2, 10));
+  EXPECT_FALSE(m.test(W - 4, 59));
+}
+
+// MissingDepth::Nearest: a pixel without depth is in the mask when its nearest pixel with depth (exact
+// Euclidean distance, within the box) is in the band; ties go to the mask. The raster (two exact distance
+// transforms) and the point labels (ring search) must both equal a brute-force evaluation of that rule,
+// on random scenes of people with holes of every size.
+TYPED_TEST(DepthMask, MissingDepthTakesTheNearestMeasuredPixelsDecision) {
+  using Raw = TypeParam;
+  std::uint64_t state = 12345;
+  auto next = [&](int n) {  // xorshift, uniform in [0, n)
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return static_cast<int>(state % static_cast<std::uint64_t>(n));
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    Scene<Raw> s;
+    s.fill(4.0);
+    s.person(40 + next(80), 30 + next(60), 8 + next(20), 15 + next(30), 1.5);
+    for (int k = 0, holes = 5 + next(30); k < holes; ++k) {
+      const int u0 = next(W), v0 = next(H), size = next(k < 3 ? 25 : 4);
+      s.hole(u0, v0, std::min(W - 1, u0 + size), std::min(H - 1, v0 + size));
+    }
+    // Every other scene also gets a wide hole (a border band, a window): rows with long runs without
+    // depth take the raster's parabola envelopes instead of the row scan.
+    if (trial % 2 == 1) s.hole(next(W / 2), next(H / 2), W - 1, next(H / 2) + H / 3);
+    const Box<double> box{double(next(40)), double(next(30)), double(100 + next(60)), double(80 + next(40))};
+    DepthMaskOptions o;  // robust, Nearest
+    Mask m(W, H);
+    std::vector<Vec2<double>> pts;
+    for (int v = 0; v < H; ++v)
+      for (int u = 0; u < W; ++u) pts.emplace_back(u, v);
+    const DepthMaskResult r = depth_mask(s.view(), std::vector<Box<double>>{box}, pts, o, m.view());
+    ASSERT_TRUE(r.ok()) << r.reason;
+    const DepthMaskOutcome outcome = r.boxes[0].outcome;
+    ASSERT_TRUE(outcome == DepthMaskOutcome::RuleApplied || outcome == DepthMaskOutcome::HistogramFallback)
+        << "trial " << trial << ": " << to_string(outcome);
+    const double thr = r.boxes[0].threshold_raw;
+    const PixelRect rc = pixel_rect(box, W, H);
+    auto depth_raw = [&](int u, int v) { return double(s.depth[v * W + u]); };
+    std::size_t holes_in = 0, holes_out = 0;
+    for (int v = 0; v < H; ++v)
+      for (int u = 0; u < W; ++u) {
+        bool expected = false;
+        if (u >= rc.c0 && u < rc.c1 && v >= rc.r0 && v < rc.r1) {
+          if (s.depth[v * W + u] != Raw(0)) {
+            expected = depth_raw(u, v) < thr;
+          } else {
+            long best_in = -1, best_out = -1;
+            for (int y = rc.r0; y < rc.r1; ++y)
+              for (int x = rc.c0; x < rc.c1; ++x) {
+                if (s.depth[y * W + x] == Raw(0)) continue;
+                const long d2 = long(x - u) * (x - u) + long(y - v) * (y - v);
+                long& best = depth_raw(x, y) < thr ? best_in : best_out;
+                if (best < 0 || d2 < best) best = d2;
+              }
+            expected = best_in >= 0 && (best_out < 0 || best_in <= best_out);
+            (expected ? holes_in : holes_out) += 1;
+          }
+        }
+        ASSERT_EQ(m.test(u, v), expected) << "raster, trial " << trial << " at " << u << "," << v;
+        ASSERT_EQ(r.labels[std::size_t(v * W + u)] == FeatureLabel::Dynamic, expected)
+            << "label, trial " << trial << " at " << u << "," << v;
+      }
+    EXPECT_EQ(r.num_mask_pixels, m.count());
+    if (trial == 0) {
+      EXPECT_GT(holes_in, 0u);
+      EXPECT_GT(holes_out, 0u);
+    }
+  }
+}
+
+// Kinect shadows: the pixels without depth on the background side of a silhouette belong to the wall,
+// those on the person side to the person, and a feature there is labelled accordingly.
+TYPED_TEST(DepthMask, HolesBesideASilhouetteGoWithTheSurfaceTheyLieOn) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(80, 60, 20, 40, 1.5);
+  // An 8 px hole across the left outline at rows 50-70: columns 54-59 are wall (the outline is at x = 60
+  // on row 60), 60-61 person. Nearest measured pixels on row 60: the wall at x = 53, the person at x = 62.
+  s.hole(54, 50, 61, 70);
+  const std::vector<Box<double>> boxes = {{50, 15, 110, 105}};
+  const std::vector<Vec2<float>> pts = {{55.f, 60.f}, {61.f, 60.f}, {57.f, 60.f}};
+  for (MissingDepth policy : {MissingDepth::Nearest, MissingDepth::InMask, MissingDepth::OutOfMask}) {
+    DepthMaskOptions o;
+    o.missing_depth = policy;
+    const DepthMaskResult r = depth_mask(s.view(), boxes, pts, o);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    const bool nearest = policy == MissingDepth::Nearest, in = policy == MissingDepth::InMask;
+    EXPECT_EQ(r.labels[0] == FeatureLabel::Dynamic, in) << "wall side, far from the person";
+    EXPECT_EQ(r.labels[1] == FeatureLabel::Dynamic, in || nearest) << "person side";
+    EXPECT_EQ(r.labels[2] == FeatureLabel::Dynamic, in) << "wall side, 4 px from the wall, 5 px from the person";
+  }
 }
 
 TYPED_TEST(DepthMask, BoxWithoutDepthAndBoxesOutsideTheImage) {

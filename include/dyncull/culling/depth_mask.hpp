@@ -37,8 +37,15 @@ namespace dyncull {
 
 /// Plain: 000 eq. 1-2 on single pixels (corner and integer centre pixels, raw units, strict
 /// inequalities); when the rule does not apply the mask is empty and features in the box are
-/// Candidates. Robust: patch estimates, missing-depth pixels masked, histogram fallback.
+/// Candidates. Robust: patch estimates, missing-depth pixels decided by their nearest measured pixel
+/// (MissingDepth), histogram fallback.
 enum class DepthMaskMode : std::uint8_t { Plain = 0, Robust = 1 };
+
+/// What a box pixel without a depth measurement is (robust mode; the plain rule never masks one).
+/// Nearest: the decision of the nearest box pixel with depth (exact Euclidean distance; when pixels in
+/// and out of the band are equally near, in). A Kinect hole takes the side of the surface around it, so
+/// the border band and the shadows beside a person go with the wall they lie on, not with the person.
+enum class MissingDepth : std::uint8_t { Nearest = 0, InMask = 1, OutOfMask = 2 };
 
 /// Seed000: threshold d_c + eps iff d_max - d_c > eps. DynamicVins (HITSZ-NRSL/Dynamic-VINS
 /// setSemanticMask): both valid: midpoint (d_c + d_max)/2 if d_max - d_c > eps, else d_c + eps;
@@ -80,9 +87,11 @@ struct DepthMaskOptions {
   /// most this many steps (< 0: half the box's shorter side). Covers the band without depth
   /// along the image border.
   int corner_search_px = -1;
-  /// Mask box pixels without a depth measurement too: inside a dynamic object's box an unknown
-  /// pixel cannot be trusted, and Kinect holes cluster at object boundaries.
-  bool mask_missing_depth = true;
+  /// Box pixels without a depth measurement. Nearest (default): on the real TUM frame the standing
+  /// person's box holds 26.8k such pixels, 9.8k of them background (border band, ceiling); masking all
+  /// of them (InMask, the choice before) gave IoU 0.800 against the whole box's 0.829, Nearest gives
+  /// 0.864 (sitting person 0.657 -> 0.658). InMask suits a caller who never wants an unknown pixel kept.
+  MissingDepth missing_depth = MissingDepth::Nearest;
   /// Histogram fallback (rule not applicable): bins of this width from 0 to histogram_max_m,
   /// over every histogram_stride_px-th row and column. 0 (default) = auto: the smallest stride that
   /// samples at most histogram_target_samples pixels (it is a statistic; a 300 x 200 box uses every
@@ -126,7 +135,7 @@ struct DepthMaskBoxInfo {
   bool rule_applies = false;
   double d_max_m = 0, d_c_m = 0, threshold_m = 0;
   double threshold_raw = 0;   ///< exclusive threshold in the view's raw units (TUM: 13085 for 2.617 m)
-  bool masks_missing = false; ///< pixels without depth are part of this box's mask
+  bool masks_missing = false; ///< every pixel without depth is in this box's mask (InMask or whole box)
   std::size_t num_mask_pixels = 0;  ///< counted only when a raster was written
   std::size_t num_valid_pixels = 0; ///< sampled pixels with depth (histogram fallback only)
 };
@@ -149,10 +158,10 @@ struct DepthMaskResult {
 namespace detail {
 
 /// Pixel predicate of one box in raw units: in = lo <= d < hi (valid range already folded in);
-/// missing pixels are in when `missing`; `all` masks the whole rect.
+/// missing pixels follow `missing`; `all` masks the whole rect.
 struct DepthBand {
   double lo = 1, hi = 0;
-  bool missing = false;
+  MissingDepth missing = MissingDepth::OutOfMask;
   bool all = false;
   bool none = true;
 };
@@ -222,10 +231,11 @@ double walk_inwards(const DepthView<Raw>& v, const RawRange<Raw>& range, int u, 
   return 0;
 }
 
-/// One pass over the rect: OR mask_value where the band holds; returns the number of set pixels.
+/// One pass over the rect: OR `value` where the band holds, with missing pixels in when `missing_in`;
+/// returns the number of set pixels.
 template <class Raw>
-std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rect,
-                           const DepthBand& band, std::uint8_t value, MaskView out) {
+std::size_t rasterise_pass(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rect,
+                           const DepthBand& band, bool missing_in, std::uint8_t value, MaskView out) {
   std::size_t count = 0;
   const int c0 = rect.c0, c1 = rect.c1, r0 = rect.r0, r1 = rect.r1;
   if (band.all || band.none) {
@@ -242,7 +252,7 @@ std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, 
     const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));
     const auto vlo = static_cast<std::uint16_t>(range.lo);
     const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);
-    const std::uint8_t miss_value = band.missing ? value : std::uint8_t(0);
+    const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
     for (int y = r0; y < r1; ++y) {
       const std::uint16_t* d = v.row(y);
       std::uint8_t* o = out.row(y);
@@ -257,7 +267,7 @@ std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, 
         const __m128i vlo8 = _mm_set1_epi16(static_cast<short>(vlo));
         const __m128i vspan8 = _mm_set1_epi16(static_cast<short>(vspan));
         const __m128i zero = _mm_setzero_si128();
-        const __m128i miss_on = band.missing ? _mm_set1_epi16(-1) : zero;
+        const __m128i miss_on = missing_in ? _mm_set1_epi16(-1) : zero;
         const __m128i val = _mm_set1_epi8(static_cast<char>(value));
         // Set lanes are -1: subtracting them counts per 16-bit lane (no popcnt in baseline x86-64).
         __m128i counts = zero;
@@ -285,14 +295,14 @@ std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, 
         const bool miss = static_cast<std::uint16_t>(d[x] - vlo) > vspan;
         const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (miss ? miss_value : 0));
         o[x] = static_cast<std::uint8_t>(o[x] | m);
-        row_count += (in || (miss && band.missing)) ? 1u : 0u;
+        row_count += (in || (miss && missing_in)) ? 1u : 0u;
       }
       count += row_count;
     }
   } else {
     const Raw lo = static_cast<Raw>(band.lo), hi = static_cast<Raw>(band.hi);
     const Raw vlo = static_cast<Raw>(range.lo), vhi = static_cast<Raw>(range.hi);
-    const std::uint8_t miss_value = band.missing ? value : std::uint8_t(0);
+    const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
     for (int y = r0; y < r1; ++y) {
       const Raw* d = v.row(y);
       std::uint8_t* o = out.row(y);
@@ -310,14 +320,257 @@ std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, 
   return count;
 }
 
+/// A measured pixel's band test (the scalar form of rasterise_pass).
 template <class Raw>
-bool band_contains(const DepthView<Raw>& v, const RawRange<Raw>& range, const DepthBand& band, int u, int y) {
+bool measured_in_band(Raw d, const DepthBand& band) {
+  const double x = static_cast<double>(d);
+  return x >= band.lo && x < band.hi;
+}
+
+/// MissingDepth::Nearest at one pixel without depth: rings of growing Chebyshev radius r around it
+/// until r^2 exceeds the nearest squared distance found (no later ring can hold a nearer pixel). In
+/// when the nearest in-band pixel is at least as near as the nearest out-of-band one (also when the
+/// rect has no measured pixel: nothing contradicts the box). Cost grows with the hole's size only.
+template <class Raw>
+bool nearest_measured_in_band(const DepthView<Raw>& v, const RawRange<Raw>& range, const DepthBand& band,
+                              const PixelRect& rect, int u, int y) {
+  constexpr long long kNone = std::numeric_limits<long long>::max();
+  long long best_in = kNone, best_out = kNone;
+  const int reach = std::max(std::max(u - rect.c0, rect.c1 - 1 - u), std::max(y - rect.r0, rect.r1 - 1 - y));
+  auto visit = [&](int x, int yy) {
+    if (x < rect.c0 || x >= rect.c1 || yy < rect.r0 || yy >= rect.r1) return;
+    const Raw d = v.raw(x, yy);
+    if (!raw_valid(d, range)) return;
+    const long long dx = x - u, dy = yy - y, d2 = dx * dx + dy * dy;
+    long long& best = measured_in_band(d, band) ? best_in : best_out;
+    best = std::min(best, d2);
+  };
+  for (int r = 1; r <= reach; ++r) {
+    if (static_cast<long long>(r) * r > std::min(best_in, best_out)) break;
+    for (int x = u - r; x <= u + r; ++x) {
+      visit(x, y - r);
+      visit(x, y + r);
+    }
+    for (int yy = y - r + 1; yy <= y + r - 1; ++yy) {
+      visit(u - r, yy);
+      visit(u + r, yy);
+    }
+  }
+  return best_in <= best_out;
+}
+
+/// One row of a rect classified for MissingDepth::Nearest: 0 = no depth, 1 = in the band, 2 = measured
+/// outside it. Branch-free integer compares for uint16 (as rasterise_pass), the generic test otherwise.
+template <class Raw>
+void classify_row(const Raw* d, int w, const RawRange<Raw>& range, const DepthBand& band, std::uint8_t* cls) {
+  if constexpr (std::is_same<Raw, std::uint16_t>::value) {
+    const auto lo = static_cast<std::uint16_t>(band.lo);
+    const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));
+    const auto vlo = static_cast<std::uint16_t>(range.lo);
+    const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);
+    for (int x = 0; x < w; ++x) {
+      const bool valid = static_cast<std::uint16_t>(d[x] - vlo) <= vspan;
+      const bool in = static_cast<std::uint16_t>(d[x] - lo) < span;
+      cls[x] = static_cast<std::uint8_t>(valid ? (in ? 1 : 2) : 0);
+    }
+  } else {
+    for (int x = 0; x < w; ++x)
+      cls[x] = static_cast<std::uint8_t>(raw_valid(d[x], range) ? (measured_in_band(d[x], band) ? 1 : 2) : 0);
+  }
+}
+
+/// Lower envelope of the parabolas (x - q)^2 + f[q] over one row (the second pass of Felzenszwalb &
+/// Huttenlocher, "Distance transforms of sampled functions", 2012); f[q] >= kNoParabola means none.
+/// Breakpoints are exact fractions num / den (den > 0) in 64-bit integers.
+inline constexpr std::int32_t kNoParabola = std::int32_t(1) << 30;
+struct ParabolaEnvelope {
+  std::vector<int> vertex;
+  std::vector<long long> num, den;
+  int size = 0;
+
+  void build(const std::int32_t* f, int w) {
+    vertex.resize(static_cast<std::size_t>(w));
+    num.resize(static_cast<std::size_t>(w));
+    den.resize(static_cast<std::size_t>(w));
+    int k = -1;
+    for (int q = 0; q < w; ++q) {
+      if (f[q] >= kNoParabola) continue;
+      const long long fq = f[q] + static_cast<long long>(q) * q;
+      long long n = 0, d = 1;
+      while (k >= 0) {
+        const int p = vertex[static_cast<std::size_t>(k)];
+        n = fq - (f[p] + static_cast<long long>(p) * p);
+        d = 2LL * (q - p);
+        // p stays when the new breakpoint lies right of p's own left breakpoint (k = 0: -infinity).
+        if (k == 0 || n * den[static_cast<std::size_t>(k)] > num[static_cast<std::size_t>(k)] * d) break;
+        --k;
+      }
+      ++k;
+      vertex[static_cast<std::size_t>(k)] = q;
+      num[static_cast<std::size_t>(k)] = n;
+      den[static_cast<std::size_t>(k)] = d;
+    }
+    size = k + 1;
+  }
+  /// min over q of (x - q)^2 + f[q], kNoParabola without parabolas. Non-decreasing x per build; `j`
+  /// starts at 0.
+  long long at(const std::int32_t* f, int x, int* j) const {
+    if (size == 0) return kNoParabola;
+    while (*j + 1 < size && num[static_cast<std::size_t>(*j + 1)] <= static_cast<long long>(x) * den[static_cast<std::size_t>(*j + 1)])
+      ++*j;
+    const int q = vertex[static_cast<std::size_t>(*j)];
+    return static_cast<long long>(x - q) * (x - q) + f[q];
+  }
+};
+
+/// MissingDepth::Nearest over a rect, exactly the rule of nearest_measured_in_band at every pixel
+/// without depth. Two column sweeps give each pixel's distance along its column to the nearest in-band
+/// and out-of-band pixel (the first pass of the distance transform); then each pixel without depth scans
+/// its row outwards, min over columns q of (x - q)^2 + column distance^2, until (x - q)^2 exceeds the
+/// best found. A row whose holes are wide takes the exact parabola envelopes instead (linear in the
+/// row), whichever is cheaper by the holes' run lengths. ORs `value` into the pixels
+/// that are in and returns how many. Allocates O(rect area): the pipeline's point labels never call it.
+template <class Raw>
+std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rect,
+                                      const DepthBand& band, std::uint8_t value, MaskView out) {
+  const int w = rect.width(), h = rect.height();
+  const auto W = static_cast<std::size_t>(w);
+  const std::size_t n = W * static_cast<std::size_t>(h);
+  // Column distances in int16 (half the memory traffic; the sweeps vectorise at -O3); `none` is farther
+  // than any in-rect distance and means no such pixel in the column. Rects too large for int16 (over
+  // 32k pixels across) take the per-pixel search.
+  if (w + h + 1 > 32766) {
+    std::size_t count = 0;
+    for (int y = rect.r0; y < rect.r1; ++y)
+      for (int x = rect.c0; x < rect.c1; ++x)
+        if (!raw_valid(v.raw(x, y), range) && nearest_measured_in_band(v, range, band, rect, x, y)) {
+          out.row(y)[x] = static_cast<std::uint8_t>(out.row(y)[x] | value);
+          ++count;
+        }
+    return count;
+  }
+  const auto none = static_cast<std::int16_t>(w + h + 1);
+  std::vector<std::uint8_t> cls(n);
+  std::vector<std::uint8_t> row_has_hole(static_cast<std::size_t>(h), 0);
+  bool any_hole = false;
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* c = cls.data() + static_cast<std::size_t>(y) * W;
+    classify_row(v.row(rect.r0 + y) + rect.c0, w, range, band, c);
+    unsigned holes = 0;
+    for (int x = 0; x < w; ++x) holes += c[x] == 0;
+    row_has_hole[static_cast<std::size_t>(y)] = holes != 0;
+    any_hole |= holes != 0;
+  }
+  if (!any_hole) return 0;
+  std::vector<std::int16_t> col_in(n), col_out(n);
+  for (int y = 0; y < h; ++y) {  // nearest above (or at)
+    const std::uint8_t* c = cls.data() + static_cast<std::size_t>(y) * W;
+    std::int16_t* gi = col_in.data() + static_cast<std::size_t>(y) * W;
+    std::int16_t* go = col_out.data() + static_cast<std::size_t>(y) * W;
+    const std::int16_t* ui = y > 0 ? gi - W : nullptr;
+    const std::int16_t* uo = y > 0 ? go - W : nullptr;
+    for (int x = 0; x < w; ++x) {
+      const std::int16_t above_in = ui ? std::min<std::int16_t>(static_cast<std::int16_t>(ui[x] + 1), none) : none;
+      const std::int16_t above_out = uo ? std::min<std::int16_t>(static_cast<std::int16_t>(uo[x] + 1), none) : none;
+      gi[x] = c[x] == 1 ? std::int16_t(0) : above_in;
+      go[x] = c[x] == 2 ? std::int16_t(0) : above_out;
+    }
+  }
+  for (int y = h - 2; y >= 0; --y) {  // ... or below
+    std::int16_t* gi = col_in.data() + static_cast<std::size_t>(y) * W;
+    std::int16_t* go = col_out.data() + static_cast<std::size_t>(y) * W;
+    for (int x = 0; x < w; ++x) {
+      gi[x] = std::min<std::int16_t>(gi[x], static_cast<std::int16_t>(gi[x + w] + 1));
+      go[x] = std::min<std::int16_t>(go[x], static_cast<std::int16_t>(go[x + w] + 1));
+    }
+  }
+  // Per row with a hole: squared column distances, kNoParabola where the column has none (larger than
+  // any in-rect squared distance, (w + h)^2 < 2^30, so every sum below stays in int32 and needs no branch).
+  std::vector<std::int32_t> f_in(W), f_out(W);
+  ParabolaEnvelope env_in, env_out;
+  std::size_t count = 0;
+  for (int y = 0; y < h; ++y) {
+    if (!row_has_hole[static_cast<std::size_t>(y)]) continue;
+    const std::size_t i0 = static_cast<std::size_t>(y) * W;
+    const std::uint8_t* c = cls.data() + i0;
+    const std::int16_t* gi = col_in.data() + i0;
+    const std::int16_t* go = col_out.data() + i0;
+    std::int32_t* fi = f_in.data();
+    std::int32_t* fo = f_out.data();
+    for (int q = 0; q < w; ++q) {
+      fi[q] = gi[q] < none ? std::int32_t(gi[q]) * gi[q] : kNoParabola;
+      fo[q] = go[q] < none ? std::int32_t(go[q]) * go[q] : kNoParabola;
+    }
+    // Scanning a run of L pixels without depth visits about L^2 / 2 columns; the two envelopes cost about
+    // 6 visits per column of the row (measured on the real TUM frame): take the cheaper.
+    long long scan_cost = 0;
+    for (int x = 0, run = 0; x <= w; ++x) {
+      if (x < w && c[x] == 0) {
+        ++run;
+      } else {
+        scan_cost += static_cast<long long>(run) * run / 2;
+        run = 0;
+      }
+    }
+    const bool use_envelope = scan_cost > 6LL * w;
+    if (use_envelope) {
+      env_in.build(fi, w);
+      env_out.build(fo, w);
+    }
+    std::uint8_t* o = out.row(rect.r0 + y) + rect.c0;
+    int j_in = 0, j_out = 0;
+    for (int x = 0; x < w; ++x) {
+      if (c[x] != 0) continue;
+      std::int32_t best_in = fi[x], best_out = fo[x];
+      if (use_envelope) {
+        best_in = static_cast<std::int32_t>(std::min<long long>(env_in.at(fi, x, &j_in), kNoParabola));
+        best_out = static_cast<std::int32_t>(std::min<long long>(env_out.at(fo, x, &j_out), kNoParabola));
+      } else {
+        const int reach = std::max(x, w - 1 - x);
+        for (int r = 1; r <= reach; ++r) {
+          const std::int32_t r2 = r * r;
+          if (r2 > std::min(best_in, best_out)) break;
+          if (x - r >= 0) {
+            best_in = std::min(best_in, r2 + fi[x - r]);
+            best_out = std::min(best_out, r2 + fo[x - r]);
+          }
+          if (x + r < w) {
+            best_in = std::min(best_in, r2 + fi[x + r]);
+            best_out = std::min(best_out, r2 + fo[x + r]);
+          }
+        }
+      }
+      if (best_in > best_out) continue;  // ties, and a rect without measured pixels: in
+      o[x] = static_cast<std::uint8_t>(o[x] | value);
+      ++count;
+    }
+  }
+  return count;
+}
+
+/// The box's mask over its rect, OR-ed into `out`; returns the number of set pixels.
+template <class Raw>
+std::size_t rasterise_band(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rect,
+                           const DepthBand& band, std::uint8_t value, MaskView out) {
+  std::size_t count = rasterise_pass(v, range, rect, band, band.missing == MissingDepth::InMask, value, out);
+  if (band.missing == MissingDepth::Nearest && !band.all && !band.none)
+    count += rasterise_missing_nearest(v, range, rect, band, value, out);
+  return count;
+}
+
+template <class Raw>
+bool band_contains(const DepthView<Raw>& v, const RawRange<Raw>& range, const DepthBand& band, const PixelRect& rect,
+                   int u, int y) {
   if (band.none) return false;
   if (band.all) return true;
   const Raw d = v.raw(u, y);
-  if (!raw_valid(d, range)) return band.missing;
-  const double x = static_cast<double>(d);
-  return x >= band.lo && x < band.hi;
+  if (raw_valid(d, range)) return measured_in_band(d, band);
+  switch (band.missing) {
+    case MissingDepth::InMask: return true;
+    case MissingDepth::OutOfMask: return false;
+    case MissingDepth::Nearest: return nearest_measured_in_band(v, range, band, rect, u, y);
+  }
+  return false;
 }
 
 /// Exclusive upper threshold of a box's band in raw units (pixels nearer than it are in).
@@ -379,7 +632,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
   info.d_c_m = dc / upm;
   const bool integral = std::is_integral<Raw>::value;
   auto eps_raw = [&](double eps_m) { return integral ? std::round(eps_m * upm) : eps_m * upm; };
-  band->missing = robust && o.mask_missing_depth;
+  band->missing = robust ? o.missing_depth : MissingDepth::OutOfMask;
   band->lo = range.lo;
 
   auto set_threshold = [&](double thr_raw, DepthMaskOutcome outcome) {
@@ -398,7 +651,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     else if (dmax > 0) set_threshold(dmax, DepthMaskOutcome::RuleApplied);
     else if (dc > 0) set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
     else whole_box();
-    info.masks_missing = band->missing || band->all;
+    info.masks_missing = band->missing == MissingDepth::InMask || band->all;
     return info;
   }
 
@@ -484,7 +737,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
       if (info.d_c_m == 0) info.d_c_m = seed_raw / upm;
     }
   }
-  info.masks_missing = band->missing || band->all;
+  info.masks_missing = band->missing == MissingDepth::InMask || band->all;
   return info;
 }
 
@@ -537,7 +790,7 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
     b->reason = "centre occluded by a nearer box: d_c from the box's pixels outside it";
     set_band_threshold(range, thr, upm, DepthMaskOutcome::RuleApplied, b, band);
     band->all = false;
-    b->masks_missing = band->missing;
+    b->masks_missing = band->missing == MissingDepth::InMask;
     return true;
   }
   return false;
@@ -644,7 +897,7 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
           r.reasons[i] = CullReason::DepthMask;
           r.box_index[i] = static_cast<std::int32_t>(b);
         }
-      } else if (detail::band_contains(depth, range, bands[b], static_cast<int>(lu), static_cast<int>(lv))) {
+      } else if (detail::band_contains(depth, range, bands[b], info.rect, static_cast<int>(lu), static_cast<int>(lv))) {
         if (r.labels[i] != FeatureLabel::Dynamic) {
           r.labels[i] = FeatureLabel::Dynamic;
           r.reasons[i] = CullReason::DepthMask;
