@@ -133,6 +133,17 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.6);
   EXPECT_LT(dynamic_rate(s, r, SceneKind::Tv), 0.05);
   EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.03);
+  // The frame's depth reaches the check (the preset's depth residual): measured where the track's pixel has
+  // depth, and nowhere without a depth image.
+  std::size_t with_depth = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) with_depth += std::isfinite(double(state.reprojection.depth_residual_m[i]));
+  EXPECT_GT(with_depth, s.size() / 2);
+  auto no_depth_frame = frame;
+  no_depth_frame.depth = {};
+  PipelineState<T> state_no_depth;
+  cull_frame(no_depth_frame, o, &state_no_depth);
+  ASSERT_TRUE(state_no_depth.result.reprojection.ran()) << state_no_depth.result.reprojection.reason;
+  for (std::size_t i = 0; i < s.size(); ++i) EXPECT_TRUE(std::isnan(double(state_no_depth.reprojection.depth_residual_m[i])));
 
   // Either: a track is geometric-dynamic when either check flags it, so never fewer flags than Replace.
   PipelineOptions<T> either = o;

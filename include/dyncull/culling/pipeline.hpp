@@ -426,7 +426,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       r.reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
     } else {
       check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &s.reprojection, frame.track_valid,
-                         have_boxes ? s.in_dyn_box.data() : nullptr);
+                         have_boxes ? s.in_dyn_box.data() : nullptr, frame.depth);
       r.reprojection.status = s.reprojection.status;
       r.reprojection.reason = s.reprojection.reason;
       r.reprojection.num_dynamic = s.reprojection.num_dynamic;
