@@ -182,6 +182,61 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
 // Recommended: a medium-level candidate is culled only on its own geometric evidence (flagged itself in a
 // dynamic sub-box, or by the multi-view check), never by its sub-box's vote alone; the pushed chair,
 // whose features are flagged, is still culled.
+// Sub-box memory: the seated person's upper body moves in frame 1, then pauses (its 3-D points re-measured
+// where it is: residual 0, nothing flagged) for 20 frames. The recommended preset (memory 15 frames) keeps
+// culling it for 15 frames and then lets it go; without memory, or without track ids, it is kept from the
+// first pause on. The still legs are never culled.
+TYPED_TEST(PipelineTest, SubBoxMemoryBridgesAPauseOfASlowMover) {
+  using T = TypeParam;
+  SceneConfig config;
+  config.walking = false;  // the seated person's box alone, as its sway pauses
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  std::vector<std::int64_t> ids(s.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i);
+  // Points where the surfaces are now: what the reference keyframe's depth gives once the motion stops.
+  std::vector<Vec3<T>> paused = s.prev_points_world;
+  const Rigid3<T> world_from_cam = s.cam_from_world.inverse();
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.kind[i] == SceneKind::SittingUpper && std::isfinite(double(s.prev_points_world[i].x())))
+      paused[i] = world_from_cam.apply(s.camera.backproject(s.keypoints[i], s.depth_m[i]));
+  auto frame = frame_of(s, dets);
+  frame.track_ids = &ids;
+  auto run_sequence = [&](const PipelineOptions<T>& o, bool with_ids) {
+    PipelineState<T> state;
+    auto f = frame;
+    if (!with_ids) f.track_ids = nullptr;
+    std::vector<double> upper, lower;
+    for (int k = 0; k <= 20; ++k) {
+      f.points_3d = k == 0 ? &s.prev_points_world : &paused;
+      const PipelineResult<T>& r = cull_frame(f, o, &state);
+      EXPECT_TRUE(r.ok()) << r.reason;
+      upper.push_back(dynamic_rate(s, r, SceneKind::SittingUpper));
+      lower.push_back(dynamic_rate(s, r, SceneKind::SittingLower));
+      if (k == 1 && o.subbox_memory_frames > 0 && !with_ids) {
+        EXPECT_NE(r.subbox.reason.find("track_ids"), std::string::npos) << r.subbox.reason;
+      }
+    }
+    return std::make_pair(upper, lower);
+  };
+  const PipelineOptions<T> with_memory = presets::recommended<T>();
+  ASSERT_EQ(with_memory.subbox_memory_frames, 15);
+  PipelineOptions<T> without = with_memory;
+  without.subbox_memory_frames = 0;
+  const auto [mem_upper, mem_lower] = run_sequence(with_memory, true);
+  const auto [no_upper, no_lower] = run_sequence(without, true);
+  const auto [no_ids_upper, no_ids_lower] = run_sequence(with_memory, false);
+  EXPECT_GT(mem_upper[0], 0.9);  // moving: culled by every configuration
+  EXPECT_GT(no_upper[0], 0.9);
+  for (int k = 1; k <= 15; ++k) {
+    EXPECT_GT(mem_upper[k], 0.9) << "pause frame " << k;
+    EXPECT_LT(no_upper[k], 0.1) << "pause frame " << k;
+    EXPECT_LT(no_ids_upper[k], 0.1) << "pause frame " << k;
+  }
+  for (int k = 16; k <= 20; ++k) EXPECT_LT(mem_upper[k], 0.1) << "pause frame " << k << ": forgotten";
+  for (int k = 0; k <= 20; ++k) EXPECT_LT(mem_lower[k], 0.2) << "frame " << k;
+}
+
 TYPED_TEST(PipelineTest, CandidatesAreCulledOnTheirOwnEvidenceOnly) {
   using T = TypeParam;
   SceneConfig config;

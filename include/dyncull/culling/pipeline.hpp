@@ -20,6 +20,7 @@
 #include "dyncull/culling/moving_consistency.hpp"
 #include "dyncull/culling/reprojection_check.hpp"
 #include "dyncull/culling/multiview_check.hpp"
+#include "dyncull/culling/subbox_memory.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 
 #include <algorithm>
@@ -105,6 +106,11 @@ struct PipelineOptions {
   /// feature in a person's box but only in a chair's mask. false: the box rule's label (highest level
   /// of the rectangles holding it) stands.
   bool assign_overlaps_by_depth = false;
+  /// Sub-box memory (subbox_memory.hpp): a sub-box its own features voted dynamic stays dynamic for this
+  /// many frames in the same tracked box, for the tracks flagged in that time or younger than it. 0 = off.
+  /// Needs the box tracker (use_box_tracker) and CullingFrame::track_ids; without them the stage report
+  /// says so and the vote is this frame's only.
+  int subbox_memory_frames = 0;
   /// An epipolar flag of a feature with a depth step above edge_depth_step_ratio within this many
   /// pixels (sampled every 2 px) is not evidence (its moving-consistency label becomes Candidate): an LK
   /// window straddling an occlusion edge follows the contour, not a 3-D point, and is flagged although
@@ -152,6 +158,7 @@ template <class T>
 struct PipelineState {
   BoxTracker<T> tracker;
   TrackStateStore track_states;      ///< K of 000 eq. 3, keyed by the caller's track ids
+  SubBoxMemory subbox_memory;        ///< PipelineOptions::subbox_memory_frames
   KeyframeRing<T> keyframes;         ///< multi-view references (push with is_keyframe or by hand)
   std::uint64_t frame_index = 0;
 
@@ -160,6 +167,8 @@ struct PipelineState {
   std::vector<Detection<T>> boxes, dyn_boxes;
   std::vector<std::uint32_t> object_box_bits;  ///< per feature: the dynamic boxes whose depth mask holds it
   std::vector<std::int32_t> dyn_box_source;
+  std::vector<std::int64_t> box_track_id, dyn_box_track_id;  ///< box-tracker id per box (-1: none)
+  std::vector<std::uint8_t> remembered_cells, memory_eligible;
   std::vector<FeatureLabel> sem_labels;
   std::vector<CullReason> sem_reasons;
   std::vector<std::uint8_t> in_dyn_box, in_object, mv_dynamic;
@@ -178,6 +187,7 @@ struct PipelineState {
   void reset() {
     tracker = BoxTracker<T>(tracker_options_);
     track_states.clear();
+    subbox_memory.clear();
     keyframes.clear();
     frame_index = 0;
   }
@@ -340,16 +350,24 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     BoxTrackerResult<T> t = s.tracker.update(s.boxes, W, H);
     r.tracker.status = t.status;
     r.tracker.reason = t.reason;
-    if (t.ok()) s.boxes = t.boxes;
+    s.box_track_id.assign(s.boxes.size(), -1);
+    if (t.ok()) {
+      s.boxes = t.boxes;
+      s.box_track_id = t.track_id;
+    }
+  } else {
+    s.box_track_id.assign(s.boxes.size(), -1);
   }
   // Dynamic-class boxes (high and medium level): the ones sub-box refinement and the depth mask act on.
   s.dyn_boxes.clear();
   s.dyn_box_source.clear();
+  s.dyn_box_track_id.clear();
   for (std::size_t b = 0; b < s.boxes.size(); ++b) {
     const MotionLevel lv = options.levels.level(s.boxes[b].class_id);
     if (lv == MotionLevel::High || lv == MotionLevel::Medium) {
       s.dyn_boxes.push_back(s.boxes[b]);
       s.dyn_box_source.push_back(static_cast<std::int32_t>(b));
+      s.dyn_box_track_id.push_back(b < s.box_track_id.size() ? s.box_track_id[b] : -1);
     }
   }
 
@@ -514,11 +532,25 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
                         "its evidence inside the boxes is not trusted";
     } else {
       const bool masks = options.use_depth_mask && r.depth_mask.ran();
+      const bool memory = options.subbox_memory_frames > 0 && options.use_box_tracker && r.tracker.ran() &&
+                          frame.track_ids && frame.track_ids->size() == n;
+      if (memory) {
+        s.subbox_memory.recall(s.dyn_box_track_id, options.subbox.grid, s.frame_index, options.subbox_memory_frames,
+                               &s.remembered_cells);
+        s.subbox_memory.update_tracks(*frame.track_ids, s.moving.labels.data(), s.frame_index,
+                                      options.subbox_memory_frames, &s.memory_eligible);
+      }
       refine_subboxes(kp, s.moving.labels.data(), s.dyn_boxes, options.subbox, &s.subbox,
-                      masks ? s.in_object.data() : nullptr, masks ? s.object_box_bits.data() : nullptr);
+                      masks ? s.in_object.data() : nullptr, masks ? s.object_box_bits.data() : nullptr,
+                      memory ? s.remembered_cells.data() : nullptr, memory ? s.memory_eligible.data() : nullptr);
+      if (memory && s.subbox.ok())
+        s.subbox_memory.remember(s.dyn_box_track_id, s.subbox, options.subbox, s.frame_index,
+                                 options.subbox_memory_frames);
       r.subbox.status = s.subbox.status;
       r.subbox.reason = s.subbox.reason;
       r.subbox.num_dynamic = s.subbox.num_dynamic;
+      if (options.subbox_memory_frames > 0 && !memory && s.subbox.ok())
+        r.subbox.reason = "sub-box memory off this frame: it needs the box tracker and CullingFrame::track_ids";
     }
   }
   const bool subbox_ok = r.subbox.ran();

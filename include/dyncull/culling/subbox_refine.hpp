@@ -98,10 +98,15 @@ inline bool subbox_in_object(const std::uint8_t* in_object, const std::uint32_t*
 /// object_box_bits: optional per-feature bit set (bit b: in box b's own object mask, as
 /// DepthMaskResult::box_bits): box b then acts only on its own object's features, so a chair that a
 /// walker's box overlaps is not culled by the walker's sub-box (boxes from the 33rd on use in_object_mask).
+/// extra_dynamic_cells: optional per box grid*grid flags (box-major, as SubBoxResult::cells) of cells that
+/// are dynamic besides this frame's vote (remembered from earlier frames, subbox_memory.hpp); they take no
+/// part in merging or in the whole-box count and act only on the features with extra_eligible[i] != 0
+/// (nullptr: on all), inside the object mask as the voted cells.
 template <class T, class Points, class Boxes>
 void refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
-                     const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr) {
+                     const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr,
+                     const std::uint8_t* extra_dynamic_cells = nullptr, const std::uint8_t* extra_eligible = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::refine_subboxes: points must hold points (see PointTraits)");
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -197,8 +202,9 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
       const int c = detail::subbox_cell(box, g, x, y);
       if (c < 0) continue;
       in_box = true;
-      in_dynamic = r.cells[b * cells_per_box + static_cast<std::size_t>(c)] != 0 &&
-                   detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
+      const std::size_t cell = b * cells_per_box + static_cast<std::size_t>(c);
+      const bool extra = extra_dynamic_cells && extra_dynamic_cells[cell] && (!extra_eligible || extra_eligible[i]);
+      in_dynamic = (r.cells[cell] != 0 || extra) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
     }
     const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
     if (!std::isfinite(x) || !std::isfinite(y)) {

@@ -1,0 +1,121 @@
+/// @file subbox_memory.hpp
+/// Temporal memory of the sub-box vote (003 Algorithm 1 across frames; our extension, in the spirit of
+/// 000's last-frame state K): a sub-box whose own features voted it dynamic stays dynamic for a few frames
+/// in the same tracked box, for the tracks that showed motion themselves in that time or are younger
+/// than it. 003 votes every frame afresh, so a slow mover is kept whenever its motion pauses (a seated
+/// person's sway turning round) and its new corners, which have no history, are kept too.
+#pragma once
+
+#include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/subbox_refine.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace dyncull {
+
+/// Memory of the sub-box votes, owned by the caller (PipelineState holds one). Frames are counted by
+/// the caller (any increasing counter). Boxes are identified by their box-tracker id, features by
+/// their track id; boxes without an id (-1) have no memory.
+class SubBoxMemory {
+ public:
+  /// Flags, per feature, the tracks a remembered cell may cull: flagged dynamic by the geometric check, or
+  /// first seen, in this frame or one of the `frames` frames before it.
+  /// Records this frame's geometric flags and forgets tracks unseen for more than `frames` frames.
+  void update_tracks(const std::vector<std::int64_t>& track_ids, const FeatureLabel* geometric, std::uint64_t frame,
+                     int frames, std::vector<std::uint8_t>* eligible) {
+    const std::size_t n = track_ids.size();
+    eligible->assign(n, 0);
+    const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
+    for (std::size_t i = 0; i < n; ++i) {
+      TrackHistory& h = tracks_[track_ids[i]];
+      if (h.first_seen == 0) h.first_seen = frame;
+      h.last_seen = frame;
+      if (geometric && geometric[i] == FeatureLabel::Dynamic) h.last_flagged = frame;
+      const bool flagged = h.last_flagged != 0 && frame - h.last_flagged <= window;
+      const bool young = frame - h.first_seen <= window;
+      (*eligible)[i] = flagged || young;
+    }
+    for (auto it = tracks_.begin(); it != tracks_.end();)
+      it = frame - it->second.last_seen > window ? tracks_.erase(it) : std::next(it);
+  }
+
+  /// Cells (per box grid*grid, box-major like SubBoxResult::cells) that a vote of the last `frames`
+  /// frames before `frame` made dynamic in the same tracked box. grid*grid must be at most 64.
+  void recall(const std::vector<std::int64_t>& box_ids, int grid, std::uint64_t frame, int frames,
+              std::vector<std::uint8_t>* cells) const {
+    const std::size_t cpb = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
+    cells->assign(box_ids.size() * cpb, 0);
+    if (cpb > kMaxCells) return;
+    const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
+    for (std::size_t b = 0; b < box_ids.size(); ++b) {
+      const BoxCells* m = find(box_ids[b]);
+      if (!m) continue;
+      for (std::size_t c = 0; c < cpb; ++c)
+        (*cells)[b * cpb + c] = m->last_dynamic[c] != 0 && m->last_dynamic[c] < frame && frame - m->last_dynamic[c] <= window;
+    }
+  }
+
+  /// Stores the cells this frame's own votes made dynamic (the ratio rule of `options`; not merged
+  /// cells, not the whole-box rule: those are inferences, remembering them would spread them) and
+  /// forgets boxes unseen for more than `frames` frames.
+  template <class T>
+  void remember(const std::vector<std::int64_t>& box_ids, const SubBoxResult<T>& votes, const SubBoxOptions<T>& options,
+                std::uint64_t frame, int frames) {
+    const std::size_t cpb = static_cast<std::size_t>(options.grid) * static_cast<std::size_t>(options.grid);
+    if (cpb > kMaxCells || votes.dyn_count.size() < box_ids.size() * cpb) return;
+    for (std::size_t b = 0; b < box_ids.size(); ++b) {
+      if (box_ids[b] < 0) continue;
+      BoxCells* m = find(box_ids[b]);
+      if (!m) {
+        boxes_.push_back(BoxCells{});
+        m = &boxes_.back();
+        m->id = box_ids[b];
+      }
+      m->last_seen = frame;
+      for (std::size_t c = 0; c < cpb; ++c) {
+        const std::uint32_t dyn = votes.dyn_count[b * cpb + c], stat = votes.static_count[b * cpb + c];
+        const std::uint32_t total = dyn + stat;
+        if (total > 0 && total >= options.min_points && T(dyn) >= options.sigma1 * T(total)) m->last_dynamic[c] = frame;
+      }
+    }
+    const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
+    boxes_.erase(std::remove_if(boxes_.begin(), boxes_.end(),
+                                [&](const BoxCells& m) { return frame - m.last_seen > window; }),
+                 boxes_.end());
+  }
+
+  void clear() {
+    boxes_.clear();
+    tracks_.clear();
+  }
+  std::size_t num_boxes() const { return boxes_.size(); }
+  std::size_t num_tracks() const { return tracks_.size(); }
+
+ private:
+  static constexpr std::size_t kMaxCells = 64;  ///< SubBoxOptions::grid is at most 8
+  struct BoxCells {
+    std::int64_t id = -1;
+    std::uint64_t last_seen = 0;
+    std::uint64_t last_dynamic[kMaxCells] = {};  ///< frame of the last own dynamic vote, 0 = never
+  };
+  struct TrackHistory {
+    std::uint64_t first_seen = 0, last_seen = 0, last_flagged = 0;  ///< 0 = never
+  };
+
+  const BoxCells* find(std::int64_t id) const {
+    if (id < 0) return nullptr;
+    for (const BoxCells& m : boxes_)
+      if (m.id == id) return &m;
+    return nullptr;
+  }
+  BoxCells* find(std::int64_t id) { return const_cast<BoxCells*>(static_cast<const SubBoxMemory*>(this)->find(id)); }
+
+  std::vector<BoxCells> boxes_;  ///< a handful of tracked boxes: a linear search is enough
+  std::unordered_map<std::int64_t, TrackHistory> tracks_;
+};
+
+}  // namespace dyncull

@@ -1,0 +1,127 @@
+// Sub-box memory: which cells are remembered, for how long, in which box, and which tracks they may cull.
+#include "dyncull/culling/subbox_memory.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace dyncull {
+namespace {
+
+// One 3x3 vote result for `boxes` boxes with the given (dyn, static) counts in cell c of box 0.
+SubBoxResult<float> votes_with(std::size_t boxes, std::size_t cell, std::uint32_t dyn, std::uint32_t stat) {
+  SubBoxResult<float> r;
+  r.dyn_count.assign(boxes * 9, 0);
+  r.static_count.assign(boxes * 9, 0);
+  r.cells.assign(boxes * 9, 0);
+  r.dyn_count[cell] = dyn;
+  r.static_count[cell] = stat;
+  return r;
+}
+
+TEST(SubBoxMemory, ACellVotedDynamicIsRememberedForTheWindowInItsTrackedBoxOnly) {
+  SubBoxMemory memory;
+  const SubBoxOptions<float> options;  // sigma1 0.5, min_points 2
+  const std::vector<std::int64_t> ids = {7, 9};
+  std::vector<std::uint8_t> cells;
+  memory.remember(ids, votes_with(2, 1, 3, 1), options, 10, 15);  // frame 10: box 7's cell 1 dynamic (3 of 4)
+  memory.recall(ids, 3, 10, 15, &cells);
+  EXPECT_EQ(cells[1], 0) << "this frame's own vote is the vote's business, not the memory's";
+  for (std::uint64_t f = 11; f <= 25; ++f) {
+    memory.recall(ids, 3, f, 15, &cells);
+    EXPECT_EQ(cells[1], 1) << "frame " << f;
+    EXPECT_EQ(cells[9 + 1], 0) << "box 9 never voted";
+    memory.remember(ids, votes_with(2, 1, 0, 5), options, f, 15);  // static votes do not erase it
+  }
+  memory.recall(ids, 3, 26, 15, &cells);
+  EXPECT_EQ(cells[1], 0) << "16 frames later";
+  // Other ids, and boxes without an id, have no memory.
+  memory.remember(ids, votes_with(2, 4, 5, 0), options, 30, 15);
+  memory.recall({9, 7, -1}, 3, 31, 15, &cells);
+  ASSERT_EQ(cells.size(), 27u);
+  EXPECT_EQ(cells[4], 0);
+  EXPECT_EQ(cells[9 + 4], 1);
+  EXPECT_EQ(cells[18 + 4], 0);
+}
+
+TEST(SubBoxMemory, OnlyOwnVotesAreRemembered) {
+  SubBoxMemory memory;
+  SubBoxOptions<float> options;
+  const std::vector<std::int64_t> ids = {1};
+  std::vector<std::uint8_t> cells;
+  // Below sigma1 (1 of 3), too few points (1 of 1), and a cell set by merging or the whole-box rule
+  // (cells[] = 1 without the counts): none is remembered.
+  SubBoxResult<float> v = votes_with(1, 0, 1, 2);
+  v.dyn_count[2] = 1;
+  v.cells.assign(9, 1);
+  memory.remember(ids, v, options, 5, 15);
+  memory.recall(ids, 3, 6, 15, &cells);
+  for (std::uint8_t c : cells) EXPECT_EQ(c, 0);
+  options.min_points = 1;
+  memory.remember(ids, v, options, 6, 15);
+  memory.recall(ids, 3, 7, 15, &cells);
+  EXPECT_EQ(cells[2], 1);
+  EXPECT_EQ(cells[0], 0);
+}
+
+TEST(SubBoxMemory, RememberedCellsCullRecentlyFlaggedAndYoungTracksOnly) {
+  SubBoxMemory memory;
+  std::vector<std::uint8_t> eligible;
+  const std::vector<std::int64_t> tracks = {100, 200};
+  // Frame 1: track 100 flagged, 200 not; both are new (young) anyway.
+  std::vector<FeatureLabel> geo = {FeatureLabel::Dynamic, FeatureLabel::Static};
+  memory.update_tracks(tracks, geo.data(), 1, 15, &eligible);
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{1, 1}));
+  geo = {FeatureLabel::Static, FeatureLabel::Candidate};
+  for (std::uint64_t f = 2; f <= 16; ++f) {
+    memory.update_tracks(tracks, geo.data(), f, 15, &eligible);
+    EXPECT_EQ(eligible, (std::vector<std::uint8_t>{1, 1})) << "frame " << f;
+  }
+  // Frame 17: 100's flag and 200's first sighting are 16 frames back, out of the window.
+  geo = {FeatureLabel::Static, FeatureLabel::Dynamic};
+  memory.update_tracks(tracks, geo.data(), 17, 15, &eligible);
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 1})) << "200 is flagged now";
+  geo = {FeatureLabel::Static, FeatureLabel::Static};
+  memory.update_tracks(tracks, geo.data(), 32, 15, &eligible);
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 1}));
+  memory.update_tracks(tracks, geo.data(), 33, 15, &eligible);
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 0}));
+  // A new track is eligible at once; one unseen for longer than the window is forgotten.
+  memory.update_tracks({300}, geo.data(), 49, 15, &eligible);
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{1}));
+  EXPECT_EQ(memory.num_tracks(), 1u);
+  // Without geometric labels nothing is flagged, and a new memory is empty.
+  memory.update_tracks({300}, nullptr, 65, 15, &eligible);
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0}));
+  memory.clear();
+  EXPECT_EQ(memory.num_tracks(), 0u);
+  EXPECT_EQ(memory.num_boxes(), 0u);
+}
+
+// The refinement applies remembered cells to eligible features in the object only, and they neither merge
+// nor count towards the whole-box rule.
+TEST(SubBoxMemory, RefinementAppliesRememberedCellsToEligibleFeaturesInTheObject) {
+  const std::vector<Box<float>> boxes = {{0, 0, 90, 90}};
+  // Cell 0 (top left) holds features 0-2, cell 4 (centre) features 3-5; all geometric-static.
+  const std::vector<Vec2<float>> pts = {{10, 10}, {12, 14}, {20, 5}, {45, 45}, {50, 40}, {40, 50}};
+  const std::vector<FeatureLabel> geo(pts.size(), FeatureLabel::Static);
+  std::vector<std::uint8_t> extra(9, 0);
+  extra[0] = 1;
+  const std::vector<std::uint8_t> eligible = {1, 0, 1, 1, 1, 1};
+  const std::vector<std::uint8_t> in_object = {1, 1, 0, 1, 1, 1};
+  SubBoxResult<float> r;
+  refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<float>{}, &r, in_object.data(), nullptr, extra.data(),
+                  eligible.data());
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(r.reasons[0], CullReason::SubBox);
+  EXPECT_EQ(r.labels[1], FeatureLabel::Static) << "not eligible";
+  EXPECT_EQ(r.labels[2], FeatureLabel::Static) << "outside the object";
+  for (std::size_t i = 3; i < 6; ++i) EXPECT_EQ(r.labels[i], FeatureLabel::Static) << "no merge from a remembered cell";
+  EXPECT_EQ(r.cells[0], 0) << "the vote itself is unchanged";
+  EXPECT_EQ(r.votes[0].num_dynamic_cells, 0);
+}
+
+}  // namespace
+}  // namespace dyncull
