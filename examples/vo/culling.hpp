@@ -11,6 +11,7 @@
 #include "dyncull/opencv/views.hpp"
 
 #include "frontend.hpp"
+#include "report.hpp"
 #include "sources.hpp"
 
 #include <cstdint>
@@ -73,6 +74,7 @@ class Culler {
             std::vector<std::uint8_t>* keep) {
     keep->assign(tracks.size(), 1);
     reasons_.assign(tracks.size(), CullReason::None);
+    kept_why_.assign(tracks.size(), KeptWhy::NotExplained);
     ++frame_index_;
     if (!spec_.culls) return;
     if (spec_.oracle) {
@@ -100,18 +102,49 @@ class Culler {
     if (r.keep.size() == tracks.size()) {
       *keep = r.keep;
       reasons_ = r.reasons;
+      explain_kept(r);
     }
   }
 
   /// Why each track of the last cull() was labelled (None for the oracle and no culling).
   const std::vector<CullReason>& reasons() const { return reasons_; }
+  /// For each track the last cull() kept with reason None: at which stage it stayed static.
+  const std::vector<KeptWhy>& kept_why() const { return kept_why_; }
 
  private:
+  /// Reads the pipeline's per-stage scratch of this frame (PipelineState): which stage left a kept track
+  /// static. Diagnostic only (dynamic_vo --diagnose).
+  void explain_kept(const PipelineResult<float>& r) {
+    const std::size_t n = r.labels.size();
+    kept_why_.assign(n, KeptWhy::NotExplained);
+    const PipelineState<float>& s = state_;
+    const bool masks = r.depth_mask.ran() && s.in_object.size() == n;
+    const bool geo = (r.moving_consistency.ran() || r.reprojection.ran()) && s.moving.labels.size() == n;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!r.keep[i] || r.reasons[i] != CullReason::None) continue;
+      KeptWhy& why = kept_why_[i];
+      if (i >= s.in_dyn_box.size() || !s.in_dyn_box[i]) {
+        why = KeptWhy::OutsideBoxes;
+      } else if (masks && !s.in_object[i]) {
+        why = KeptWhy::OutsideObjectBand;
+      } else if (s.sem_labels.size() == n && s.sem_labels[i] == FeatureLabel::Candidate) {
+        why = KeptWhy::CandidateNotFlagged;
+      } else if (!geo || s.moving.labels[i] == FeatureLabel::Candidate) {
+        why = KeptWhy::NoGeometricEvidence;
+      } else if (s.moving.labels[i] == FeatureLabel::Dynamic) {
+        why = KeptWhy::FlaggedInStaticSubBox;
+      } else {
+        why = KeptWhy::NotFlagged;
+      }
+    }
+  }
+
   StrategySpec spec_;
   PinholeCamera<float> camera_;
   PipelineState<float> state_;
   std::vector<std::int64_t> ids_;
   std::vector<CullReason> reasons_;
+  std::vector<KeptWhy> kept_why_;
   Rigid3<float> pose_;
   int frame_index_ = 0;
 };

@@ -81,25 +81,54 @@ inline void count_labels(const std::vector<cv::Point2f>& px, const std::vector<s
   }
 }
 
-/// Where the labels of one strategy come from: counts per (sim instance, truth, decision, reason), so a
-/// low precision or recall can be traced to the actor and the stage (dynamic_vo --diagnose).
-struct LabelBreakdown {
-  static constexpr int kInstances = 8, kReasons = 12;
-  std::array<std::size_t, kInstances * 2 * 2 * kReasons> counts{};
+/// Where a kept feature (final reason None) stayed static, for dynamic_vo --diagnose.
+enum class KeptWhy : std::uint8_t {
+  NotExplained = 0,       ///< no culling ran, or the oracle
+  OutsideBoxes,           ///< in no high- or medium-level box (detector miss, box too small)
+  OutsideObjectBand,      ///< in a box but outside its object's depth band (000 mask)
+  CandidateNotFlagged,    ///< medium-level candidate its own evidence did not flag
+  NoGeometricEvidence,    ///< in the object, without a geometric label (no track / point, depth edge)
+  NotFlagged,             ///< in the object, the geometric check said static, and so did its sub-box
+  FlaggedInStaticSubBox,  ///< in the object, flagged by the geometric check, but its sub-box voted static
+};
 
-  std::size_t& at(int instance, bool moving, bool culled, CullReason reason) {
+constexpr const char* to_string(KeptWhy w) noexcept {
+  switch (w) {
+    case KeptWhy::NotExplained: return "";
+    case KeptWhy::OutsideBoxes: return "(outside boxes)";
+    case KeptWhy::OutsideObjectBand: return "(outside object band)";
+    case KeptWhy::CandidateNotFlagged: return "(candidate not flagged)";
+    case KeptWhy::NoGeometricEvidence: return "(no geometric evidence)";
+    case KeptWhy::NotFlagged: return "(not flagged)";
+    case KeptWhy::FlaggedInStaticSubBox: return "(flagged, static sub-box)";
+  }
+  return "";
+}
+
+/// Where the labels of one strategy come from: counts per (sim instance, truth, decision, reason), so a
+/// low precision or recall can be traced to the actor and the stage (dynamic_vo --diagnose). A kept
+/// feature's reason is None; `kept_why` (optional) then says at which stage it stayed static.
+struct LabelBreakdown {
+  static constexpr int kInstances = 8, kReasons = 12, kKeptWhy = 7;
+  static constexpr int kCells = kReasons + kKeptWhy;  ///< reasons, then None split by KeptWhy
+  std::array<std::size_t, kInstances * 2 * 2 * kCells> counts{};
+
+  std::size_t& at(int instance, bool moving, bool culled, int cell) {
     const int inst = instance < 0 || instance >= kInstances ? kInstances - 1 : instance;
-    const int why = std::min(static_cast<int>(reason), kReasons - 1);
-    return counts[static_cast<std::size_t>(((inst * 2 + moving) * 2 + culled) * kReasons + why)];
+    return counts[static_cast<std::size_t>(((inst * 2 + moving) * 2 + culled) * kCells + cell)];
   }
   void add(const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep,
-           const std::vector<CullReason>& reasons, const cv::Mat& moving, const cv::Mat& instance) {
+           const std::vector<CullReason>& reasons, const std::vector<KeptWhy>& kept_why, const cv::Mat& moving,
+           const cv::Mat& instance) {
     if (moving.empty() || instance.empty() || instance.type() != CV_16UC1) return;
     for (std::size_t i = 0; i < px.size(); ++i) {
       const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
       if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
       const CullReason why = i < reasons.size() ? reasons[i] : CullReason::None;
-      ++at(instance.at<std::uint16_t>(v, u), moving.at<std::uint8_t>(v, u) != 0, i < keep.size() && keep[i] == 0, why);
+      int cell = std::min(static_cast<int>(why), kReasons - 1);
+      if (why == CullReason::None && i < kept_why.size() && kept_why[i] != KeptWhy::NotExplained)
+        cell = kReasons + static_cast<int>(kept_why[i]);
+      ++at(instance.at<std::uint16_t>(v, u), moving.at<std::uint8_t>(v, u) != 0, i < keep.size() && keep[i] == 0, cell);
     }
   }
   /// One line per non-empty cell: "instance truth decision reason count".
@@ -110,11 +139,13 @@ struct LabelBreakdown {
     for (int inst = 0; inst < kInstances; ++inst)
       for (int mv = 0; mv < 2; ++mv)
         for (int cu = 0; cu < 2; ++cu)
-          for (int why = 0; why < kReasons; ++why) {
-            const std::size_t c = counts[static_cast<std::size_t>(((inst * 2 + mv) * 2 + cu) * kReasons + why)];
+          for (int cell = 0; cell < kCells; ++cell) {
+            const std::size_t c = counts[static_cast<std::size_t>(((inst * 2 + mv) * 2 + cu) * kCells + cell)];
             if (c == 0) continue;
-            o << "    " << names[inst] << (mv ? " moving " : " static ") << (cu ? "culled " : "kept   ")
-              << to_string(static_cast<CullReason>(why)) << " " << c << "\n";
+            o << "    " << names[inst] << (mv ? " moving " : " static ") << (cu ? "culled " : "kept   ");
+            if (cell < kReasons) o << to_string(static_cast<CullReason>(cell));
+            else o << "none " << to_string(static_cast<KeptWhy>(cell - kReasons));
+            o << " " << c << "\n";
           }
     return o.str();
   }

@@ -128,7 +128,9 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
       const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
       if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
-      if (options.diagnose) run.breakdown.add(fe.tracks().cur_px, keep, cullers[k].reasons(), frame.moving, frame.instance);
+      if (options.diagnose)
+        run.breakdown.add(fe.tracks().cur_px, keep, cullers[k].reasons(), cullers[k].kept_why(), frame.moving,
+                          frame.instance);
       if (draw && k == draw_strategy && fe.tracks().size() > 0) {
         source.load_colour(&frame);
         char file[64];
