@@ -183,9 +183,9 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
 // dynamic sub-box, or by the multi-view check), never by its sub-box's vote alone; the pushed chair,
 // whose features are flagged, is still culled.
 // Sub-box memory: the seated person's upper body moves in frame 1, then pauses (its 3-D points re-measured
-// where it is: residual 0, nothing flagged) for 20 frames. The recommended preset (memory 15 frames) keeps
-// culling it for 15 frames and then lets it go; without memory, or without track ids, it is kept from the
-// first pause on. The still legs are never culled.
+// where it is: residual 0, nothing flagged) for 20 frames. The recommended preset with a 15-frame memory
+// keeps culling it for 15 frames and then lets it go; without memory (the preset's default), or without
+// track ids, it is kept from the first pause on. The still legs are never culled.
 TYPED_TEST(PipelineTest, SubBoxMemoryBridgesAPauseOfASlowMover) {
   using T = TypeParam;
   SceneConfig config;
@@ -219,10 +219,10 @@ TYPED_TEST(PipelineTest, SubBoxMemoryBridgesAPauseOfASlowMover) {
     }
     return std::make_pair(upper, lower);
   };
-  const PipelineOptions<T> with_memory = presets::recommended<T>();
-  ASSERT_EQ(with_memory.subbox_memory_frames, 15);
-  PipelineOptions<T> without = with_memory;
-  without.subbox_memory_frames = 0;
+  const PipelineOptions<T> without = presets::recommended<T>();
+  ASSERT_EQ(without.subbox_memory_frames, 0);
+  PipelineOptions<T> with_memory = without;
+  with_memory.subbox_memory_frames = 15;
   const auto [mem_upper, mem_lower] = run_sequence(with_memory, true);
   const auto [no_upper, no_lower] = run_sequence(without, true);
   const auto [no_ids_upper, no_ids_lower] = run_sequence(with_memory, false);

@@ -101,9 +101,9 @@ PipelineOptions<T> zhang_2023() {
 /// by the geometric check fitted outside boxes (003 + SG-SLAM: the RGB-D reprojection check when the
 /// caller gives 3-D points, with the depth residual, else the epipolar one; flags within 8 px of a depth
 /// edge are not evidence)
-/// and the evidence-aware sub-box vote (keeps a seated person's still legs) with a half-second memory,
-/// medium-level objects culled only when their own features are flagged, each box's sub-boxes voted by
-/// and acting on its own depth-mask object only, a tracker for missed boxes, and the survivor guard.
+/// and the evidence-aware sub-box vote (keeps a seated person's still legs), medium-level objects culled
+/// only when their own features are flagged, each box's sub-boxes voted by and acting on its own
+/// depth-mask object only, a tracker for missed boxes, and the survivor guard.
 /// Tracks: give as prev_keypoints the features' positions in a reference frame a few frames back (the
 /// front end's keyframe), not the previous frame: slow movers (a seated person) build up a measurable
 /// epipolar distance only over several frames, hence the 1 px in-box threshold (0.5 px suits
@@ -144,10 +144,11 @@ PipelineOptions<T> recommended() {
   o.use_subbox = true;
   o.subbox.object_mask_votes_only = true;
   o.subbox_verifies_candidates = false;
-  // A sub-box voted dynamic stays so for half a second for its recently flagged and its new tracks: the
-  // seated person's sway pauses, and corners detected on it have no history. Over six seeds recall
-  // 0.65-0.68 -> 0.78-0.82, precision -0.01 to -0.03, ATE within the noise (docs/results.md).
-  o.subbox_memory_frames = 15;
+  // Sub-box memory off: with 15 frames (half a second) the demo's recall rose from 0.65-0.68 to 0.78-0.82
+  // on every sequence, precision fell by 0.01-0.03, and the map-less VO's ATE got worse (summed over six
+  // seeds and four sequences 61.9 -> 69.6 cm; 8 frames: 73.1 cm). Set it with CullingFrame::track_ids when
+  // missed slow movers cost more than culled static features, e.g. before map insertion (docs/results.md).
+  o.subbox_memory_frames = 0;
   o.use_multiview = false;
   // When switched on: outside boxes a depth jump is more often a sensor edge, and a person at 2-3 m
   // covers about 20k pixels at 640x480; a seed on a static occlusion edge would otherwise flood a whole
