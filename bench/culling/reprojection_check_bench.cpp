@@ -72,6 +72,22 @@ void BM_ReprojectionCheck_Dyncull(benchmark::State& state) {
 }
 BENCHMARK(BM_ReprojectionCheck_Dyncull)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// Ours with the depth residual at 5 sigma (the recommended preset), reading the scene's depth image.
+void BM_ReprojectionCheck_DyncullWithDepth(benchmark::State& state) {
+  const Data& d = data();
+  ReprojectionCheckOptions<float> o;
+  o.max_depth_residual_sigmas = 5.f;
+  ReprojectionCheckResult<float> r;
+  for (auto _ : state) {
+    check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, o, &r, d.scene.track_valid.data(),
+                       d.in_box.data(), d.scene.depth_view());
+    benchmark::DoNotOptimize(r.labels.data());
+  }
+  state.counters["depth_flagged"] = double(r.num_depth_dynamic);
+  accuracy(state, [&](std::size_t i) { return r.labels[i] == FeatureLabel::Dynamic; });
+}
+BENCHMARK(BM_ReprojectionCheck_DyncullWithDepth)->Unit(benchmark::kMicrosecond);
+
 // The epipolar check on the same tracks (what the reprojection check replaces when depth is there).
 void BM_ReprojectionCheck_EpipolarOnSameTracks(benchmark::State& state) {
   const Data& d = data();

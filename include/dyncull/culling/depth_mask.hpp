@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -424,7 +425,8 @@ struct ParabolaEnvelope {
 };
 
 /// MissingDepth::Nearest over a rect, exactly the rule of nearest_measured_in_band at every pixel
-/// without depth. Two column sweeps give each pixel's distance along its column to the nearest in-band
+/// without depth. A hole with a measured pixel among its 8 neighbours is decided by them; for the others,
+/// two column sweeps give each pixel's distance along its column to the nearest in-band
 /// and out-of-band pixel (the first pass of the distance transform); then each pixel without depth scans
 /// its row outwards, min over columns q of (x - q)^2 + column distance^2, until (x - q)^2 exceeds the
 /// best found. A row whose holes are wide takes the exact parabola envelopes instead (linear in the
@@ -451,17 +453,52 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
   }
   const auto none = static_cast<std::int16_t>(w + h + 1);
   std::vector<std::uint8_t> cls(n);
-  std::vector<std::uint8_t> row_has_hole(static_cast<std::size_t>(h), 0);
-  bool any_hole = false;
+  for (int y = 0; y < h; ++y)
+    classify_row(v.row(rect.r0 + y) + rect.c0, w, range, band, cls.data() + static_cast<std::size_t>(y) * W);
+  // Most holes are single pixels or slivers: a measured 4-neighbour (distance 1), else a measured
+  // diagonal one (distance sqrt 2), is the nearest, and the decision is exact from the 8-neighbourhood.
+  // The rest (class 3) need the distance transform below.
+  constexpr std::uint8_t kUnresolved = 3;
+  std::vector<std::uint8_t> row_unresolved(static_cast<std::size_t>(h), 0);
+  bool any_unresolved = false;
+  std::size_t count = 0;
   for (int y = 0; y < h; ++y) {
     std::uint8_t* c = cls.data() + static_cast<std::size_t>(y) * W;
-    classify_row(v.row(rect.r0 + y) + rect.c0, w, range, band, c);
-    unsigned holes = 0;
-    for (int x = 0; x < w; ++x) holes += c[x] == 0;
-    row_has_hole[static_cast<std::size_t>(y)] = holes != 0;
-    any_hole |= holes != 0;
+    const std::uint8_t* up = y > 0 ? c - W : nullptr;
+    const std::uint8_t* down = y + 1 < h ? c + W : nullptr;
+    std::uint8_t* o = out.row(rect.r0 + y) + rect.c0;
+    for (int x = 0; x < w; ++x) {
+      // Next hole of the row (memchr: a vectorised scan over the measured pixels).
+      const void* hole = std::memchr(c + x, 0, static_cast<std::size_t>(w - x));
+      if (!hole) break;
+      x = static_cast<int>(static_cast<const std::uint8_t*>(hole) - c);
+      // Measured neighbours in and out of the band: bit 0 = some in band, bit 1 = some out of it.
+      auto seen = [](std::uint8_t k) { return k == 1 ? 1u : (k == 2 ? 2u : 0u); };
+      unsigned edge = 0, corner = 0;
+      if (x > 0) edge |= seen(c[x - 1]);
+      if (x + 1 < w) edge |= seen(c[x + 1]);
+      if (up) {
+        edge |= seen(up[x]);
+        if (x > 0) corner |= seen(up[x - 1]);
+        if (x + 1 < w) corner |= seen(up[x + 1]);
+      }
+      if (down) {
+        edge |= seen(down[x]);
+        if (x > 0) corner |= seen(down[x - 1]);
+        if (x + 1 < w) corner |= seen(down[x + 1]);
+      }
+      const unsigned nearest = edge ? edge : corner;
+      if (nearest == 0) {
+        c[x] = kUnresolved;
+        row_unresolved[static_cast<std::size_t>(y)] = 1;
+        any_unresolved = true;
+      } else if (nearest & 1u) {  // an in-band pixel among the nearest (ties: in)
+        o[x] = static_cast<std::uint8_t>(o[x] | value);
+        ++count;
+      }
+    }
   }
-  if (!any_hole) return 0;
+  if (!any_unresolved) return count;
   std::vector<std::int16_t> col_in(n), col_out(n);
   for (int y = 0; y < h; ++y) {  // nearest above (or at)
     const std::uint8_t* c = cls.data() + static_cast<std::size_t>(y) * W;
@@ -488,9 +525,8 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
   // any in-rect squared distance, (w + h)^2 < 2^30, so every sum below stays in int32 and needs no branch).
   std::vector<std::int32_t> f_in(W), f_out(W);
   ParabolaEnvelope env_in, env_out;
-  std::size_t count = 0;
   for (int y = 0; y < h; ++y) {
-    if (!row_has_hole[static_cast<std::size_t>(y)]) continue;
+    if (!row_unresolved[static_cast<std::size_t>(y)]) continue;
     const std::size_t i0 = static_cast<std::size_t>(y) * W;
     const std::uint8_t* c = cls.data() + i0;
     const std::int16_t* gi = col_in.data() + i0;
@@ -505,7 +541,7 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
     // 6 visits per column of the row (measured on the real TUM frame): take the cheaper.
     long long scan_cost = 0;
     for (int x = 0, run = 0; x <= w; ++x) {
-      if (x < w && c[x] == 0) {
+      if (x < w && c[x] == kUnresolved) {
         ++run;
       } else {
         scan_cost += static_cast<long long>(run) * run / 2;
@@ -520,7 +556,7 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
     std::uint8_t* o = out.row(rect.r0 + y) + rect.c0;
     int j_in = 0, j_out = 0;
     for (int x = 0; x < w; ++x) {
-      if (c[x] != 0) continue;
+      if (c[x] != kUnresolved) continue;
       std::int32_t best_in = fi[x], best_out = fo[x];
       if (use_envelope) {
         best_in = static_cast<std::int32_t>(std::min<long long>(env_in.at(fi, x, &j_in), kNoParabola));
