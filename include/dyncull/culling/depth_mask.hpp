@@ -521,7 +521,7 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
       go[x] = std::min<std::int16_t>(go[x], static_cast<std::int16_t>(go[x + w] + 1));
     }
   }
-  // Per row with a hole: squared column distances, kNoParabola where the column has none (larger than
+  // Per row with an unresolved hole: squared column distances, kNoParabola where the column has none (larger than
   // any in-rect squared distance, (w + h)^2 < 2^30, so every sum below stays in int32 and needs no branch).
   std::vector<std::int32_t> f_in(W), f_out(W);
   ParabolaEnvelope env_in, env_out;
@@ -537,8 +537,8 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
       fi[q] = gi[q] < none ? std::int32_t(gi[q]) * gi[q] : kNoParabola;
       fo[q] = go[q] < none ? std::int32_t(go[q]) * go[q] : kNoParabola;
     }
-    // Scanning a run of L pixels without depth visits about L^2 / 2 columns; the two envelopes cost about
-    // 6 visits per column of the row (measured on the real TUM frame): take the cheaper.
+    // Scanning a run of L pixels without depth visits about L^2 / 2 columns; the two envelopes cost roughly
+    // 6 visits per column of the row (a rough reading on the real TUM frame): take the cheaper.
     long long scan_cost = 0;
     for (int x = 0, run = 0; x <= w; ++x) {
       if (x < w && c[x] == kUnresolved) {

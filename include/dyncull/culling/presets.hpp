@@ -146,7 +146,7 @@ PipelineOptions<T> recommended() {
   o.subbox_verifies_candidates = false;
   // Sub-box memory off: with 15 frames (half a second) the demo's recall rose from 0.65-0.68 to 0.78-0.82
   // on every sequence, precision fell by 0.01-0.03, and the map-less VO's ATE got worse (summed over six
-  // seeds and four sequences 61.9 -> 69.6 cm; 8 frames: 73.1 cm). Set it with CullingFrame::track_ids when
+  // seeds and four sequences 61.8 -> 69.6 cm; 8 frames: 73.1 cm). Set it with CullingFrame::track_ids when
   // missed slow movers cost more than culled static features, e.g. before map insertion (docs/results.md).
   o.subbox_memory_frames = 0;
   o.use_multiview = false;
