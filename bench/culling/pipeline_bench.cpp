@@ -40,8 +40,10 @@ const Data& data() {
   return d;
 }
 
-/// with_points: each track's 3-D point at the previous frame (the recommended preset's RGB-D input).
-void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options, bool with_points = false) {
+/// with_points: each track's 3-D point at the previous frame (the recommended preset's RGB-D input);
+/// with_ids: a track id per feature (the sub-box memory's input).
+void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options, bool with_points = false,
+                  bool with_ids = false) {
   const Data& d = data();
   PipelineState<float> st;
   st.keyframes.push(d.keyframe.cam_from_world, d.keyframe.keypoints, d.keyframe.depth_m);
@@ -54,6 +56,9 @@ void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options
   frame.camera = d.scene.camera;
   frame.cam_from_world = &d.scene.cam_from_world;
   if (with_points) frame.points_3d = &d.scene.prev_points_world;
+  std::vector<std::int64_t> ids(d.scene.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i);
+  if (with_ids) frame.track_ids = &ids;
   std::size_t dyn = 0;
   for (auto _ : state) {
     const auto& r = cull_frame(frame, options, &st);
@@ -82,6 +87,14 @@ void BM_Pipeline_RecommendedWithPoints(benchmark::State& state) {
   run_pipeline(state, presets::recommended<float>(), true);
 }
 BENCHMARK(BM_Pipeline_RecommendedWithPoints)->Unit(benchmark::kMicrosecond);
+
+// With points and the sub-box memory option (15 frames, track ids): the memory's bookkeeping per frame.
+void BM_Pipeline_RecommendedWithPointsAndMemory(benchmark::State& state) {
+  PipelineOptions<float> o = presets::recommended<float>();
+  o.subbox_memory_frames = 15;
+  run_pipeline(state, o, true, true);
+}
+BENCHMARK(BM_Pipeline_RecommendedWithPointsAndMemory)->Unit(benchmark::kMicrosecond);
 
 // The multi-view check (left out of the recommended preset since session 5) verifying the candidates.
 void BM_Pipeline_RecommendedPlusMultiView(benchmark::State& state) {
