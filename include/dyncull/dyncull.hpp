@@ -37,6 +37,7 @@
 #include "dyncull/culling/multiview_check.hpp"
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
+#include "dyncull/culling/subbox_memory.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 
 #include "dyncull/eval/ate.hpp"
