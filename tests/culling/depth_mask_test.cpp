@@ -352,14 +352,20 @@ TYPED_TEST(DepthMask, MissingDepthTakesTheNearestMeasuredPixelsDecision) {
   for (int trial = 0; trial < 20; ++trial) {
     Scene<Raw> s;
     s.fill(4.0);
-    s.person(40 + next(80), 30 + next(60), 8 + next(20), 15 + next(30), 1.5);
+    // One draw per statement: the order of evaluation of function arguments is unspecified (g++ and
+    // clang differ), and the scenes must not depend on the compiler.
+    const int cx = 40 + next(80), cy = 30 + next(60), rx = 8 + next(20), ry = 15 + next(30);
+    s.person(cx, cy, rx, ry, 1.5);
     for (int k = 0, holes = 5 + next(30); k < holes; ++k) {
       const int u0 = next(W), v0 = next(H), size = next(k < 3 ? 25 : 4);
       s.hole(u0, v0, std::min(W - 1, u0 + size), std::min(H - 1, v0 + size));
     }
     // Every other scene also gets a wide hole (a border band, a window): rows with long runs without
     // depth take the raster's parabola envelopes instead of the row scan.
-    if (trial % 2 == 1) s.hole(next(W / 2), next(H / 2), W - 1, next(H / 2) + H / 3);
+    if (trial % 2 == 1) {
+      const int u0 = next(W / 2), v0 = next(H / 2), v1 = next(H / 2) + H / 3;
+      s.hole(u0, v0, W - 1, v1);
+    }
     const Box<double> box{double(next(40)), double(next(30)), double(100 + next(60)), double(80 + next(40))};
     DepthMaskOptions o;  // robust, Nearest
     Mask m(W, H);
