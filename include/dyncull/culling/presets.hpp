@@ -126,7 +126,7 @@ PipelineOptions<T> recommended() {
   // A feature on a pixel without depth in a mover's box is culled, although as a segmentation the mask
   // gives such pixels to their nearest measured neighbour (DepthMaskOptions default, better IoU on the
   // real frame): on the silhouette such a track is dragged along the contour. Over six seeds the
-  // nearest-pixel labels raised precision by 0.01-0.02 but median ATE rose on static, xyz and rpy
+  // nearest-pixel labels raised precision by up to 0.02 but median ATE rose on static, xyz and rpy
   // (0.76 / 1.26 / 4.23 -> 0.87 / 2.51 / 5.14 cm; halfsphere 3.59 -> 2.85), docs/results.md.
   o.depth_mask.missing_depth = MissingDepth::InMask;
   o.use_probability = false;
