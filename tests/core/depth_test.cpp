@@ -74,4 +74,12 @@ TEST(DepthView, RowStrideSkipsPadding) {
   EXPECT_EQ(view.row_stride(), 3);
 }
 
+// Nguyen et al. 2012 (Kinect v1): 1.2 mm at 0.4 m, growing with the square of the distance beyond it.
+TEST(AxialDepthSigma, KinectModelAndItsParameters) {
+  EXPECT_DOUBLE_EQ(dyncull::axial_depth_sigma_m(0.4), 0.0012);
+  EXPECT_NEAR(dyncull::axial_depth_sigma_m(2.4), 0.0012 + 0.0019 * 4.0, 1e-15);
+  EXPECT_NEAR(dyncull::axial_depth_sigma_m(3.0f), 0.0012f + 0.0019f * 6.76f, 1e-7f);
+  EXPECT_DOUBLE_EQ(dyncull::axial_depth_sigma_m(1.0, 0.001, 0.01, 0.5), 0.001 + 0.01 * 0.25);
+}
+
 }  // namespace

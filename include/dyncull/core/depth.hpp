@@ -44,6 +44,15 @@ struct DepthView {
   double to_raw(double metres) const { return metres * static_cast<double>(units_per_metre); }
 };
 
+/// Axial (along the ray) depth noise of a structured-light sensor at z metres, sigma(z) = base +
+/// quadratic (z - reference)^2 (Nguyen, Izadi & Lovell 2012, Kinect v1: 0.0012, 0.0019, 0.4 m). Used by
+/// the sim to degrade depth and by the reprojection check to judge a depth residual.
+template <class T>
+T axial_depth_sigma_m(T z, T base = T(0.0012), T quadratic = T(0.0019), T reference = T(0.4)) {
+  const T dz = z - reference;
+  return base + quadratic * dz * dz;
+}
+
 /// True when a pixel within `radius` of (u, v) (sampled every 2 px beyond radius 2; pixels outside the
 /// image are not looked at) has no depth or differs from the depth at (u, v) by more than `ratio` of it:
 /// (u, v) lies near an occlusion edge or a hole. A centre without depth is not near an edge (nothing to

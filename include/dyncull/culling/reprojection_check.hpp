@@ -221,8 +221,8 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
   const T t_out = options.max_residual_px, t_in = options.max_residual_in_boxes_px;
   const bool use_depth = options.max_depth_residual_sigmas > T(0) && !depth.empty();
   auto depth_sigma = [&](T z) {
-    const T dz = z - options.depth_sigma_reference_m;
-    return options.depth_sigma_base_m + options.depth_sigma_quadratic * dz * dz;
+    return axial_depth_sigma_m(z, options.depth_sigma_base_m, options.depth_sigma_quadratic,
+                               options.depth_sigma_reference_m);
   };
   for (std::size_t i = 0; i < n; ++i) {
     if (valid && !valid[i]) continue;

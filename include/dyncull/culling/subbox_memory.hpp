@@ -59,7 +59,7 @@ class SubBoxMemory {
     }
   }
 
-  /// Stores the cells this frame's own votes made dynamic (the ratio rule of `options`; not merged
+  /// Stores the cells this frame's own votes made dynamic (detail::subbox_cell_vote; not merged
   /// cells, not the whole-box rule: those are inferences, remembering them would spread them) and
   /// forgets boxes unseen for more than `frames` frames.
   template <class T>
@@ -76,11 +76,9 @@ class SubBoxMemory {
         m->id = box_ids[b];
       }
       m->last_seen = frame;
-      for (std::size_t c = 0; c < cpb; ++c) {
-        const std::uint32_t dyn = votes.dyn_count[b * cpb + c], stat = votes.static_count[b * cpb + c];
-        const std::uint32_t total = dyn + stat;
-        if (total > 0 && total >= options.min_points && T(dyn) >= options.sigma1 * T(total)) m->last_dynamic[c] = frame;
-      }
+      for (std::size_t c = 0; c < cpb; ++c)
+        if (detail::subbox_cell_vote(votes.dyn_count[b * cpb + c], votes.static_count[b * cpb + c], options) == 1)
+          m->last_dynamic[c] = frame;
     }
     const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
     boxes_.erase(std::remove_if(boxes_.begin(), boxes_.end(),

@@ -83,6 +83,15 @@ int subbox_cell(const Box<T>& b, int grid, T x, T y) {
   return cy * grid + cx;
 }
 
+/// The vote of one cell from its counts (Algorithm 1 l. 3-12): 2 = empty (fewer than min_points labelled
+/// features), 1 = dynamic (dyn / (dyn + static) >= sigma1), 0 = static.
+template <class T>
+std::uint8_t subbox_cell_vote(std::uint32_t dyn, std::uint32_t stat, const SubBoxOptions<T>& options) {
+  const std::uint32_t total = dyn + stat;
+  if (total < options.min_points || total == 0) return 2;
+  return T(dyn) >= options.sigma1 * T(total) ? 1 : 0;
+}
+
 /// Whether feature i belongs to box b's object (no mask given: every feature does).
 inline bool subbox_in_object(const std::uint8_t* in_object, const std::uint32_t* box_bits, std::size_t i, std::size_t b) {
   if (box_bits && b < 32) return ((box_bits[i] >> b) & 1u) != 0;
@@ -156,11 +165,7 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
     const std::uint32_t* dc = r.dyn_count.data() + b * cells_per_box;
     const std::uint32_t* sc = r.static_count.data() + b * cells_per_box;
     std::uint8_t st[64];  // voted states; merging reads these, so it never chains
-    for (std::size_t c = 0; c < cells_per_box; ++c) {
-      const std::uint32_t total = dc[c] + sc[c];
-      if (total < options.min_points || total == 0) st[c] = 2;
-      else st[c] = T(dc[c]) >= options.sigma1 * T(total) ? 1 : 0;
-    }
+    for (std::size_t c = 0; c < cells_per_box; ++c) st[c] = detail::subbox_cell_vote(dc[c], sc[c], options);
     // Merge (Algorithm 1 line 14) in one pass against the voted dynamic cells, so merging does not chain.
     SubBoxVote& vote = r.votes[b];
     for (int row = 0; row < g; ++row)

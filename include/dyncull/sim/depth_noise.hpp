@@ -4,6 +4,8 @@
 /// (1/5000 m), holes at depth discontinuities, a border band and the sensor's range limits.
 #pragma once
 
+#include "dyncull/core/depth.hpp"
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -23,8 +25,7 @@ struct DepthNoiseOptions {
 
 /// Axial standard deviation of the depth at z metres.
 inline double kinect_depth_sigma_m(double z, const DepthNoiseOptions& options = {}) {
-  const double dz = z - options.sigma_reference_m;
-  return options.sigma_base_m + options.sigma_quadratic * dz * dz;
+  return axial_depth_sigma_m(z, options.sigma_base_m, options.sigma_quadratic, options.sigma_reference_m);
 }
 
 namespace detail {
