@@ -267,8 +267,8 @@ int main(int argc, char** argv) {
     for (const auto& r : reports)
       for (const auto& run : r.runs)
         if (run.spec.culls)
-          std::printf("\n%s / %s: instance truth decision reason count\n%s", r.name.c_str(), run.spec.name.c_str(),
-                      run.breakdown.format().c_str());
+          std::printf("\n%s / %s: instance truth decision reason count\n%s%s", r.name.c_str(), run.spec.name.c_str(),
+                      run.breakdown.format().c_str(), run.recall_by_speed.format().c_str());
   }
   const std::string md = args.out + "/results.md";
   std::ofstream(md) << table;

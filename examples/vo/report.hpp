@@ -151,6 +151,61 @@ struct LabelBreakdown {
   }
 };
 
+/// Recall of the moving features by how far their surface moved since the previous frame (sim truth,
+/// FrameData::motion_m), overall and per sim instance, for dynamic_vo --diagnose: it tells slow movers,
+/// which no geometric check sees within a few frames, from fast ones the culling missed for other reasons.
+struct RecallBySpeed {
+  static constexpr int kBands = 4, kInstances = LabelBreakdown::kInstances;
+  static constexpr float kUpperMm[kBands - 1] = {2.f, 5.f, 10.f};  ///< band edges, mm per frame
+  std::array<std::size_t, kInstances * kBands> moving{}, culled{};
+
+  void add(const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep, const cv::Mat& is_moving,
+           const cv::Mat& motion_m, const cv::Mat& instance) {
+    if (is_moving.empty() || motion_m.empty() || motion_m.type() != CV_32FC1 || instance.type() != CV_16UC1) return;
+    for (std::size_t i = 0; i < px.size(); ++i) {
+      const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
+      if (u < 0 || v < 0 || u >= is_moving.cols || v >= is_moving.rows || !is_moving.at<std::uint8_t>(v, u)) continue;
+      const float mm = 1000.f * motion_m.at<float>(v, u);
+      int band = 0;
+      while (band < kBands - 1 && !(mm < kUpperMm[band])) ++band;
+      const int inst = std::min<int>(instance.at<std::uint16_t>(v, u), kInstances - 1);
+      const auto cell = static_cast<std::size_t>(inst * kBands + band);
+      ++moving[cell];
+      culled[cell] += i < keep.size() && keep[i] == 0;
+    }
+  }
+  /// One line for all moving features and one per instance: "band culled/moving (recall)".
+  std::string format() const {
+    static const char* bands[kBands] = {"< 2 mm", "2-5 mm", "5-10 mm", ">= 10 mm"};
+    static const char* names[kInstances] = {"background", "walker_a", "walker_b", "sitting_person",
+                                            "pushed_chair", "sitting_chair", "tv", "other"};
+    std::ostringstream o;
+    auto line = [&](const char* name, int first, int last) {
+      std::size_t total = 0;
+      std::ostringstream l;
+      l << "    recall by surface motion per frame, " << name << ":";
+      for (int b = 0; b < kBands; ++b) {
+        std::size_t m = 0, c = 0;
+        for (int k = first; k <= last; ++k) {
+          m += moving[static_cast<std::size_t>(k * kBands + b)];
+          c += culled[static_cast<std::size_t>(k * kBands + b)];
+        }
+        total += m;
+        l << "  " << bands[b] << " " << c << "/" << m;
+        if (m > 0) {
+          char buf[16];
+          std::snprintf(buf, sizeof buf, " (%.2f)", static_cast<double>(c) / static_cast<double>(m));
+          l << buf;
+        }
+      }
+      if (total > 0) o << l.str() << "\n";
+    };
+    line("all", 0, kInstances - 1);
+    for (int k = 0; k < kInstances; ++k) line(names[k], k, k);
+    return o.str();
+  }
+};
+
 /// A distinct colour per strategy (BGR), ground truth is black.
 inline cv::Scalar strategy_colour(std::size_t i) {
   static const std::array<cv::Scalar, 8> colours = {cv::Scalar(40, 40, 220),  cv::Scalar(40, 160, 40),

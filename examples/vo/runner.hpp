@@ -43,6 +43,7 @@ struct StrategyRun {
   eval::Trajectory<double> estimate;
   LabelCounts labels;
   LabelBreakdown breakdown;  ///< filled when RunnerOptions::diagnose
+  RecallBySpeed recall_by_speed;  ///< filled when RunnerOptions::diagnose (sim only)
   double cull_ms = 0, front_end_ms = 0;  ///< totals over the frames
   std::size_t frames = 0, fallbacks = 0, keyframes = 0, tracks = 0, kept = 0, inliers = 0;
   // Evaluation.
@@ -128,9 +129,11 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
       const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
       if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
-      if (options.diagnose)
+      if (options.diagnose) {
         run.breakdown.add(fe.tracks().cur_px, keep, cullers[k].reasons(), cullers[k].kept_why(), frame.moving,
                           frame.instance);
+        run.recall_by_speed.add(fe.tracks().cur_px, keep, frame.moving, frame.motion_m, frame.instance);
+      }
       if (draw && k == draw_strategy && fe.tracks().size() > 0) {
         source.load_colour(&frame);
         char file[64];

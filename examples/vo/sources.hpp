@@ -35,6 +35,7 @@ struct SequenceFrame {
   cv::Mat depth_m;  ///< CV_32FC1 metres, 0 = no measurement
   cv::Mat moving;   ///< CV_8UC1, 1 where the surface moves; empty when there is no truth
   cv::Mat instance; ///< CV_16UC1 sim instance ids (sim::SceneInstance); empty when there is no truth
+  cv::Mat motion_m; ///< CV_32FC1 sim: metres the surface moved since the previous frame (sim::FrameData)
   std::vector<Detection<float>> detections;
   bool has_truth_pose = false;
   Rigid3<double> truth_world_from_cam;
@@ -68,6 +69,7 @@ class SimSource {
     out->depth_m = cv::Mat(h, w, CV_32FC1, data_.depth_m.data());
     out->moving = data_.moving.size() == data_.gray.size() ? cv::Mat(h, w, CV_8UC1, data_.moving.data()) : cv::Mat();
     out->instance = data_.instance.size() == data_.gray.size() ? cv::Mat(h, w, CV_16UC1, data_.instance.data()) : cv::Mat();
+    out->motion_m = data_.motion_m.size() == data_.gray.size() ? cv::Mat(h, w, CV_32FC1, data_.motion_m.data()) : cv::Mat();
     out->detections = data_.detections;
     out->has_truth_pose = true;
     out->truth_world_from_cam = data_.world_from_cam;
@@ -206,6 +208,7 @@ class TumSource {
     out->depth_m = depth_;
     out->moving.release();
     out->instance.release();
+    out->motion_m.release();
     out->detections.clear();
     if (has_detections_) {
       auto it = detections_.find(detail::stem(p.rgb.path));

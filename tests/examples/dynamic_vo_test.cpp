@@ -8,6 +8,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -108,6 +109,45 @@ TEST(DynamicVo, LabelCountsAgainstTruth) {
   EXPECT_DOUBLE_EQ(c.recall(), 2.0 / 3.0);
   vo::LabelCounts empty;
   EXPECT_TRUE(std::isnan(empty.precision()));
+}
+
+// --diagnose: recall of the moving features split by their truth speed (mm a frame) and instance; static
+// features and points outside the image are not counted, a band edge belongs to the faster band.
+TEST(DynamicVo, RecallBySpeedBandsAndInstances) {
+  cv::Mat moving(10, 10, CV_8UC1, cv::Scalar(0));
+  moving(cv::Rect(0, 0, 5, 10)).setTo(1);  // left half moves
+  cv::Mat motion(10, 10, CV_32FC1, cv::Scalar(0));
+  motion.at<float>(1, 1) = 0.001f;   // < 2 mm
+  motion.at<float>(2, 2) = 0.002f;   // 2-5 mm (edge)
+  motion.at<float>(3, 3) = 0.012f;   // >= 10 mm
+  motion.at<float>(4, 4) = 0.012f;   // >= 10 mm
+  cv::Mat instance(10, 10, CV_16UC1, cv::Scalar(1));
+  instance.at<std::uint16_t>(4, 4) = 3;
+  const std::vector<cv::Point2f> px = {{1, 1}, {2, 2}, {3, 3}, {4, 4}, {7, 7}, {50, 50}};
+  const std::vector<std::uint8_t> keep = {0, 1, 0, 1, 0, 0};
+  vo::RecallBySpeed r;
+  r.add(px, keep, moving, motion, instance);
+  const auto at = [](const std::array<std::size_t, vo::RecallBySpeed::kInstances * vo::RecallBySpeed::kBands>& a,
+                     int inst, int band) { return a[static_cast<std::size_t>(inst * vo::RecallBySpeed::kBands + band)]; };
+  EXPECT_EQ(at(r.moving, 1, 0), 1u);
+  EXPECT_EQ(at(r.culled, 1, 0), 1u);
+  EXPECT_EQ(at(r.moving, 1, 1), 1u);
+  EXPECT_EQ(at(r.culled, 1, 1), 0u);
+  EXPECT_EQ(at(r.moving, 1, 3), 1u);
+  EXPECT_EQ(at(r.culled, 1, 3), 1u);
+  EXPECT_EQ(at(r.moving, 3, 3), 1u);
+  EXPECT_EQ(at(r.culled, 3, 3), 0u);
+  std::size_t total = 0;
+  for (std::size_t m : r.moving) total += m;
+  EXPECT_EQ(total, 4u);
+  const std::string text = r.format();
+  EXPECT_NE(text.find("all:  < 2 mm 1/1 (1.00)  2-5 mm 0/1 (0.00)  5-10 mm 0/0  >= 10 mm 1/2 (0.50)"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("sitting_person:"), std::string::npos) << text;
+  EXPECT_EQ(text.find("background:"), std::string::npos) << text;  // no moving features there
+  vo::RecallBySpeed none;
+  none.add(px, keep, moving, cv::Mat(), instance);  // no truth (TUM): nothing counted
+  EXPECT_EQ(none.format().find("all:"), std::string::npos);
 }
 
 // rgb.txt / depth.txt association (nearest within 0.02 s), depth scale 5000 and YOLO detections.
