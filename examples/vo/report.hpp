@@ -131,10 +131,14 @@ struct LabelBreakdown {
       ++at(instance.at<std::uint16_t>(v, u), moving.at<std::uint8_t>(v, u) != 0, i < keep.size() && keep[i] == 0, cell);
     }
   }
-  /// One line per non-empty cell: "instance truth decision reason count".
-  std::string format() const {
+  /// Name of a sim instance id (sim::SceneInstance order; ids past the table are "other").
+  static const char* instance_name(int instance) {
     static const char* names[kInstances] = {"background", "walker_a", "walker_b", "sitting_person",
                                             "pushed_chair", "sitting_chair", "tv", "other"};
+    return names[instance < 0 || instance >= kInstances ? kInstances - 1 : instance];
+  }
+  /// One line per non-empty cell: "instance truth decision reason count".
+  std::string format() const {
     std::ostringstream o;
     for (int inst = 0; inst < kInstances; ++inst)
       for (int mv = 0; mv < 2; ++mv)
@@ -142,7 +146,7 @@ struct LabelBreakdown {
           for (int cell = 0; cell < kCells; ++cell) {
             const std::size_t c = counts[static_cast<std::size_t>(((inst * 2 + mv) * 2 + cu) * kCells + cell)];
             if (c == 0) continue;
-            o << "    " << names[inst] << (mv ? " moving " : " static ") << (cu ? "culled " : "kept   ");
+            o << "    " << instance_name(inst) << (mv ? " moving " : " static ") << (cu ? "culled " : "kept   ");
             if (cell < kReasons) o << to_string(static_cast<CullReason>(cell));
             else o << "none " << to_string(static_cast<KeptWhy>(cell - kReasons));
             o << " " << c << "\n";
@@ -177,8 +181,6 @@ struct RecallBySpeed {
   /// One line for all moving features and one per instance: "band culled/moving (recall)".
   std::string format() const {
     static const char* bands[kBands] = {"< 2 mm", "2-5 mm", "5-10 mm", ">= 10 mm"};
-    static const char* names[kInstances] = {"background", "walker_a", "walker_b", "sitting_person",
-                                            "pushed_chair", "sitting_chair", "tv", "other"};
     std::ostringstream o;
     auto line = [&](const char* name, int first, int last) {
       std::size_t total = 0;
@@ -201,7 +203,7 @@ struct RecallBySpeed {
       if (total > 0) o << l.str() << "\n";
     };
     line("all", 0, kInstances - 1);
-    for (int k = 0; k < kInstances; ++k) line(names[k], k, k);
+    for (int k = 0; k < kInstances; ++k) line(LabelBreakdown::instance_name(k), k, k);
     return o.str();
   }
 };
