@@ -55,10 +55,10 @@ struct FrontEndOptions {
   /// (the homography K R K^-1 of a point at infinity; what is left, parallax and the prediction's error, is
   /// a shift LK handles). Without it the tracks of a turning camera (rpy: up to 0.8 deg a frame) are not
   /// refined from 5 deg on and their LK error adds up again. Measured on the sim, `dynamic_vo --sequences
-  /// rpy --seeds 1-6`, oracle culling: median ATE 2.64 -> 1.32 cm (better on 5 of 6 seeds), recommended
-  /// preset 4.22 -> 2.41 cm; halfsphere never turns 5 deg from its keyframe and is unchanged; the front
-  /// end costs about 1.5 ms more per rpy frame (docs/results.md). (Warping from 2 deg on was no better on
-  /// rpy and worse on halfsphere: the warped, resampled patch is slightly blurred.)
+  /// rpy --seeds 1-6`, oracle culling: median ATE 2.64 -> 1.31 cm (better on 5 of 6 seeds), recommended
+  /// preset 4.22 -> 2.41 cm; static, xyz and halfsphere hardly ever turn 5 deg from their keyframe (one
+  /// run each changed); the front end costs 0.7 ms more per rpy frame (0.4-1.3 ms; docs/results.md).
+  /// (Warping from 2 deg on was no better on rpy and worse on halfsphere: the resampled patch is blurred.)
   bool refine_rotation_compensated = true;
   double pnp_threshold_px = 2.0;      ///< reprojection inlier threshold of PnP-RANSAC
   double track_max_error_px = 4.0;    ///< tracks (kept or culled) further than this from their point's
