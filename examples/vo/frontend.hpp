@@ -379,11 +379,7 @@ class FrontEnd {
     if (kf_from_cam_rotation) {
       // kf_from_cam maps a current-frame pixel to where a point at infinity was in the keyframe,
       // x_kf ~ K R x_cam; the warped keyframe W(x) = kf(kf_from_cam x) looks like the current frame.
-      Mat3<double> K = Mat3<double>::Identity();
-      K(0, 0) = camera_.fx;
-      K(1, 1) = camera_.fy;
-      K(0, 2) = camera_.cx;
-      K(1, 2) = camera_.cy;
+      const Mat3<double> K = camera_.K();
       const Mat3<double> kf_from_cam = K * *kf_from_cam_rotation * K.inverse();
       const Mat3<double> cam_from_kf = kf_from_cam.inverse();
       const cv::Matx33d h(kf_from_cam(0, 0), kf_from_cam(0, 1), kf_from_cam(0, 2), kf_from_cam(1, 0), kf_from_cam(1, 1),

@@ -199,11 +199,7 @@ double rolled_track_rms_px(bool rotation_compensated, int frames) {
   }
   cv::GaussianBlur(canvas, canvas, cv::Size(3, 3), 0.8);
   const double ox = 600 - cam.cx, oy = 600 - cam.cy;  // frame 0's pixel (0, 0) on the canvas
-  Mat3<double> K = Mat3<double>::Identity();
-  K(0, 0) = cam.fx;
-  K(1, 1) = cam.fy;
-  K(0, 2) = cam.cx;
-  K(1, 2) = cam.cy;
+  const Mat3<double> K = cam.K();
   auto frame0_from_frame = [&](int k) {  // pixel of frame k -> pixel of frame 0 (roll about the optical axis)
     const double a = k * Constants<double>::deg_to_rad();
     Mat3<double> R;
@@ -249,6 +245,7 @@ TEST(DynamicVo, RefinementAgainstTurnedKeyframeKeepsRolledTracksAccurate) {
   std::printf("RMS track error after a 15 deg roll: %.3f px compensated, %.3f px frame to frame\n", compensated,
               frame_to_frame);
   EXPECT_LT(compensated, 0.5 * frame_to_frame);
+  EXPECT_LT(compensated, 0.1);  // measured 0.017 px (frame to frame 1.19 px)
 }
 
 TEST(DynamicVo, TumSourceReadsDirectory) {
