@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -188,16 +189,21 @@ TEST(DynamicVo, SeedSummaryGivesMediansAndPooledLabels) {
 // The front end's refinement against the keyframe when the camera rolls 1 deg a frame over a textured
 // plane 2 m away (pure rotation: every pixel's truth is the homography K R K^-1 of its keyframe position).
 // Returns the tracks' RMS error against that truth after `frames` frames, or -1 when a keyframe was made.
-double rolled_track_rms_px(bool rotation_compensated, int frames) {
-  const PinholeCamera<double> cam{525, 525, 319.5, 239.5, 640, 480};
-  // Random grey rectangles on a larger canvas: corners for ORB, texture for LK, no empty border when turned.
-  cv::Mat canvas(1200, 1200, CV_8UC1, cv::Scalar(128));
+// Random grey rectangles: corners for ORB, texture for LK.
+cv::Mat rectangle_texture(int size) {
+  cv::Mat canvas(size, size, CV_8UC1, cv::Scalar(128));
   cv::RNG rng(12345);
-  for (int i = 0; i < 3000; ++i) {
-    const int x = rng.uniform(0, 1190), y = rng.uniform(0, 1190);
+  for (int i = 0; i < size * size / 480; ++i) {
+    const int x = rng.uniform(0, size - 10), y = rng.uniform(0, size - 10);
     cv::rectangle(canvas, cv::Rect(x, y, rng.uniform(4, 30), rng.uniform(4, 30)), cv::Scalar(rng.uniform(0, 256)), -1);
   }
   cv::GaussianBlur(canvas, canvas, cv::Size(3, 3), 0.8);
+  return canvas;
+}
+
+double rolled_track_rms_px(bool rotation_compensated, int frames) {
+  const PinholeCamera<double> cam{525, 525, 319.5, 239.5, 640, 480};
+  const cv::Mat canvas = rectangle_texture(1200);  // larger than the image: no empty border when turned
   const double ox = 600 - cam.cx, oy = 600 - cam.cy;  // frame 0's pixel (0, 0) on the canvas
   const Mat3<double> K = cam.K();
   auto frame0_from_frame = [&](int k) {  // pixel of frame k -> pixel of frame 0 (roll about the optical axis)
@@ -246,6 +252,54 @@ TEST(DynamicVo, RefinementAgainstTurnedKeyframeKeepsRolledTracksAccurate) {
               frame_to_frame);
   EXPECT_LT(compensated, 0.5 * frame_to_frame);
   EXPECT_LT(compensated, 0.1);  // measured 0.017 px (frame to frame 1.19 px)
+}
+
+// At a keyframe the budget freed by the tracks the culling removed is not spent on new corners next to
+// them (they would be on the same mover, seen with a one-frame baseline); without the option it is.
+TEST(DynamicVo, NewCornersKeepAwayFromCulledTracks) {
+  const PinholeCamera<double> cam{525, 525, 319.5, 239.5, 640, 480};
+  const cv::Mat texture = rectangle_texture(640)(cv::Rect(0, 0, 640, 480)).clone();
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(2.f));
+  auto new_corners_near_culled = [&](bool away, std::size_t* culled) {
+    vo::FrontEndOptions options;
+    options.detect_away_from_culled = away;
+    options.keyframe_min_inliers = 100000;  // every frame becomes a keyframe
+    vo::FrontEnd front_end(cam, options);
+    front_end.track(vo::FrameInput{0.0, texture, depth});
+    front_end.estimate({});
+    front_end.track(vo::FrameInput{1 / 30.0, texture, depth});
+    // Cull every track in the left half of the image (a "mover" there).
+    const vo::Tracks& before = front_end.tracks();
+    std::vector<std::uint8_t> keep(before.size(), 1);
+    std::vector<cv::Point2f> culled_px;
+    for (std::size_t i = 0; i < before.size(); ++i)
+      if (before.cur_px[i].x < 320) {
+        keep[i] = 0;
+        culled_px.push_back(before.cur_px[i]);
+      }
+    std::set<std::uint32_t> old_ids(before.ids.begin(), before.ids.end());
+    EXPECT_TRUE(front_end.estimate(keep).keyframe);
+    *culled = culled_px.size();
+    std::size_t near = 0;
+    const vo::Tracks& after = front_end.tracks();
+    const double r = options.min_feature_distance_px;
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      if (old_ids.count(after.ids[i])) continue;  // a track carried over, not a new corner
+      for (const cv::Point2f& c : culled_px)
+        if (std::hypot(after.cur_px[i].x - c.x, after.cur_px[i].y - c.y) < r - 1) {
+          ++near;
+          break;
+        }
+    }
+    return near;
+  };
+  std::size_t culled_away = 0, culled_plain = 0;
+  const std::size_t near_away = new_corners_near_culled(true, &culled_away);
+  const std::size_t near_plain = new_corners_near_culled(false, &culled_plain);
+  ASSERT_GT(culled_away, 100u) << "too few tracks in the culled half";
+  std::printf("new corners near culled tracks: %zu with the option, %zu without (%zu culled)\n", near_away, near_plain, culled_away);
+  EXPECT_EQ(near_away, 0u);
+  EXPECT_GT(near_plain, 50u) << "without the option the freed budget goes back to the culled half";
 }
 
 TEST(DynamicVo, TumSourceReadsDirectory) {
