@@ -36,7 +36,7 @@ struct FrontEndOptions {
   /// a one-frame baseline only (a keyframe resets every track's reference). Measured on the sim,
   /// `dynamic_vo` seeds 1-12, four sequences: recommended preset summed ATE static / xyz / rpy /
   /// halfsphere 12.2 / 27.7 / 30.0 / 30.8 -> 10.0 / 17.2 / 29.1 / 30.2 cm, oracle 5.2 / 14.5 / 19.4 /
-  /// 24.6 -> 4.8 / 13.0 / 15.7 / 19.1 cm; label recall 0.00-0.05 lower (docs/results.md, session 10).
+  /// 24.6 -> 4.8 / 13.0 / 15.7 / 19.1 cm; label recall up to 0.06 lower (docs/results.md, session 10).
   /// No effect without culling.
   bool detect_away_from_culled = true;
   int border_px = 12;                 ///< no features this close to the edge (Kinect depth band, LK window)
