@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 namespace dyncull {
 namespace {
 
@@ -57,6 +59,28 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);
   EXPECT_EQ(o.min_survivors, 30u);
   EXPECT_FLOAT_EQ(o.detections.box_padding_px, 5.f);
+  EXPECT_DOUBLE_EQ(o.depth_mask.eps_m, 0.5);  // 000's range is 0.3-0.5 m; see the test below
+}
+
+// The recommended preset's object band reaches 0.5 m behind the centre depth (000's eps range is 0.3-0.5 m):
+// the far side of a close, oblique walker 0.4 m behind its torso is in the object; the background is not.
+TEST(Presets, RecommendedBandTakesInTheFarSideOfACloseWalker) {
+  const int w = 100, h = 100;
+  std::vector<float> depth(static_cast<std::size_t>(w * h), 3.0f);  // background wall at 3 m
+  for (int r = 0; r < h; ++r)
+    for (int c = 30; c <= 72; ++c) depth[static_cast<std::size_t>(r * w + c)] = c <= 60 ? 0.85f : 1.25f;
+  const DepthView<float> view{depth.data(), w, h, 0, 1.f, 0.4f, 8.f};
+  const std::vector<Box<float>> boxes = {Box<float>{20, 0, 80, 99}};
+  const std::vector<Vec2<float>> points = {{45, 50}, {66, 50}, {25, 50}};  // torso, far side, wall
+  const DepthMaskResult recommended = depth_mask(view, boxes, points, presets::recommended<float>().depth_mask);
+  ASSERT_TRUE(recommended.ok()) << recommended.reason;
+  EXPECT_EQ(recommended.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(recommended.labels[1], FeatureLabel::Dynamic);
+  EXPECT_EQ(recommended.labels[2], FeatureLabel::Static);
+  const DepthMaskResult plain_eps = depth_mask(view, boxes, points, DepthMaskOptions{});  // eps 0.3 m
+  ASSERT_TRUE(plain_eps.ok()) << plain_eps.reason;
+  EXPECT_EQ(plain_eps.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(plain_eps.labels[1], FeatureLabel::Static);
 }
 
 TEST(Presets, DefaultsOfTheGeometricOptions) {
