@@ -186,9 +186,6 @@ TEST(DynamicVo, SeedSummaryGivesMediansAndPooledLabels) {
   EXPECT_NE(table.find("| 0.833 | 0.526 |"), std::string::npos) << table;
 }
 
-// The front end's refinement against the keyframe when the camera rolls 1 deg a frame over a textured
-// plane 2 m away (pure rotation: every pixel's truth is the homography K R K^-1 of its keyframe position).
-// Returns the tracks' RMS error against that truth after `frames` frames, or -1 when a keyframe was made.
 // Random grey rectangles: corners for ORB, texture for LK.
 cv::Mat rectangle_texture(int size) {
   cv::Mat canvas(size, size, CV_8UC1, cv::Scalar(128));
@@ -201,6 +198,9 @@ cv::Mat rectangle_texture(int size) {
   return canvas;
 }
 
+// The front end's refinement against the keyframe when the camera rolls 1 deg a frame over a textured
+// plane 2 m away (pure rotation: every pixel's truth is the homography K R K^-1 of its keyframe position).
+// Returns the tracks' RMS error against that truth after `frames` frames, or -1 when a keyframe was made.
 double rolled_track_rms_px(bool rotation_compensated, int frames) {
   const PinholeCamera<double> cam{525, 525, 319.5, 239.5, 640, 480};
   const cv::Mat canvas = rectangle_texture(1200);  // larger than the image: no empty border when turned

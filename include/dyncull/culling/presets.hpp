@@ -131,8 +131,8 @@ PipelineOptions<T> recommended() {
   o.depth_mask.missing_depth = MissingDepth::InMask;
   // The top of 000's eps range (0.3-0.5 m; DepthMaskOptions keeps 0.3, the best fit on the real TUM frame's
   // mask): a walker within a metre of the camera, seen obliquely, reaches more than 0.3 m behind its centre
-  // depth, and its far side was left out of the band (rpy seed 9: ~95 of its features a frame, the pose
-  // pulled 20 cm). With the session 10 front end, twelve seeds, four sequences: summed ATE static / xyz /
+  // depth, and its far side was left out of the band (rpy seed 9: up to 97 of the walkers' features a frame,
+  // the pose pulled 20 cm). With the session 10 front end, twelve seeds, four sequences: summed ATE static / xyz /
   // rpy / halfsphere 10.0 / 17.2 / 29.1 / 30.2 -> 7.8 / 18.1 / 21.8 / 26.2 cm, median cut rpy 84.2 -> 88.7 %,
   // recall +0.01 to +0.04, precision within 0.01, static in boxes kept 0.97-0.99 (docs/results.md).
   o.depth_mask.eps_m = 0.5;
