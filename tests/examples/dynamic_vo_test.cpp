@@ -302,6 +302,40 @@ TEST(DynamicVo, NewCornersKeepAwayFromCulledTracks) {
   EXPECT_GT(near_plain, 50u) << "without the option the freed budget goes back to the culled half";
 }
 
+// A keyframe every keyframe_max_translation_m of travel (default 0.1 m): the camera slides sideways
+// 3 cm a frame in front of a textured plane 2 m away, so the other keyframe rules (inliers, tracked
+// share, turn) stay quiet and the first keyframe after frame 0 is the one past 0.1 m, frame 4 (0.12 m).
+// frames_since_keyframe() counts the frames in between.
+TEST(DynamicVo, KeyframeAfterTenCentimetresOfTravel) {
+  const PinholeCamera<double> cam{525, 525, 319.5, 239.5, 640, 480};
+  const cv::Mat canvas = rectangle_texture(1200);
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(2.f));
+  const vo::FrontEndOptions options;
+  EXPECT_DOUBLE_EQ(options.keyframe_max_translation_m, 0.1);
+  vo::FrontEnd front_end(cam, options);
+  constexpr double kStepM = 0.03, kDepthM = 2.0;
+  int first_keyframe = -1;
+  for (int k = 0; k <= 8 && first_keyframe < 0; ++k) {
+    // Camera at x = k * step: the plane's texture moves left by f * x / Z pixels.
+    const double shift_px = cam.fx * kStepM * k / kDepthM;
+    const cv::Matx23d canvas_from_frame(1, 0, 300 + shift_px, 0, 1, 300);
+    cv::Mat gray;
+    cv::warpAffine(canvas, gray, canvas_from_frame, cv::Size(640, 480), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    front_end.track(vo::FrameInput{k / 30.0, gray, depth});
+    const int since_keyframe = front_end.frames_since_keyframe();  // the culling's baseline (evidence_frames)
+    const vo::FrameStats stats = front_end.estimate(std::vector<std::uint8_t>(front_end.tracks().size(), 1));
+    if (k > 0) {
+      EXPECT_EQ(since_keyframe, k);
+      ASSERT_FALSE(stats.fallback) << "frame " << k << ": " << stats.reason;
+      const double error_m = (front_end.world_from_cam().t - Vec3<double>(kStepM * k, 0, 0)).norm();
+      EXPECT_LT(error_m, 0.005) << "frame " << k << ": pose off the truth";
+    }
+    if (k > 0 && stats.keyframe) first_keyframe = k;
+  }
+  EXPECT_EQ(first_keyframe, 4);
+  EXPECT_EQ(front_end.frames_since_keyframe(), 0);
+}
+
 TEST(DynamicVo, TumSourceReadsDirectory) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "dyncull_dynamic_vo_test_tum";
   std::filesystem::create_directories(dir / "rgb");
