@@ -69,9 +69,10 @@ class Culler {
   Culler(const StrategySpec& spec, const PinholeCamera<double>& camera)
       : spec_(spec), camera_(camera.cast<float>()) {}
 
-  /// keep[i] != 0 for the tracks PnP may use. `predicted_world_from_cam`: the motion-model pose.
+  /// keep[i] != 0 for the tracks PnP may use. `predicted_world_from_cam`: the motion-model pose;
+  /// `frames_since_keyframe`: FrontEnd::frames_since_keyframe() (the baseline of tracks from the keyframe).
   void cull(const SequenceFrame& frame, const Tracks& tracks, const Rigid3<double>& predicted_world_from_cam,
-            std::vector<std::uint8_t>* keep) {
+            int frames_since_keyframe, std::vector<std::uint8_t>* keep) {
     keep->assign(tracks.size(), 1);
     reasons_.assign(tracks.size(), CullReason::None);
     kept_why_.assign(tracks.size(), KeptWhy::NotExplained);
@@ -98,6 +99,7 @@ class Culler {
     f.camera = camera_;
     f.cam_from_world = &pose_;
     f.is_keyframe = frame_index_ % kReferenceEvery == 1;
+    f.evidence_frames = spec_.tracks_from_keyframe ? frames_since_keyframe : 1;
     const PipelineResult<float>& r = cull_frame(f, spec_.pipeline, &state_);
     if (r.keep.size() == tracks.size()) {
       *keep = r.keep;

@@ -124,7 +124,7 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       fe.track(input);
       const double track_ms = detail::ms_since(t0);
       const auto t1 = std::chrono::steady_clock::now();
-      cullers[k].cull(frame, fe.tracks(), fe.predicted_world_from_cam(), &keep);
+      cullers[k].cull(frame, fe.tracks(), fe.predicted_world_from_cam(), fe.frames_since_keyframe(), &keep);
       run.cull_ms += detail::ms_since(t1);
       // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
       const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));

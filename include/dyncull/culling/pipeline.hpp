@@ -118,6 +118,15 @@ struct PipelineOptions {
   int edge_evidence_radius_px = 0;
   double edge_depth_step_ratio = 0.05;
 
+  /// Shortest baseline, in frames (CullingFrame::evidence_frames), at which the geometric labels may make
+  /// part of a dynamic-class box static through the sub-box vote. Over fewer frames a slow mover has not
+  /// moved past the thresholds (a walker at 0.4 m/s covers 13 mm a frame, at 2.5 m about 2.8 px sideways
+  /// and nothing along the ray), so "not flagged" says nothing: the sub-box refinement is skipped and the
+  /// box rule decides (high-level objects culled, candidates on their own flags). A front end that
+  /// measures against its keyframe has such frames right after each keyframe, when its corners on the
+  /// movers are new. 0 = off; frames with evidence_frames 0 (unknown) are never affected.
+  int min_evidence_frames = 0;
+
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
   /// all culling. ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
@@ -214,6 +223,9 @@ struct CullingFrame {
   PinholeCamera<T> camera{};
   const Rigid3<T>* cam_from_world = nullptr;  ///< current pose (a motion-model prediction is enough)
   bool is_keyframe = false;  ///< store this frame's static features with depth as a multi-view reference
+  /// Frames between the reference of prev_keypoints / points_3d and this frame (1: the previous frame;
+  /// a keyframe-based front end: frames since its keyframe); 0 = unknown. See min_evidence_frames.
+  int evidence_frames = 0;
 };
 
 namespace detail {
@@ -526,6 +538,10 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       r.subbox.reason = "needs geometric labels (moving consistency or reprojection), unavailable this frame";
     } else if (!have_boxes) {
       r.subbox.reason = "no dynamic-class boxes";
+    } else if (options.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
+               frame.evidence_frames < options.min_evidence_frames) {
+      r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
+                        " frame(s) too short for static evidence (min_evidence_frames): the box rule decides";
     } else if (options.subbox_requires_fit_outside_boxes && !geo_fit_outside_boxes &&
                std::any_of(s.in_dyn_box.begin(), s.in_dyn_box.end(), [](std::uint8_t f) { return f != 0; })) {
       r.subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "

@@ -101,7 +101,8 @@ PipelineOptions<T> zhang_2023() {
 /// by the geometric check fitted outside boxes (003 + SG-SLAM: the RGB-D reprojection check when the
 /// caller gives 3-D points, with the depth residual, else the epipolar one; flags within 8 px of a depth
 /// edge are not evidence)
-/// and the evidence-aware sub-box vote (keeps a seated person's still legs), medium-level objects culled
+/// and the evidence-aware sub-box vote (keeps a seated person's still legs; not on a one-frame baseline),
+/// medium-level objects culled
 /// only when their own features are flagged, each box's sub-boxes voted by and acting on its own
 /// depth-mask object only, a tracker for missed boxes, and the survivor guard.
 /// Tracks: give as prev_keypoints the features' positions in a reference frame a few frames back (the
@@ -110,7 +111,8 @@ PipelineOptions<T> zhang_2023() {
 /// frame-to-frame tracks). 3-D points (CullingFrame::points_3d): each track's point measured in that
 /// reference frame's depth. The reprojection residual then replaces the epipolar distance: it also sees
 /// motion along the epipolar line (a walker crossing a sideways-moving camera), and on the sim it flags
-/// still chairs far less often. Measured on the dynamic_vo sim, seeds 1-3: docs/results.md.
+/// still chairs far less often. CullingFrame::evidence_frames: frames since that reference frame (the box
+/// rule decides in the first one, min_evidence_frames). Measured on the dynamic_vo sim: docs/results.md.
 /// Left out: the probability (000; its M term is the epipolar evidence already used, its S term
 /// duplicates the box rule) and the multi-view check (001): with static features protected it only
 /// verifies candidates, and on the sim it mostly culled static chairs next to walkers.
@@ -151,6 +153,13 @@ PipelineOptions<T> recommended() {
   o.use_subbox = true;
   o.subbox.object_mask_votes_only = true;
   o.subbox_verifies_candidates = false;
+  // In the first frame after the keyframe (a one-frame baseline) the box rule decides: the trace of
+  // halfsphere seed 1 showed up to 118 features of a walker kept "not flagged" in the two frames after a
+  // keyframe made as it came into view, and the pose pulled 2-4 cm. With the session 11 front end, twelve
+  // seeds: summed ATE static / xyz / rpy / halfsphere 7.8 / 17.1 / 21.8 / 24.6 -> 6.0 / 17.7 / 20.8 / 22.7 cm,
+  // recall 0.62-0.70 -> 0.70-0.79, precision 0.90-0.95 -> 0.88-0.93; 3 frames: recall 0.75-0.82 but summed
+  // ATE 73.5 cm (docs/results.md, session 11). Needs CullingFrame::evidence_frames.
+  o.min_evidence_frames = 2;
   // Sub-box memory off: with 15 frames (half a second) the demo's recall rose from 0.65-0.68 to 0.78-0.82
   // on every sequence, precision fell by 0.01-0.03, and the map-less VO's ATE got worse (summed over six
   // seeds and four sequences 61.8 -> 69.6 cm; 8 frames: 73.1 cm). Set it with CullingFrame::track_ids when
