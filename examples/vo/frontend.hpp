@@ -79,7 +79,7 @@ struct FrontEndOptions {
   // keyframe_max_translation_m was 0.2 m until session 11. Measured on the sim, `dynamic_vo` seeds 1-12,
   // four sequences, 0.2 -> 0.1 m: oracle summed ATE static / xyz / rpy / halfsphere 4.8 / 13.0 / 15.7 /
   // 19.1 -> 4.8 / 12.9 / 15.7 / 16.5 cm; recommended preset 7.8 / 18.1 / 21.8 / 26.2 -> 7.8 / 17.1 / 21.8 /
-  // 24.6 cm, its halfsphere precision 0.88-0.90 -> 0.91-0.92; about 15 % more keyframes on xyz and
+  // 24.6 cm, its halfsphere precision 0.88-0.90 -> 0.91-0.92; 15-18 % more keyframes on xyz and
   // halfsphere. 0.15 m and 0.07 m were no better (docs/results.md, session 11).
   std::uint64_t seed = 7;             ///< PnP-RANSAC seed (deterministic runs)
 };
