@@ -560,6 +560,51 @@ TYPED_TEST(PipelineTest, ShortBaselineLeavesPersonBoxesToTheBoxRule) {
   }
 }
 
+// In a frame whose baseline is too short, a tracked box keeps its last vote: the seated person's still legs,
+// voted static, stay static; its moving upper body and the walker stay culled. Without a recent vote
+// (a new state, or the vote more than min_evidence_frames frames back) the box rule decides.
+TYPED_TEST(PipelineTest, ShortBaselineKeepsTheLastVoteOfTrackedBoxes) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  PipelineOptions<T> o = presets::recommended<T>();
+  ASSERT_TRUE(o.short_baseline_keeps_last_vote);
+  auto cull_with_baseline = [&](int evidence_frames, PipelineState<T>* state) -> const PipelineResult<T>& {
+    auto frame = frame_of(s, dets);
+    frame.evidence_frames = evidence_frames;
+    return cull_frame(frame, o, state);
+  };
+  PipelineState<T> state;
+  const std::vector<FeatureLabel> voted = cull_with_baseline(2, &state).labels;
+  ASSERT_TRUE(state.result.subbox.ran()) << state.result.subbox.reason;
+  for (int repeat = 0; repeat < 2; ++repeat) {  // the vote is 1, then 2 frames back
+    const auto& r = cull_with_baseline(1, &state);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    EXPECT_TRUE(r.subbox.ran()) << r.subbox.reason;
+    EXPECT_NE(r.subbox.reason.find("last vote"), std::string::npos) << r.subbox.reason;
+    EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2) << repeat;
+    EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.9) << repeat;
+    EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95) << repeat;
+    EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.05) << repeat;
+    for (std::size_t i = 0; i < s.size(); ++i)
+      EXPECT_FALSE(voted[i] == FeatureLabel::Dynamic && r.labels[i] != FeatureLabel::Dynamic)
+          << i << ": what the vote culled stays culled";
+  }
+  const auto& late = cull_with_baseline(1, &state);  // the vote is 3 frames back
+  EXPECT_FALSE(late.subbox.ran());
+  EXPECT_NE(late.subbox.reason.find("the box rule decides"), std::string::npos) << late.subbox.reason;
+  EXPECT_GT(dynamic_rate(s, late, SceneKind::SittingLower), 0.9);
+  PipelineState<T> fresh;
+  const auto& first = cull_with_baseline(1, &fresh);
+  EXPECT_FALSE(first.subbox.ran());
+  EXPECT_GT(dynamic_rate(s, first, SceneKind::SittingLower), 0.9);
+  o.use_box_tracker = false;  // no box identity across frames: no memory
+  PipelineState<T> untracked;
+  cull_with_baseline(2, &untracked);
+  EXPECT_FALSE(cull_with_baseline(1, &untracked).subbox.ran());
+}
+
 TYPED_TEST(PipelineTest, StateBuffersAreReusedAcrossFrames) {
   using T = TypeParam;
   SceneConfig config;

@@ -126,6 +126,12 @@ struct PipelineOptions {
   /// measures against its keyframe has such frames right after each keyframe, when its corners on the
   /// movers are new. 0 = off; frames with evidence_frames 0 (unknown) are never affected.
   int min_evidence_frames = 0;
+  /// With min_evidence_frames: in a frame whose baseline is too short, the cells of a tracked box (box
+  /// tracker) keep the states of its last vote within min_evidence_frames frames, where there was one:
+  /// static where none of that cell's features was flagged (a seated person's still legs), dynamic where
+  /// it voted dynamic; the box rule decides elsewhere and in boxes without such a vote (a walker just
+  /// come into view). Needs the box tracker; without it the box rule decides.
+  bool short_baseline_keeps_last_vote = false;
 
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
@@ -540,8 +546,24 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       r.subbox.reason = "no dynamic-class boxes";
     } else if (options.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
                frame.evidence_frames < options.min_evidence_frames) {
-      r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
-                        " frame(s) too short for static evidence (min_evidence_frames): the box rule decides";
+      const bool masks = options.use_depth_mask && r.depth_mask.ran();
+      const std::size_t recalled =
+          options.short_baseline_keeps_last_vote && options.use_box_tracker && r.tracker.ran()
+              ? s.subbox_memory.recall_states(s.dyn_box_track_id, options.subbox.grid, s.frame_index,
+                                              options.min_evidence_frames, &s.remembered_cells)
+              : 0;
+      if (recalled > 0) {
+        apply_subbox_states(kp, s.moving.labels.data(), s.dyn_boxes, s.remembered_cells.data(), options.subbox, &s.subbox,
+                            masks ? s.in_object.data() : nullptr, masks ? s.object_box_bits.data() : nullptr);
+        r.subbox.status = s.subbox.status;
+        r.subbox.num_dynamic = s.subbox.num_dynamic;
+        r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
+                          " frame(s) too short for static evidence (min_evidence_frames): the last vote of " +
+                          std::to_string(recalled) + " tracked box(es) kept, the box rule elsewhere";
+      } else {
+        r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
+                          " frame(s) too short for static evidence (min_evidence_frames): the box rule decides";
+      }
     } else if (options.subbox_requires_fit_outside_boxes && !geo_fit_outside_boxes &&
                std::any_of(s.in_dyn_box.begin(), s.in_dyn_box.end(), [](std::uint8_t f) { return f != 0; })) {
       r.subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
@@ -562,6 +584,10 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       if (memory && s.subbox.ok())
         s.subbox_memory.remember(s.dyn_box_track_id, s.subbox, options.subbox, s.frame_index,
                                  options.subbox_memory_frames);
+      if (options.short_baseline_keeps_last_vote && options.min_evidence_frames > 0 && options.use_box_tracker &&
+          r.tracker.ran() && s.subbox.ok())
+        s.subbox_memory.remember_states(s.dyn_box_track_id, s.subbox, options.subbox, s.frame_index,
+                                        options.min_evidence_frames);
       r.subbox.status = s.subbox.status;
       r.subbox.reason = s.subbox.reason;
       r.subbox.num_dynamic = s.subbox.num_dynamic;

@@ -86,9 +86,60 @@ class SubBoxMemory {
                  boxes_.end());
   }
 
+  /// Stores the final state of every cell of this frame's vote per tracked box, for a later frame whose
+  /// own baseline is too short to vote (PipelineOptions::min_evidence_frames): 1 dynamic (voted, merged
+  /// or whole box), 0 static with unanimous evidence (none of its features flagged), 2 otherwise (no
+  /// evidence, or static by a split vote: not trusted beyond its frame). Forgets boxes not stored for
+  /// `frames` frames.
+  template <class T>
+  void remember_states(const std::vector<std::int64_t>& box_ids, const SubBoxResult<T>& votes,
+                       const SubBoxOptions<T>& options, std::uint64_t frame, int frames) {
+    const std::size_t cpb = static_cast<std::size_t>(options.grid) * static_cast<std::size_t>(options.grid);
+    if (cpb > kMaxCells || votes.cells.size() < box_ids.size() * cpb || votes.dyn_count.size() < box_ids.size() * cpb)
+      return;
+    for (std::size_t b = 0; b < box_ids.size(); ++b) {
+      if (box_ids[b] < 0) continue;
+      auto it = std::find_if(states_.begin(), states_.end(), [&](const BoxStates& m) { return m.id == box_ids[b]; });
+      if (it == states_.end()) it = states_.insert(states_.end(), BoxStates{});
+      it->id = box_ids[b];
+      it->frame = frame;
+      for (std::size_t c = 0; c < cpb; ++c) {
+        const std::size_t k = b * cpb + c;
+        const std::uint8_t vote = detail::subbox_cell_vote(votes.dyn_count[k], votes.static_count[k], options);
+        it->state[c] = votes.cells[k] || vote == 1 ? 1 : vote == 2 || votes.dyn_count[k] > 0 ? 2 : 0;
+      }
+    }
+    const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
+    states_.erase(std::remove_if(states_.begin(), states_.end(),
+                                 [&](const BoxStates& m) { return frame - m.frame > window; }),
+                  states_.end());
+  }
+
+  /// Cell states (as remember_states) of the last stored vote of each tracked box within `frames` frames
+  /// before `frame`, box-major; 2 (unknown) for boxes without one. Returns how many boxes had one.
+  std::size_t recall_states(const std::vector<std::int64_t>& box_ids, int grid, std::uint64_t frame, int frames,
+                            std::vector<std::uint8_t>* states) const {
+    const std::size_t cpb = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
+    states->assign(box_ids.size() * cpb, 2);
+    if (cpb > kMaxCells) return 0;
+    const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
+    std::size_t found = 0;
+    for (std::size_t b = 0; b < box_ids.size(); ++b) {
+      if (box_ids[b] < 0) continue;
+      for (const BoxStates& m : states_) {
+        if (m.id != box_ids[b] || m.frame >= frame || frame - m.frame > window) continue;
+        std::copy(m.state, m.state + cpb, states->begin() + static_cast<std::ptrdiff_t>(b * cpb));
+        ++found;
+        break;
+      }
+    }
+    return found;
+  }
+
   void clear() {
     boxes_.clear();
     tracks_.clear();
+    states_.clear();
   }
   std::size_t num_boxes() const { return boxes_.size(); }
   std::size_t num_tracks() const { return tracks_.size(); }
@@ -112,8 +163,15 @@ class SubBoxMemory {
   }
   BoxCells* find(std::int64_t id) { return const_cast<BoxCells*>(static_cast<const SubBoxMemory*>(this)->find(id)); }
 
+  struct BoxStates {
+    std::int64_t id = -1;
+    std::uint64_t frame = 0;
+    std::uint8_t state[kMaxCells] = {};
+  };
+
   std::vector<BoxCells> boxes_;  ///< a handful of tracked boxes: a linear search is enough
   std::unordered_map<std::int64_t, TrackHistory> tracks_;
+  std::vector<BoxStates> states_;  ///< remember_states
 };
 
 }  // namespace dyncull

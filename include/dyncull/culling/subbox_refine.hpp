@@ -97,6 +97,53 @@ inline bool subbox_in_object(const std::uint8_t* in_object, const std::uint32_t*
   if (box_bits && b < 32) return ((box_bits[i] >> b) & 1u) != 0;
   return !in_object || in_object[i] != 0;
 }
+
+/// Feature labels from r.cells (Algorithm 1's last step): dynamic inside any dynamic cell (and the
+/// object mask if given), static inside boxes otherwise. Fills labels, reasons and the counts.
+template <class T, class Points, class Boxes>
+void subbox_label_features(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+                           const SubBoxOptions<T>& options, SubBoxResult<T>* out, const std::uint8_t* in_object_mask,
+                           const std::uint32_t* object_box_bits, const std::uint8_t* extra_dynamic_cells,
+                           const std::uint8_t* extra_eligible) {
+  SubBoxResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(points.size());
+  const std::size_t nb = static_cast<std::size_t>(boxes.size());
+  const int g = options.grid;
+  const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  r.num_dynamic = r.num_static = r.num_rescued = r.num_added = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
+    bool in_box = false, in_dynamic = false;
+    for (std::size_t b = 0; b < nb && !in_dynamic; ++b) {
+      const Box<T>& box = detail::subbox_as_box(boxes[b]);
+      if (!box.valid()) continue;
+      const int c = detail::subbox_cell(box, g, x, y);
+      if (c < 0) continue;
+      in_box = true;
+      const std::size_t cell = b * cells_per_box + static_cast<std::size_t>(c);
+      const bool extra = extra_dynamic_cells && extra_dynamic_cells[cell] && (!extra_eligible || extra_eligible[i]);
+      in_dynamic = (r.cells[cell] != 0 || extra) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
+    }
+    const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
+    if (!std::isfinite(x) || !std::isfinite(y)) {
+      r.labels[i] = FeatureLabel::Dynamic;  // never trust a non-finite feature as static
+      r.reasons[i] = CullReason::InvalidInput;
+    } else if (in_dynamic) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      r.reasons[i] = CullReason::SubBox;
+      r.num_added += !geo_dyn;
+    } else if (in_box) {
+      r.num_rescued += geo_dyn;
+    } else if (geo_dyn && options.keep_geometric_outside_boxes) {
+      r.labels[i] = FeatureLabel::Dynamic;
+      r.reasons[i] = CullReason::Epipolar;
+    }
+    r.num_dynamic += r.labels[i] == FeatureLabel::Dynamic;
+  }
+  r.num_static = n - r.num_dynamic;
+}
 }  // namespace detail
 
 /// Runs Algorithm 1 on every box, writing into `out` (buffers reused across frames).
@@ -197,37 +244,8 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
     }
   }
 
-  // Features: dynamic inside any dynamic cell (and the object mask if given); static inside boxes otherwise.
-  for (std::size_t i = 0; i < n; ++i) {
-    const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
-    bool in_box = false, in_dynamic = false;
-    for (std::size_t b = 0; b < nb && !in_dynamic; ++b) {
-      const Box<T>& box = detail::subbox_as_box(boxes[b]);
-      if (!box.valid()) continue;
-      const int c = detail::subbox_cell(box, g, x, y);
-      if (c < 0) continue;
-      in_box = true;
-      const std::size_t cell = b * cells_per_box + static_cast<std::size_t>(c);
-      const bool extra = extra_dynamic_cells && extra_dynamic_cells[cell] && (!extra_eligible || extra_eligible[i]);
-      in_dynamic = (r.cells[cell] != 0 || extra) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
-    }
-    const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
-    if (!std::isfinite(x) || !std::isfinite(y)) {
-      r.labels[i] = FeatureLabel::Dynamic;  // never trust a non-finite feature as static
-      r.reasons[i] = CullReason::InvalidInput;
-    } else if (in_dynamic) {
-      r.labels[i] = FeatureLabel::Dynamic;
-      r.reasons[i] = CullReason::SubBox;
-      r.num_added += !geo_dyn;
-    } else if (in_box) {
-      r.num_rescued += geo_dyn;
-    } else if (geo_dyn && options.keep_geometric_outside_boxes) {
-      r.labels[i] = FeatureLabel::Dynamic;
-      r.reasons[i] = CullReason::Epipolar;
-    }
-    r.num_dynamic += r.labels[i] == FeatureLabel::Dynamic;
-  }
-  r.num_static = n - r.num_dynamic;
+  detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits,
+                                extra_dynamic_cells, extra_eligible);
   if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
 }
 
@@ -239,6 +257,51 @@ SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geomet
   SubBoxResult<T> r;
   refine_subboxes(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   return r;
+}
+
+/// Algorithm 1's last step with cell states given instead of voted (subbox_memory.hpp keeps them from an
+/// earlier frame): per box grid*grid states, box-major, 0 = static with evidence, 1 = dynamic, 2 =
+/// unknown; unknown cells act as dynamic (inside the object mask, as voted ones), so a box without a
+/// remembered vote falls back to the box rule. The counts in `out` stay zero: nothing was voted.
+template <class T, class Points, class Boxes>
+void apply_subbox_states(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+                         const std::uint8_t* states, const SubBoxOptions<T>& options, SubBoxResult<T>* out,
+                         const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr) {
+  static_assert(is_point_container_v<Points>, "dyncull::apply_subbox_states: points must hold points (see PointTraits)");
+  SubBoxResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(points.size());
+  const std::size_t nb = static_cast<std::size_t>(boxes.size());
+  const int g = options.grid;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_boxes = nb;
+  r.num_whole_boxes = r.num_invalid_boxes = 0;
+  if (g < 1 || g > 8) {
+    r.status = Status::InvalidInput;
+    r.reason = "invalid options: 1 <= grid <= 8 required";
+    r.labels.assign(n, FeatureLabel::Static);
+    r.reasons.assign(n, CullReason::None);
+    r.votes.clear();
+    return;
+  }
+  const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  r.votes.assign(nb, SubBoxVote{});
+  r.cells.assign(nb * cells_per_box, 0);
+  r.dyn_count.assign(nb * cells_per_box, 0);
+  r.static_count.assign(nb * cells_per_box, 0);
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!detail::subbox_as_box(boxes[b]).valid()) {
+      ++r.num_invalid_boxes;
+      continue;
+    }
+    for (std::size_t c = 0; c < cells_per_box; ++c) {
+      r.cells[b * cells_per_box + c] = states[b * cells_per_box + c] != 0;
+      r.votes[b].num_dynamic_cells += r.cells[b * cells_per_box + c];
+    }
+  }
+  detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits, nullptr,
+                                nullptr);
+  if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
 }
 
 /// Square (Chebyshev) binary dilation of `mask` inside `roi` by `radius` pixels, two separable passes
