@@ -98,8 +98,33 @@ inline bool subbox_in_object(const std::uint8_t* in_object, const std::uint32_t*
   return !in_object || in_object[i] != 0;
 }
 
+/// Starts a result for n features and nb boxes: status Ok, every feature Static, counts zeroed.
+template <class T>
+void subbox_begin(SubBoxResult<T>* out, std::size_t n, std::size_t nb) {
+  SubBoxResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  r.num_dynamic = r.num_static = r.num_rescued = r.num_added = 0;
+  r.num_boxes = nb;
+  r.num_whole_boxes = r.num_invalid_boxes = 0;
+}
+
+/// Zeroed per-box votes and per-cell buffers for nb boxes of grid*grid cells; returns grid*grid.
+template <class T>
+std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
+  const std::size_t cells_per_box = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
+  out->votes.assign(nb, SubBoxVote{});
+  out->cells.assign(nb * cells_per_box, 0);
+  out->dyn_count.assign(nb * cells_per_box, 0);
+  out->static_count.assign(nb * cells_per_box, 0);
+  return cells_per_box;
+}
+
 /// Feature labels from r.cells (Algorithm 1's last step): dynamic inside any dynamic cell (and the
-/// object mask if given), static inside boxes otherwise. Fills labels, reasons and the counts.
+/// object mask if given), static inside boxes otherwise. Fills labels, reasons and the counts of a result
+/// started by subbox_begin.
 template <class T, class Points, class Boxes>
 void subbox_label_features(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
                            const SubBoxOptions<T>& options, SubBoxResult<T>* out, const std::uint8_t* in_object_mask,
@@ -110,9 +135,6 @@ void subbox_label_features(const Points& points, const FeatureLabel* geometric, 
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
   const int g = options.grid;
   const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
-  r.labels.assign(n, FeatureLabel::Static);
-  r.reasons.assign(n, CullReason::None);
-  r.num_dynamic = r.num_static = r.num_rescued = r.num_added = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
     bool in_box = false, in_dynamic = false;
@@ -168,24 +190,14 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
   const int g = options.grid;
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.labels.assign(n, FeatureLabel::Static);
-  r.reasons.assign(n, CullReason::None);
-  r.num_dynamic = r.num_static = r.num_rescued = r.num_added = 0;
-  r.num_boxes = nb;
-  r.num_whole_boxes = r.num_invalid_boxes = 0;
+  detail::subbox_begin(&r, n, nb);
   if (g < 1 || g > 8 || !(options.sigma1 >= T(0)) || options.sigma2 < 0) {
     r.status = Status::InvalidInput;
     r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0 and sigma2 >= 0 required";
     r.votes.clear();
     return;
   }
-  const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
-  r.votes.assign(nb, SubBoxVote{});
-  r.cells.assign(nb * cells_per_box, 0);
-  r.dyn_count.assign(nb * cells_per_box, 0);
-  r.static_count.assign(nb * cells_per_box, 0);
+  const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
 
   // Votes: every labelled feature counts in every box containing it (boxes may overlap).
   for (std::size_t b = 0; b < nb; ++b) {
@@ -272,23 +284,14 @@ void apply_subbox_states(const Points& points, const FeatureLabel* geometric, co
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
   const int g = options.grid;
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_boxes = nb;
-  r.num_whole_boxes = r.num_invalid_boxes = 0;
+  detail::subbox_begin(&r, n, nb);
   if (g < 1 || g > 8) {
     r.status = Status::InvalidInput;
     r.reason = "invalid options: 1 <= grid <= 8 required";
-    r.labels.assign(n, FeatureLabel::Static);
-    r.reasons.assign(n, CullReason::None);
     r.votes.clear();
     return;
   }
-  const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
-  r.votes.assign(nb, SubBoxVote{});
-  r.cells.assign(nb * cells_per_box, 0);
-  r.dyn_count.assign(nb * cells_per_box, 0);
-  r.static_count.assign(nb * cells_per_box, 0);
+  const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
   for (std::size_t b = 0; b < nb; ++b) {
     if (!detail::subbox_as_box(boxes[b]).valid()) {
       ++r.num_invalid_boxes;
