@@ -156,6 +156,48 @@ TYPED_TEST(SubBoxTest, EmptyAndInvalidBoxesAndObjectMask) {
   EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, bad).status, Status::InvalidInput);
 }
 
+// With static_needs_evidence a cell stays static only on a clear static vote: empty cells and split
+// static votes keep the box rule's "dynamic"; such cells neither merge nor make the whole box dynamic.
+TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
+  using T = TypeParam;
+  std::vector<Vec2<T>> pts;
+  std::vector<FeatureLabel> geo;
+  auto add = [&](T x, T y, int n_static, int n_dynamic) {
+    for (int k = 0; k < n_static + n_dynamic; ++k) {
+      pts.emplace_back(x + T(2 * k), y + T(k));
+      geo.push_back(k < n_static ? FeatureLabel::Static : FeatureLabel::Dynamic);
+    }
+  };
+  add(T(5), T(5), 5, 0);    // cell 0: unanimous static
+  add(T(65), T(5), 4, 1);   // cell 2: 1 of 5 flagged (ratio 0.2)
+  add(T(5), T(65), 3, 2);   // cell 6: 2 of 5 flagged (0.4, under sigma1 0.5)
+  add(T(65), T(65), 1, 0);  // cell 8: one labelled feature, no evidence
+  const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(90), T(90)}};
+  SubBoxOptions<T> o;
+  const auto plain = refine_subboxes(pts, geo.data(), boxes, o);
+  ASSERT_TRUE(plain.ok());
+  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(plain.labels[i], FeatureLabel::Static) << i;
+  o.static_needs_evidence = true;
+  o.static_max_dynamic_ratio = T(0.2);
+  const auto r = refine_subboxes(pts, geo.data(), boxes, o);
+  ASSERT_TRUE(r.ok());
+  EXPECT_FALSE(r.votes[0].whole_box) << "7 assumed cells do not count towards sigma2";
+  EXPECT_EQ(r.votes[0].num_merged_cells, 0);
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(r.labels[i], FeatureLabel::Static) << i << ": cells 0 and 2";
+  for (std::size_t i = 10; i < 16; ++i) {
+    EXPECT_EQ(r.labels[i], FeatureLabel::Dynamic) << i << ": cells 6 and 8";
+    EXPECT_EQ(r.reasons[i], CullReason::SubBox) << i;
+  }
+  EXPECT_EQ(r.cells[0], 0);
+  EXPECT_EQ(r.cells[2], 0);
+  EXPECT_EQ(r.cells[4], 1) << "no features at all: the box rule stands";
+  // Unanimity required: cell 2's single flag now makes it dynamic too.
+  o.static_max_dynamic_ratio = T(0);
+  const auto strict = refine_subboxes(pts, geo.data(), boxes, o);
+  for (std::size_t i = 5; i < 10; ++i) EXPECT_EQ(strict.labels[i], FeatureLabel::Dynamic) << i;
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(strict.labels[i], FeatureLabel::Static) << i;
+}
+
 // A walker's box overlapping a still chair's box: with per-box object bits the walker's dynamic
 // sub-boxes act only on the walker's own features, and only they vote.
 TYPED_TEST(SubBoxTest, OverlappingBoxesActOnTheirOwnObjectsOnly) {

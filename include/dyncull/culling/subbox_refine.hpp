@@ -40,6 +40,13 @@ struct SubBoxOptions {
   /// otherwise outvote the person in the border sub-boxes, and a walker crossing a chair's box makes
   /// the chair's sub-boxes dynamic. false: every labelled feature in the rectangle votes (the paper).
   bool object_mask_votes_only = false;
+  /// Burden of proof on "static" (our extension; the paper calls a cell dynamic only on evidence): a cell
+  /// not voted dynamic is still dynamic unless at least min_points labelled features vote in it and at most
+  /// static_max_dynamic_ratio of them are flagged, so an empty or split cell keeps the box rule's
+  /// "dynamic" (inside the object mask). Such cells take no part in merging or in the whole-box count.
+  /// 0.3 tolerates the 15-25 % false flags of still parts noted at merge_ratio.
+  bool static_needs_evidence = false;
+  T static_max_dynamic_ratio = T(0.3);
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
 };
 
@@ -254,6 +261,15 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
       std::fill(cells, cells + cells_per_box, std::uint8_t(1));
       ++r.num_whole_boxes;
     }
+    if (options.static_needs_evidence && !vote.whole_box)
+      for (std::size_t c = 0; c < cells_per_box; ++c) {
+        if (cells[c]) continue;
+        const std::uint32_t total = dc[c] + sc[c];
+        if (st[c] == 2 || T(dc[c]) > options.static_max_dynamic_ratio * T(total)) {
+          cells[c] = 1;
+          ++vote.num_dynamic_cells;
+        }
+      }
   }
 
   detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits,
