@@ -153,7 +153,7 @@ PipelineOptions<T> recommended() {
   o.subbox.object_mask_votes_only = true;
   // A box's sub-box is kept only on a clear static vote (at most 30 % of its features flagged): empty
   // cells and split votes stay with the box rule. Twelve seeds, session 12: summed ATE 65.0 -> 59.9 cm,
-  // median cut on the held-out seeds 7-12 xyz / halfsphere 77.3 / 81.3 -> 84.1 / 85.3 %, recall 0.68-0.77
+  // median cut on the held-out seeds 7-12 xyz / halfsphere 77.3 / 81.2 -> 84.1 / 85.3 %, recall 0.68-0.77
   // -> 0.75-0.83, precision 0.900-0.952 -> 0.881-0.936 (docs/results.md, session 12).
   o.subbox.static_needs_evidence = true;
   o.subbox.static_max_dynamic_ratio = T(0.3);
