@@ -196,6 +196,10 @@ TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
   const auto strict = refine_subboxes(pts, geo.data(), boxes, o);
   for (std::size_t i = 5; i < 10; ++i) EXPECT_EQ(strict.labels[i], FeatureLabel::Dynamic) << i;
   for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(strict.labels[i], FeatureLabel::Static) << i;
+  o.static_max_dynamic_ratio = Constants<T>::nan();
+  const auto bad = refine_subboxes(pts, geo.data(), boxes, o);
+  EXPECT_EQ(bad.status, Status::InvalidInput);
+  EXPECT_NE(bad.reason.find("static_max_dynamic_ratio"), std::string::npos) << bad.reason;
 }
 
 // A walker's box overlapping a still chair's box: with per-box object bits the walker's dynamic

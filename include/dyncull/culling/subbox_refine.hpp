@@ -53,7 +53,7 @@ struct SubBoxOptions {
 /// Per-box vote. Cell (row, col) is cells[row * grid + col]; state 1 = dynamic.
 struct SubBoxVote {
   bool whole_box = false;       ///< more than sigma2 dynamic sub-boxes: the whole box is dynamic
-  int num_dynamic_cells = 0;    ///< after merging (and after whole_box: grid*grid)
+  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (after whole_box: grid*grid)
   int num_merged_cells = 0;     ///< static or empty cells merged because they touch a dynamic one
 };
 
@@ -198,9 +198,10 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
-  if (g < 1 || g > 8 || !(options.sigma1 >= T(0)) || options.sigma2 < 0) {
+  if (g < 1 || g > 8 || !(options.sigma1 >= T(0)) || options.sigma2 < 0 ||
+      (options.static_needs_evidence && !(options.static_max_dynamic_ratio >= T(0)))) {
     r.status = Status::InvalidInput;
-    r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0 and sigma2 >= 0 required";
+    r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0, sigma2 >= 0 and static_max_dynamic_ratio >= 0 required";
     r.votes.clear();
     return;
   }
