@@ -540,13 +540,13 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
 
   // 6. Sub-box refinement of the dynamic-class boxes with the geometric labels.
   if (options.use_subbox) {
+    const bool masks = options.use_depth_mask && r.depth_mask.ran();
     if (!geo_ok) {
       r.subbox.reason = "needs geometric labels (moving consistency or reprojection), unavailable this frame";
     } else if (!have_boxes) {
       r.subbox.reason = "no dynamic-class boxes";
     } else if (options.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
                frame.evidence_frames < options.min_evidence_frames) {
-      const bool masks = options.use_depth_mask && r.depth_mask.ran();
       const std::size_t recalled =
           options.short_baseline_keeps_last_vote && options.use_box_tracker && r.tracker.ran()
               ? s.subbox_memory.recall_states(s.dyn_box_track_id, options.subbox.grid, s.frame_index,
@@ -557,19 +557,17 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
                             masks ? s.in_object.data() : nullptr, masks ? s.object_box_bits.data() : nullptr);
         r.subbox.status = s.subbox.status;
         r.subbox.num_dynamic = s.subbox.num_dynamic;
-        r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
-                          " frame(s) too short for static evidence (min_evidence_frames): the last vote of " +
-                          std::to_string(recalled) + " tracked box(es) kept, the box rule elsewhere";
-      } else {
-        r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
-                          " frame(s) too short for static evidence (min_evidence_frames): the box rule decides";
       }
+      r.subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
+                        " frame(s) too short for static evidence (min_evidence_frames): " +
+                        (recalled > 0 ? "the last vote of " + std::to_string(recalled) +
+                                            " tracked box(es) kept, the box rule elsewhere"
+                                      : std::string("the box rule decides"));
     } else if (options.subbox_requires_fit_outside_boxes && !geo_fit_outside_boxes &&
                std::any_of(s.in_dyn_box.begin(), s.in_dyn_box.end(), [](std::uint8_t f) { return f != 0; })) {
       r.subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
                         "its evidence inside the boxes is not trusted";
     } else {
-      const bool masks = options.use_depth_mask && r.depth_mask.ran();
       const bool memory = options.subbox_memory_frames > 0 && options.use_box_tracker && r.tracker.ran() &&
                           frame.track_ids && frame.track_ids->size() == n;
       if (memory) {
