@@ -94,11 +94,19 @@ TYPED_TEST(ReprojectionCheckTest, SeesMotionAlongTheEpipolarLine) {
   for (std::size_t i = 0; i < s.points.size(); i += 17) {
     const Vec2<T> q = s.camera.project(r.cam_from_world.apply(s.points[i]));
     EXPECT_NEAR(double(r.residual_px[i]), double((q - s.pixels[i]).norm()), 1e-3);
+    // The vector is measured minus predicted.
+    EXPECT_NEAR(double(r.residual_vec[i].x()), double(s.pixels[i].x() - q.x()), 1e-3);
+    EXPECT_NEAR(double(r.residual_vec[i].y()), double(s.pixels[i].y() - q.y()), 1e-3);
     EXPECT_TRUE(std::isnan(double(r.uncertainty_px[i])));  // propagation is off by default
     if (s.in_box[i]) {
       EXPECT_EQ(r.inlier_mask[i], 0);
     }
   }
+
+  // The static tracks' noise: 0.3 px at each end (the reference pixel enters through nothing here, the
+  // points are exact), so one residual component has sd 0.3; the robust estimate lands near it.
+  EXPECT_GT(double(r.inlier_noise_px), 0.2);
+  EXPECT_LT(double(r.inlier_noise_px), 0.4);
 
   // The epipolar check on the same tracks is blind to this motion.
   MovingConsistencyOptions<T> epi;
@@ -290,6 +298,7 @@ TYPED_TEST(ReprojectionCheckTest, BadInputGetsAReason) {
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(r.labels[i], FeatureLabel::Candidate) << i;
     EXPECT_TRUE(std::isnan(double(r.residual_px[i]))) << i;
+    EXPECT_FALSE(r.residual_vec[i].allFinite()) << i;
   }
   EXPECT_EQ(r.num_valid, s.points.size() - 3);
   EXPECT_EQ(r.num_dynamic + r.num_static, r.num_valid);
@@ -306,6 +315,7 @@ TYPED_TEST(ReprojectionCheckTest, BadInputGetsAReason) {
   r = check_reprojection(one_point, s.pixels, s.camera, options);
   EXPECT_FALSE(r.ok());
   EXPECT_FALSE(r.reason.empty());
+  EXPECT_TRUE(std::isnan(double(r.inlier_noise_px)));
   for (FeatureLabel l : r.labels) EXPECT_EQ(l, FeatureLabel::Candidate);
 }
 

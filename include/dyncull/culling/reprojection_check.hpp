@@ -82,6 +82,12 @@ struct ReprojectionCheckResult {
 
   std::vector<FeatureLabel> labels;
   std::vector<T> residual_px;
+  /// Measured minus predicted pixel position (the residual as a vector); NaN where not evaluated. Features
+  /// of one object moving together share its direction (coherent_motion.hpp).
+  std::vector<Vec2<T>> residual_vec;
+  /// Robust standard deviation of one residual component over the fit's PnP inliers (1.4826 times the
+  /// median absolute component): the tracking and map noise of static tracks this frame. NaN when no fit.
+  T inlier_noise_px = Constants<T>::nan();
   std::vector<T> uncertainty_px;  ///< predicted sd of the position (sqrt of the 2x2 trace); NaN when off
   /// Measured minus predicted depth (m); NaN where not evaluated (depth residual off, no depth there).
   std::vector<T> depth_residual_m;
@@ -96,6 +102,7 @@ struct ReprojectionCheckResult {
   std::vector<Vec3<T>> scratch_points;
   std::vector<Vec2<T>> scratch_pixels;
   std::vector<std::uint32_t> scratch_index;
+  std::vector<T> scratch_values;
 };
 
 /// Runs the check on n tracks: points[i] is the 3-D point of track i in any fixed frame (world, or the
@@ -121,6 +128,8 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
   r.cam_from_world = Rigid3<T>();
   r.labels.assign(n, FeatureLabel::Candidate);
   r.residual_px.assign(n, Constants<T>::nan());
+  r.residual_vec.assign(n, Vec2<T>(Constants<T>::nan(), Constants<T>::nan()));
+  r.inlier_noise_px = Constants<T>::nan();
   r.uncertainty_px.assign(n, Constants<T>::nan());
   r.depth_residual_m.assign(n, Constants<T>::nan());
   r.inlier_mask.assign(n, 0);
@@ -235,6 +244,7 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
     if (pc.z() > T(0)) {
       const T du = camera.fx * pc.x() / pc.z() + camera.cx - u, dv = camera.fy * pc.y() / pc.z() + camera.cy - v;
       res = std::sqrt(du * du + dv * dv);
+      r.residual_vec[i] = Vec2<T>(-du, -dv);
       if (use_cov) {
         const Eigen::Matrix<double, 2, 6> J = jacobian(pc);
         const T sd = static_cast<T>(std::sqrt(std::max(0.0, (J * cov * J.transpose()).trace())));
@@ -257,6 +267,19 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
     r.labels[i] = dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;
     r.num_dynamic += dyn;
     r.num_static += !dyn;
+  }
+  // Noise of the static tracks: robust spread of the inliers' residual components (zero-mean at the fit).
+  r.scratch_values.clear();
+  for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r.scratch_index.size(); ++k) {
+    const Vec2<T>& e = r.residual_vec[r.scratch_index[k]];
+    if (!pr.inlier_mask[k] || !e.allFinite()) continue;
+    r.scratch_values.push_back(std::abs(e.x()));
+    r.scratch_values.push_back(std::abs(e.y()));
+  }
+  if (!r.scratch_values.empty()) {
+    auto mid = r.scratch_values.begin() + static_cast<std::ptrdiff_t>(r.scratch_values.size() / 2);
+    std::nth_element(r.scratch_values.begin(), mid, r.scratch_values.end());
+    r.inlier_noise_px = T(1.4826) * *mid;
   }
 }
 
