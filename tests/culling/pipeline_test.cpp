@@ -112,6 +112,8 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
 
   PipelineOptions<T> o = presets::recommended<T>();
   o.use_reprojection = true;  // on in the preset itself (presets_test)
+  // The preset's coherent-motion stage adds cell flags to these labels (CoherentMotionFlagsASwayTheResidualsMiss).
+  o.use_coherent_motion = false;
   frame.points_3d = &s.prev_points_world;
   PipelineState<T> state;
   const PipelineResult<T> r = cull_frame(frame, o, &state);
@@ -178,6 +180,46 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   EXPECT_EQ(rb.reprojection.status, Status::InvalidInput);
   EXPECT_FALSE(rb.reprojection.reason.empty());
   EXPECT_EQ(rb.labels, epi_labels);
+}
+
+// The seated person sways only about 1 px between the frames (a quarter of the scene's default): its
+// residuals stay below the preset's 1.5 px in-box threshold, so the sub-box vote keeps the upper body. The
+// coherent-motion stage sees the shared median and the vote then culls it; the legs and the room stay.
+// Without 3-D points the stage says why and changes nothing.
+TYPED_TEST(PipelineTest, CoherentMotionFlagsASwayTheResidualsMiss) {
+  using T = TypeParam;
+  SceneConfig config;
+  config.sway_scale = 0.25;
+  config.num_per_object = 200;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  auto frame = frame_of(s, dets);
+  frame.points_3d = &s.prev_points_world;
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.use_coherent_motion = false;
+  PipelineState<T> plain_state;
+  const PipelineResult<T> plain = cull_frame(frame, o, &plain_state);
+  ASSERT_TRUE(plain.subbox.ran()) << plain.subbox.reason;
+  EXPECT_FALSE(plain.coherent_motion.enabled);
+  EXPECT_LT(dynamic_rate(s, plain, SceneKind::SittingUpper), 0.5);  // measured 0.0
+
+  o.use_coherent_motion = true;
+  PipelineState<T> state;
+  const PipelineResult<T>& r = cull_frame(frame, o, &state);
+  ASSERT_TRUE(r.coherent_motion.ran()) << r.coherent_motion.reason;
+  EXPECT_GT(r.coherent_motion.num_dynamic, 0u);
+  EXPECT_GT(state.coherent_motion.num_cells_flagged, 0u);
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.8);  // measured 1.0 (12 cells flagged)
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2);  // measured 0.07, as without the stage
+  EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.03);         // measured 0.018, as without the stage
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::Tv), 0.05);
+
+  frame.points_3d = nullptr;
+  PipelineState<T> no_points_state;
+  const PipelineResult<T>& rn = cull_frame(frame, o, &no_points_state);
+  EXPECT_FALSE(rn.coherent_motion.ran());
+  EXPECT_NE(rn.coherent_motion.reason.find("reprojection"), std::string::npos) << rn.coherent_motion.reason;
 }
 
 // Recommended: a medium-level candidate is culled only on its own geometric evidence (flagged itself in a

@@ -43,6 +43,7 @@ struct SceneConfig {
   int frames_between = 1;    ///< previous frame = this many frames earlier (tracks)
   double pixel_noise = 0.25; ///< Gaussian pixel noise (std, px) on both ends of a track
   double walk_speed_m = 0.04;  ///< walking speed per frame (1.2 m/s at 30 fps)
+  double sway_scale = 1.0;     ///< scales the seated person's upper-body motion (1: about 4 px a frame)
   bool static_camera = false;  ///< camera does not move (F undetermined)
   std::uint64_t seed = 7;
   PinholeCamera<double> camera = PinholeCamera<double>::tum_fr3();
@@ -108,7 +109,8 @@ class SceneWorld {
       add({-1.35, -0.5, 2.3}, {-0.85, 1.3, 2.6}, {config.walk_speed_m, 0.0, -0.01}, SceneKind::WalkingPerson, 0);
     if (config.sitting) {
       // The upper body (head and shoulders, the top 28 % of the person) sways sideways; hips and legs stay.
-      add({0.35, -0.30, 3.0}, {0.85, 0.15, 3.3}, {0.02, -0.01, 0.0}, SceneKind::SittingUpper, 1);
+      add({0.35, -0.30, 3.0}, {0.85, 0.15, 3.3}, config.sway_scale * Vec3<double>(0.02, -0.01, 0.0),
+          SceneKind::SittingUpper, 1);
       add({0.35, 0.15, 3.0}, {0.85, 1.3, 3.3}, {0.0, 0.0, 0.0}, SceneKind::SittingLower, 1);
     }
     if (config.chair) add({1.3, 0.6, 2.6}, {1.8, 1.3, 3.0}, {0.03, 0.0, 0.02}, SceneKind::Chair, 2);

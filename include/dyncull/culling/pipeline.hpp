@@ -12,6 +12,7 @@
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/box_rule.hpp"
 #include "dyncull/culling/box_tracker.hpp"
+#include "dyncull/culling/coherent_motion.hpp"
 #include "dyncull/culling/depth_mask.hpp"
 #include "dyncull/culling/detections.hpp"
 #include "dyncull/culling/dynamic_probability.hpp"
@@ -132,6 +133,13 @@ struct PipelineOptions {
   /// it voted dynamic; the box rule decides elsewhere and in boxes without such a vote (a walker just
   /// come into view). Needs the box tracker; without it the box rule decides.
   bool short_baseline_keeps_last_vote = false;
+  /// Cell-level evidence before the sub-box vote (coherent_motion.hpp): in a cell of a high-level object
+  /// (features the box rule labelled Dynamic; candidates such as chairs stay on their own evidence) whose
+  /// features' reprojection residuals share a significant median, every feature counts as flagged, so the
+  /// vote culls a seated person's sway that no single residual shows. Needs the reprojection check; runs
+  /// with the sub-box refinement, on its grid.
+  bool use_coherent_motion = false;
+  CoherentMotionOptions<T> coherent_motion{};
 
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
@@ -161,8 +169,8 @@ struct PipelineResult {
   std::vector<CullReason> reasons;   ///< deciding strategy (None for untouched statics)
   std::vector<std::uint8_t> keep;    ///< 1 = static: apply to every parallel per-keypoint array
   std::size_t num_features = 0, num_static = 0, num_dynamic = 0;
-  StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, reprojection, subbox,
-      multiview;
+  StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, reprojection,
+      coherent_motion, subbox, multiview;
   GuardAction guard = GuardAction::None;
   std::size_t guard_restored = 0;   ///< features the guard turned back to static
 };
@@ -186,12 +194,13 @@ struct PipelineState {
   std::vector<std::uint8_t> remembered_cells, memory_eligible;
   std::vector<FeatureLabel> sem_labels;
   std::vector<CullReason> sem_reasons;
-  std::vector<std::uint8_t> in_dyn_box, in_object, mv_dynamic;
+  std::vector<std::uint8_t> in_dyn_box, in_object, mv_dynamic, coherent_eligible;
   std::vector<MotionLevel> prob_levels;
   std::vector<Vec2<T>> prob_prev;
   std::vector<T> keypoint_depth;
   MovingConsistencyResult<T> moving;
   ReprojectionCheckResult<T> reprojection;
+  CoherentMotionResult<T> coherent_motion;
   SubBoxResult<T> subbox;
   MultiViewResult<T> multiview;
   Mask multiview_mask;
@@ -313,7 +322,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   r.guard = GuardAction::None;
   r.guard_restored = 0;
   for (StageReport* st : {&r.detections, &r.tracker, &r.box_rule, &r.depth_mask, &r.probability,
-                          &r.moving_consistency, &r.reprojection, &r.subbox, &r.multiview}) {
+                          &r.moving_consistency, &r.reprojection, &r.coherent_motion, &r.subbox, &r.multiview}) {
     st->status = Status::Skipped;
     st->reason.clear();
     st->num_dynamic = 0;
@@ -325,6 +334,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   r.probability.enabled = options.use_probability;
   r.moving_consistency.enabled = options.use_moving_consistency;
   r.reprojection.enabled = options.use_reprojection;
+  r.coherent_motion.enabled = options.use_coherent_motion;
+  if (options.use_coherent_motion)
+    r.coherent_motion.reason = "runs with the sub-box refinement, on the reprojection check's residuals";
   r.subbox.enabled = options.use_subbox;
   r.multiview.enabled = options.use_multiview;
 
@@ -568,6 +580,23 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       r.subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
                         "its evidence inside the boxes is not trusted";
     } else {
+      if (options.use_coherent_motion) {
+        if (!r.reprojection.ran() || s.reprojection.residual_vec.size() != n) {
+          r.coherent_motion.reason = "needs the reprojection check's residuals (use_reprojection, points_3d)";
+        } else {
+          CoherentMotionOptions<T> co = options.coherent_motion;
+          co.grid = options.subbox.grid;  // the cells the vote will count
+          // High-level objects only: a candidate (a chair) stays verified on its own evidence.
+          s.coherent_eligible.resize(n);
+          for (std::size_t i = 0; i < n; ++i) s.coherent_eligible[i] = s.sem_labels[i] == FeatureLabel::Dynamic;
+          flag_coherent_cells(kp, s.reprojection.residual_vec.data(), s.dyn_boxes, s.reprojection.inlier_noise_px, co,
+                              s.moving.labels.data(), &s.coherent_motion, masks ? s.in_object.data() : nullptr,
+                              masks ? s.object_box_bits.data() : nullptr, s.coherent_eligible.data());
+          r.coherent_motion.status = s.coherent_motion.status;
+          r.coherent_motion.reason = s.coherent_motion.reason;
+          r.coherent_motion.num_dynamic = s.coherent_motion.num_flagged;
+        }
+      }
       const bool memory = options.subbox_memory_frames > 0 && options.use_box_tracker && r.tracker.ran() &&
                           frame.track_ids && frame.track_ids->size() == n;
       if (memory) {

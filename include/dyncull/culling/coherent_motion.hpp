@@ -1,0 +1,150 @@
+/// @file coherent_motion.hpp
+/// Cell-level motion evidence for 003's sub-box vote (Algorithm 1; our extension): the features of one
+/// sub-box of an object move together, so the median of their reprojection residual vectors becomes
+/// significant well before any single residual passes its threshold (a seated person's sway). A cell whose
+/// median residual exceeds `sigmas` standard errors of a median is flagged as a whole (docs/algorithms.md).
+#pragma once
+
+#include "dyncull/core/box.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/subbox_refine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+
+/// Options. The test: |median residual vector| > sigmas * 1.2533 * noise / sqrt(N) and > min_median_px,
+/// with N the cell's features with a residual and noise the per-component sd of a static track's residual
+/// (at least min_noise_px). 1.2533 sigma / sqrt(N) is the standard error of a median of N Gaussian samples.
+template <class T>
+struct CoherentMotionOptions {
+  int grid = 3;                 ///< grid x grid cells per box, as SubBoxOptions::grid
+  std::size_t min_points = 4;   ///< fewer features with a residual: the cell is not tested
+  /// Far above a statistical 3: the residuals of a still object near the camera share an offset too (the
+  /// map points' error and the pose fitted on the far background), which the noise does not model.
+  T sigmas = T(10);
+  T min_noise_px = T(0.2);      ///< floor of the noise: LK and map points rarely do better at 640x480
+  T min_median_px = T(0.5);     ///< a shared offset below this is never motion
+};
+
+/// Outcome: which cells were flagged and how many features turned Dynamic.
+template <class T>
+struct CoherentMotionResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  std::vector<std::uint8_t> cells;  ///< per box grid*grid, 1 = coherent motion (box-major, as SubBoxResult)
+  std::size_t num_cells_tested = 0, num_cells_flagged = 0;
+  std::size_t num_flagged = 0;      ///< Static features made Dynamic
+  T noise_px = T(0);                ///< the noise the test used
+
+  // Scratch reused across frames.
+  std::vector<std::uint32_t> scratch_order, scratch_start;
+  std::vector<T> scratch_u, scratch_v;
+};
+
+/// Flags the cells of each box whose features' residual vectors share a significant median, and turns
+/// their Static labels Dynamic (Candidate labels, features without evidence, stay). residuals[i]: measured
+/// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
+/// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: min_noise_px).
+/// in_object_mask / object_box_bits as in refine_subboxes: a box's cells hold only its object's features.
+/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged).
+template <class T, class Points, class Boxes>
+void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const Boxes& boxes, T noise_px,
+                         const CoherentMotionOptions<T>& options, FeatureLabel* labels, CoherentMotionResult<T>* out,
+                         const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr,
+                         const std::uint8_t* eligible = nullptr) {
+  static_assert(is_point_container_v<Points>, "dyncull::flag_coherent_cells: points must hold points (see PointTraits)");
+  CoherentMotionResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(points.size());
+  const std::size_t nb = static_cast<std::size_t>(boxes.size());
+  const int g = options.grid;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_cells_tested = r.num_cells_flagged = r.num_flagged = 0;
+  r.cells.clear();
+  if (g < 1 || g > 8 || !(options.sigmas > T(0)) || !(options.min_noise_px > T(0)) || !(options.min_median_px >= T(0)) ||
+      options.min_points < 1) {
+    r.status = Status::InvalidInput;
+    r.reason = "invalid options: 1 <= grid <= 8, sigmas > 0, min_noise_px > 0, min_median_px >= 0, min_points >= 1";
+    return;
+  }
+  const std::size_t cells_per_box = static_cast<std::size_t>(g * g);
+  r.cells.assign(nb * cells_per_box, 0);
+  if (n == 0 || nb == 0) {
+    r.status = Status::Skipped;
+    r.reason = n == 0 ? "no features" : "no boxes";
+    return;
+  }
+  if (!residuals || !labels) {
+    r.status = Status::InvalidInput;
+    r.reason = "residuals and labels are required";
+    return;
+  }
+  r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, options.min_noise_px) : options.min_noise_px;
+  r.scratch_order.resize(n);
+  r.scratch_start.resize(cells_per_box + 1);
+  r.scratch_u.resize(n);
+  r.scratch_v.resize(n);
+  std::uint32_t* start = r.scratch_start.data();
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Box<T>& box = detail::subbox_as_box(boxes[b]);
+    if (!box.valid()) continue;
+    // Counting sort of the box's object features with a residual by cell (allocation-free).
+    std::fill(start, start + cells_per_box + 1, 0u);
+    auto cell_of = [&](std::size_t i) {
+      if ((eligible && !eligible[i]) || !detail::subbox_in_object(in_object_mask, object_box_bits, i, b) ||
+          !residuals[i].allFinite())
+        return -1;
+      return detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const int c = cell_of(i);
+      if (c >= 0) ++start[c + 1];
+    }
+    for (std::size_t c = 0; c < cells_per_box; ++c) start[c + 1] += start[c];
+    for (std::size_t i = 0; i < n; ++i) {
+      const int c = cell_of(i);
+      if (c >= 0) r.scratch_order[start[c]++] = static_cast<std::uint32_t>(i);
+    }
+    // start[c] is now the end of cell c; cell c begins at start[c - 1] (0 for the first).
+    for (std::size_t c = 0; c < cells_per_box; ++c) {
+      const std::uint32_t begin = c == 0 ? 0u : start[c - 1], end = start[c];
+      const std::size_t count = end - begin;
+      if (count < options.min_points) continue;
+      ++r.num_cells_tested;
+      for (std::uint32_t k = begin; k < end; ++k) {
+        r.scratch_u[k - begin] = residuals[r.scratch_order[k]].x();
+        r.scratch_v[k - begin] = residuals[r.scratch_order[k]].y();
+      }
+      const auto median = [count](std::vector<T>& v) {
+        const auto mid = v.begin() + static_cast<std::ptrdiff_t>(count / 2);
+        std::nth_element(v.begin(), mid, v.begin() + static_cast<std::ptrdiff_t>(count));
+        return *mid;
+      };
+      const T mu = median(r.scratch_u), mv = median(r.scratch_v);
+      const T magnitude = std::sqrt(mu * mu + mv * mv);
+      const T standard_error = T(1.2533) * r.noise_px / std::sqrt(static_cast<T>(count));
+      if (!(magnitude > options.min_median_px && magnitude > options.sigmas * standard_error)) continue;
+      r.cells[b * cells_per_box + c] = 1;
+      ++r.num_cells_flagged;
+      for (std::uint32_t k = begin; k < end; ++k) {
+        FeatureLabel& l = labels[r.scratch_order[k]];
+        if (l != FeatureLabel::Static) continue;
+        l = FeatureLabel::Dynamic;
+        ++r.num_flagged;
+      }
+    }
+  }
+}
+
+}  // namespace dyncull
