@@ -49,6 +49,7 @@ struct CoherentMotionResult {
 
   // Scratch reused across frames.
   std::vector<std::uint32_t> scratch_order, scratch_start;
+  std::vector<std::int8_t> scratch_cell;
   std::vector<T> scratch_u, scratch_v;
 };
 
@@ -92,6 +93,7 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
   }
   r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, options.min_noise_px) : options.min_noise_px;
   r.scratch_order.resize(n);
+  r.scratch_cell.resize(n);
   r.scratch_start.resize(cells_per_box + 1);
   r.scratch_u.resize(n);
   r.scratch_v.resize(n);
@@ -101,19 +103,17 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
     if (!box.valid()) continue;
     // Counting sort of the box's object features with a residual by cell (allocation-free).
     std::fill(start, start + cells_per_box + 1, 0u);
-    auto cell_of = [&](std::size_t i) {
-      if ((eligible && !eligible[i]) || !detail::subbox_in_object(in_object_mask, object_box_bits, i, b) ||
-          !residuals[i].allFinite())
-        return -1;
-      return detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
-    };
     for (std::size_t i = 0; i < n; ++i) {
-      const int c = cell_of(i);
+      int c = -1;
+      if ((!eligible || eligible[i]) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b) &&
+          residuals[i].allFinite())
+        c = detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
+      r.scratch_cell[i] = static_cast<std::int8_t>(c);  // grid <= 8: cells 0-63
       if (c >= 0) ++start[c + 1];
     }
     for (std::size_t c = 0; c < cells_per_box; ++c) start[c + 1] += start[c];
     for (std::size_t i = 0; i < n; ++i) {
-      const int c = cell_of(i);
+      const int c = r.scratch_cell[i];
       if (c >= 0) r.scratch_order[start[c]++] = static_cast<std::uint32_t>(i);
     }
     // start[c] is now the end of cell c; cell c begins at start[c - 1] (0 for the first).
