@@ -160,6 +160,7 @@ PipelineOptions<T> recommended() {
   // The whole-box rule stays (sigma2 = 4): without it (sigma2 = 9) precision rose by 0.01-0.02 but summed ATE
   // went 59.8 -> 65.6 cm over twelve seeds: it also culls movers their own cell's static vote missed
   // (docs/results.md, session 14).
+  o.subbox.sigma2 = 4;
   // A person's sub-box whose residuals share a significant median (10 standard errors, at least 0.5 px)
   // counts as flagged: a seated person's sway stays under the per-track thresholds. Twelve seeds, session
   // 13: recall 0.75-0.83 -> 0.83-0.87, precision 0.881-0.936 -> 0.861-0.931, summed ATE 59.9 -> 59.8 cm
