@@ -145,7 +145,8 @@ BENCHMARK(BM_Pipeline_PeerLK)->Unit(benchmark::kMicrosecond);
 
 namespace {
 // Cost of each stage: the recommended pipeline with one stage switched off (arg: 0 assignment of
-// overlapping masks by depth, 1 depth mask, 2 sub-box, 3 moving consistency (and so sub-box), 4 box tracker).
+// overlapping masks by depth, 1 depth mask, 2 sub-box, 3 moving consistency (and so sub-box), 4 box tracker,
+// 5 low-level shelter by depth).
 void BM_Pipeline_RecommendedWithout(benchmark::State& state) {
   dyncull::PipelineOptions<float> o = dyncull::presets::recommended<float>();
   switch (state.range(0)) {
@@ -153,9 +154,10 @@ void BM_Pipeline_RecommendedWithout(benchmark::State& state) {
     case 1: o.use_depth_mask = false; break;
     case 2: o.use_subbox = false; break;
     case 3: o.use_moving_consistency = false; break;
-    default: o.use_box_tracker = false; break;
+    case 4: o.use_box_tracker = false; break;
+    default: o.low_override_by_depth = false; break;
   }
   run_pipeline(state, o);
 }
-BENCHMARK(BM_Pipeline_RecommendedWithout)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Pipeline_RecommendedWithout)->DenseRange(0, 5)->Unit(benchmark::kMicrosecond);
 }  // namespace

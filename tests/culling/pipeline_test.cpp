@@ -523,6 +523,116 @@ TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
   }
 }
 
+// A walker passing in front of a TV, covering the TV box's centre: 002/004's rule shelters the walker's
+// features inside the TV box. With low_override_by_depth they lose the shelter (the TV's depth, re-read
+// from its pixels beside the walker, is 1.5 m behind them) and are culled; the TV's own features stay
+// static. A TV at the walker's depth keeps sheltering them.
+TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
+  using T = TypeParam;
+  const int W = 320, H = 240;
+  auto scene = [&](float tv_depth) {
+    std::vector<float> depth(static_cast<std::size_t>(W * H), 4.0f);  // back wall
+    auto fill = [&](int c0, int r0, int c1, int r1, float d) {
+      for (int v = r0; v < r1; ++v)
+        for (int u = c0; u < c1; ++u) depth[static_cast<std::size_t>(v * W + u)] = d;
+    };
+    fill(60, 60, 180, 140, tv_depth);  // TV (centre 120, 100)
+    fill(100, 30, 200, 230, 2.0f);     // walker in front, over the TV's centre
+    return depth;
+  };
+  std::vector<Detection<T>> dets = {Detection<T>{Box<T>{T(95), T(25), T(205), T(235)}, 0, T(0.9)},    // person
+                                    Detection<T>{Box<T>{T(58), T(58), T(182), T(142)}, 62, T(0.9)}};  // tv
+  std::vector<Vec2<T>> kp;
+  std::vector<int> kind;  // 0 walker in the TV box, 1 walker elsewhere, 2 TV beside the walker, 3 wall
+  auto add = [&](int u0, int v0, int u1, int v1, int k) {
+    for (int v = v0; v < v1; v += 8)
+      for (int u = u0; u < u1; u += 8) {
+        kp.emplace_back(T(u), T(v));
+        kind.push_back(k);
+      }
+  };
+  add(104, 66, 176, 136, 0);
+  add(104, 150, 196, 226, 1);
+  add(64, 66, 94, 136, 2);
+  add(8, 8, 312, 20, 3);  // outside the boxes, so the survivor guard stays quiet
+  PinholeCamera<T> camera;
+  camera.cx = T(159.5);
+  camera.cy = T(119.5);
+  camera.width = W;
+  camera.height = H;
+
+  PipelineOptions<T> o = presets::none<T>();
+  o.use_detection_filter = false;
+  o.use_box_rule = true;
+  o.use_depth_mask = true;
+  o.depth_mask.mode = DepthMaskMode::Robust;
+  auto rates = [&](const std::vector<float>& depth, const PipelineOptions<T>& opt, std::vector<double>* out) {
+    CullingFrame<T, std::vector<Vec2<T>>> frame;
+    frame.keypoints = &kp;
+    frame.detections = &dets;
+    frame.depth = DepthView<float>{depth.data(), W, H, 0, 1.f, 0.f, 1e30f};
+    frame.camera = camera;
+    PipelineState<T> state;
+    const PipelineResult<T>& r = cull_frame(frame, opt, &state);
+    ASSERT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
+    out->assign(4, 0.0);
+    std::vector<double> count(4, 0.0);
+    for (std::size_t i = 0; i < kp.size(); ++i) {
+      count[static_cast<std::size_t>(kind[i])] += 1;
+      (*out)[static_cast<std::size_t>(kind[i])] += r.labels[i] == FeatureLabel::Dynamic;
+    }
+    for (std::size_t k = 0; k < 4; ++k) (*out)[k] /= count[k];
+  };
+  const std::vector<float> behind = scene(3.5f), level = scene(2.0f);
+  std::vector<double> d;
+  rates(behind, o, &d);
+  EXPECT_EQ(d[0], 0.0) << "premise: the TV box shelters the walker (002 Table 2)";
+  EXPECT_EQ(d[1], 1.0);
+  o.low_override_by_depth = true;
+  rates(behind, o, &d);
+  EXPECT_EQ(d[0], 1.0) << "the walker is 1.5 m in front of the TV";
+  EXPECT_EQ(d[1], 1.0);
+  EXPECT_EQ(d[2], 0.0);
+  EXPECT_EQ(d[3], 0.0);
+  rates(level, o, &d);
+  EXPECT_EQ(d[0], 0.0) << "at the TV's depth the shelter stands";
+  EXPECT_EQ(d[1], 1.0);
+  EXPECT_EQ(d[2], 0.0);
+}
+
+// The box tracker carries missed dynamic-class boxes only: a TV box missed for a frame (or a one-frame false
+// positive) must not keep sheltering a walker in front of where it was.
+TYPED_TEST(PipelineTest, TrackerCarriesMoversNotLowLevelBoxes) {
+  using T = TypeParam;
+  PipelineOptions<T> o = presets::none<T>();
+  o.use_detection_filter = false;
+  o.use_box_rule = true;
+  o.use_box_tracker = true;
+  PinholeCamera<T> camera;
+  camera.width = 320;
+  camera.height = 240;
+  const Detection<T> person{Box<T>{T(100), T(30), T(200), T(230)}, 0, T(0.9)};
+  const Detection<T> tv{Box<T>{T(120), T(60), T(180), T(120)}, 62, T(0.9)};
+  std::vector<Vec2<T>> kp = {Vec2<T>(T(150), T(90)), Vec2<T>(T(150), T(200)), Vec2<T>(T(20), T(20))};
+  for (int u = 10; u < 310; u += 10) kp.emplace_back(T(u), T(10));  // wall: keeps the survivor guard quiet
+  CullingFrame<T, std::vector<Vec2<T>>> frame;
+  frame.keypoints = &kp;
+  frame.camera = camera;
+  PipelineState<T> state;
+  std::vector<Detection<T>> both = {person, tv}, none;
+  frame.detections = &both;
+  const PipelineResult<T>& first = cull_frame(frame, o, &state);
+  EXPECT_EQ(first.reasons[0], CullReason::None) << "in the TV box: sheltered (002 Table 2)";
+  EXPECT_EQ(first.labels[1], FeatureLabel::Dynamic);
+  frame.detections = &none;  // both missed in the next frame
+  const PipelineResult<T>& second = cull_frame(frame, o, &state);
+  ASSERT_TRUE(second.tracker.ran()) << second.tracker.reason;
+  EXPECT_EQ(second.labels[0], FeatureLabel::Dynamic) << "the carried person box culls; no carried TV box shelters";
+  EXPECT_EQ(second.labels[1], FeatureLabel::Dynamic);
+  EXPECT_EQ(second.labels[2], FeatureLabel::Static);
+  EXPECT_EQ(state.boxes.size(), 1u) << "only the person's box is carried";
+}
+
 // edge_evidence_radius_px: epipolar flags of features near a depth step stop counting as evidence
 // (their moving-consistency label becomes Candidate), and only those; movers are still culled through
 // their boxes' sub-box votes.

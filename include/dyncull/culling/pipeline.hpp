@@ -107,6 +107,13 @@ struct PipelineOptions {
   /// feature in a person's box but only in a chair's mask. false: the box rule's label (highest level
   /// of the rectangles holding it) stands.
   bool assign_overlaps_by_depth = false;
+  /// A low-level box (a TV) shelters a feature that a dynamic-class object's depth mask holds only when
+  /// the feature's depth is at least as near the low-level object's depth as that object's d_c: a walker
+  /// passing in front of a TV is not on it, and 002/004's rule would keep its features. The low-level
+  /// object's depth is its box's d_c (000's centre sample, re-estimated from the pixels outside a nearer
+  /// box that covers its centre: DepthMaskOptions::occluded_centre_search); without a depth there the
+  /// shelter stands. Needs the depth mask.
+  bool low_override_by_depth = false;
   /// Sub-box memory (subbox_memory.hpp): a sub-box its own features voted dynamic stays dynamic for this
   /// many frames in the same tracked box, for the tracks flagged in that time or younger than it. 0 = off.
   /// Needs the box tracker (use_box_tracker) and CullingFrame::track_ids; without them the stage report
@@ -187,7 +194,7 @@ struct PipelineState {
 
   PipelineResult<T> result;
   // Scratch (internal).
-  std::vector<Detection<T>> boxes, dyn_boxes;
+  std::vector<Detection<T>> boxes, dyn_boxes, untracked_boxes, shelter_boxes;
   std::vector<std::uint32_t> object_box_bits;  ///< per feature: the dynamic boxes whose depth mask holds it
   std::vector<std::int32_t> dyn_box_source;
   std::vector<std::int64_t> box_track_id, dyn_box_track_id;  ///< box-tracker id per box (-1: none)
@@ -256,6 +263,76 @@ bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u,
   *u = static_cast<int>(std::lround(x));
   *v = static_cast<int>(std::lround(y));
   return *u >= 0 && *v >= 0 && *u < w && *v < h;
+}
+
+/// PipelineOptions::low_override_by_depth: features the box rule sheltered (LowLevelOverride) that a
+/// dynamic-class object's depth mask holds lose the shelter when their depth is nearer that object's d_c
+/// than the d_c of every low-level box holding them. `combined` lists the dynamic-class boxes, then the
+/// low-level ones (scratch); their depth is planned again with occluded_centre_search so a TV's depth is
+/// not read off the walker in front of its centre. Returns how many features lost the shelter.
+template <class T, class Keypoints, class Raw>
+std::size_t unshelter_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, const DepthMaskResult& dm,
+                               const std::vector<Detection<T>>& dyn_boxes, const std::vector<Detection<T>>& boxes,
+                               const MotionLevelTable& levels, DepthMaskOptions depth_options,
+                               std::vector<Detection<T>>* combined, std::vector<std::uint32_t>* bits,
+                               std::vector<FeatureLabel>* labels, std::vector<CullReason>* reasons,
+                               std::vector<std::uint8_t>* in_dyn_box) {
+  const std::size_t n = bits->size();
+  bool any = false;
+  for (std::size_t i = 0; i < n && !any; ++i) any = (*reasons)[i] == CullReason::LowLevelOverride && (*bits)[i] != 0;
+  if (!any) return 0;
+  const std::size_t nd = std::min<std::size_t>({dyn_boxes.size(), dm.boxes.size(), 32});
+  combined->assign(dyn_boxes.begin(), dyn_boxes.begin() + static_cast<std::ptrdiff_t>(nd));
+  for (const Detection<T>& b : boxes)
+    if (levels.level(b.class_id) == MotionLevel::Low) combined->push_back(b);
+  if (combined->size() == nd) return 0;
+  depth_options.occluded_centre_search = true;
+  // Only the per-box depths are needed: no points.
+  const DepthMaskResult planned = depth_mask(depth, *combined, std::vector<Vec2<T>>{}, depth_options);
+  if (!planned.ok() || planned.boxes.size() != combined->size()) return 0;
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t b = (*bits)[i];
+    if ((*reasons)[i] != CullReason::LowLevelOverride || b == 0) continue;
+    int u = 0, v = 0;
+    if (!keypoint_in_image<T>(kp, i, depth.width, depth.height, &u, &v)) continue;
+    const double d = depth.depth_m(u, v);
+    if (!(d > 0)) continue;
+    // Nearest dynamic-class object among the masks holding the feature.
+    std::size_t best = nd;
+    double best_gap = 0;
+    for (std::size_t k = 0; k < nd; ++k) {
+      const double dc = dm.boxes[k].d_c_m;
+      if (!(b & (std::uint32_t(1) << k)) || !(dc > 0)) continue;
+      const double gap = std::abs(d - dc);
+      if (best == nd || gap < best_gap) {
+        best = k;
+        best_gap = gap;
+      }
+    }
+    if (best == nd) continue;
+    // Sheltered by any low-level box holding it whose depth is unknown or at least as near.
+    bool sheltered = false;
+    const T x = point_x<T>(kp[i]), y = point_y<T>(kp[i]);
+    for (std::size_t k = nd; k < combined->size() && !sheltered; ++k) {
+      const Box<T>& box = (*combined)[k].box;
+      if (!box.contains(x, y)) continue;
+      const DepthMaskBoxInfo& info = planned.boxes[k];
+      sheltered = !info.ok() || !(info.d_c_m > 0) || std::abs(d - info.d_c_m) <= best_gap;
+    }
+    if (sheltered) continue;
+    (*bits)[i] = std::uint32_t(1) << best;
+    (*in_dyn_box)[i] = 1;
+    if (levels.level(dyn_boxes[best].class_id) == MotionLevel::High) {
+      (*labels)[i] = FeatureLabel::Dynamic;
+      (*reasons)[i] = CullReason::HighLevelBox;
+    } else {
+      (*labels)[i] = FeatureLabel::Candidate;
+      (*reasons)[i] = CullReason::MediumLevelBox;
+    }
+    ++changed;
+  }
+  return changed;
 }
 
 /// PipelineOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
@@ -377,14 +454,26 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     r.detections.reason = "no detections given";
   }
   if (options.use_box_tracker) {
+    // Only dynamic-class boxes are tracked: carrying a missed (or one-frame false positive) low-level box
+    // would only stretch its shelter over whatever moves in front of it.
+    s.untracked_boxes.clear();
+    std::size_t kept = 0;
+    for (std::size_t b = 0; b < s.boxes.size(); ++b) {
+      const MotionLevel lv = options.levels.level(s.boxes[b].class_id);
+      if (lv == MotionLevel::High || lv == MotionLevel::Medium)
+        s.boxes[kept++] = s.boxes[b];
+      else
+        s.untracked_boxes.push_back(s.boxes[b]);
+    }
+    s.boxes.resize(kept);
     BoxTrackerResult<T> t = s.tracker.update(s.boxes, W, H);
     r.tracker.status = t.status;
     r.tracker.reason = t.reason;
+    if (t.ok()) s.boxes = t.boxes;
     s.box_track_id.assign(s.boxes.size(), -1);
-    if (t.ok()) {
-      s.boxes = t.boxes;
-      s.box_track_id = t.track_id;
-    }
+    if (t.ok()) s.box_track_id = t.track_id;
+    s.boxes.insert(s.boxes.end(), s.untracked_boxes.begin(), s.untracked_boxes.end());
+    s.box_track_id.resize(s.boxes.size(), -1);
   } else {
     s.box_track_id.assign(s.boxes.size(), -1);
   }
@@ -431,6 +520,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       if (dm.ok()) {
         r.depth_mask.num_dynamic = dm.num_dynamic;
         s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
+        if (options.low_override_by_depth && options.use_box_rule)
+          detail::unshelter_by_depth(kp, frame.depth, dm, s.dyn_boxes, s.boxes, options.levels, options.depth_mask,
+                                     &s.shelter_boxes, &s.object_box_bits, &s.sem_labels, &s.sem_reasons, &s.in_dyn_box);
         if (options.assign_overlaps_by_depth && options.use_box_rule)
           detail::assign_overlaps_by_depth(kp, frame.depth, dm, s.dyn_boxes, options.levels, &s.object_box_bits,
                                            &s.sem_labels, &s.sem_reasons);
