@@ -55,6 +55,28 @@ CullingFrame<T, std::vector<Vec2<T>>> frame_of(const test::CullingScene<T>& s, c
   return frame;
 }
 
+/// A W x H camera with its principal point at the image centre (hand-drawn depth scenes).
+template <class T>
+PinholeCamera<T> centred_camera(int W, int H) {
+  PinholeCamera<T> camera;
+  camera.cx = T(W - 1) / T(2);
+  camera.cy = T(H - 1) / T(2);
+  camera.width = W;
+  camera.height = H;
+  return camera;
+}
+
+/// The box rule with the robust depth mask, nothing else (no detection filter: boxes as drawn).
+template <class T>
+PipelineOptions<T> box_rule_and_depth_mask() {
+  PipelineOptions<T> o = presets::none<T>();
+  o.use_detection_filter = false;
+  o.use_box_rule = true;
+  o.use_depth_mask = true;
+  o.depth_mask.mode = DepthMaskMode::Robust;
+  return o;
+}
+
 /// Runs one preset on the scene (keyframe 8 frames back stored for the multi-view check).
 template <class T>
 const PipelineResult<T>& run(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets,
@@ -475,18 +497,10 @@ TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
     kp.emplace_back(T(u), T(10));
     kind.push_back(2);
   }
-  PinholeCamera<T> camera;
-  camera.cx = T(159.5);
-  camera.cy = T(119.5);
-  camera.width = W;
-  camera.height = H;
+  const PinholeCamera<T> camera = centred_camera<T>(W, H);
 
-  PipelineOptions<T> o = presets::none<T>();
-  o.use_detection_filter = false;
-  o.use_box_rule = true;
+  PipelineOptions<T> o = box_rule_and_depth_mask<T>();
   o.box_rule.medium_as_candidate = true;
-  o.use_depth_mask = true;
-  o.depth_mask.mode = DepthMaskMode::Robust;
   o.candidates = CandidatePolicy::Verify;  // no tracks: nothing verifies the candidates
   CullingFrame<T, std::vector<Vec2<T>>> frame;
   frame.keypoints = &kp;
@@ -555,17 +569,9 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
   add(104, 150, 196, 226, 1);
   add(64, 66, 94, 136, 2);
   add(8, 8, 312, 20, 3);  // outside the boxes, so the survivor guard stays quiet
-  PinholeCamera<T> camera;
-  camera.cx = T(159.5);
-  camera.cy = T(119.5);
-  camera.width = W;
-  camera.height = H;
+  const PinholeCamera<T> camera = centred_camera<T>(W, H);
 
-  PipelineOptions<T> o = presets::none<T>();
-  o.use_detection_filter = false;
-  o.use_box_rule = true;
-  o.use_depth_mask = true;
-  o.depth_mask.mode = DepthMaskMode::Robust;
+  PipelineOptions<T> o = box_rule_and_depth_mask<T>();
   auto rates = [&](const std::vector<float>& depth, const PipelineOptions<T>& opt, std::vector<double>* out) {
     CullingFrame<T, std::vector<Vec2<T>>> frame;
     frame.keypoints = &kp;
