@@ -537,6 +537,47 @@ TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
   }
 }
 
+// overlap_high_level_margin_m: a chair 0.1 m in front of a person (a sitter's thighs on the seat) goes to the
+// chair's box by nearest depth alone, to the person's with a 0.15 m margin; a chair 0.6 m in front stays
+// the chair's either way.
+TYPED_TEST(PipelineTest, HighLevelMarginGivesNearTiesToThePerson) {
+  using T = TypeParam;
+  const int W = 320, H = 240;
+  auto scene = [&](float chair_depth) {
+    std::vector<float> depth(static_cast<std::size_t>(W * H), 4.0f);
+    for (int v = 40; v < 220; ++v)
+      for (int u = 110; u < 190; ++u) depth[static_cast<std::size_t>(v * W + u)] = v >= 150 && u >= 120 ? chair_depth : 2.5f;
+    return depth;
+  };
+  std::vector<Detection<T>> dets = {Detection<T>{Box<T>{T(100), T(30), T(200), T(230)}, 0, T(0.9)},    // person
+                                    Detection<T>{Box<T>{T(115), T(145), T(205), T(235)}, 56, T(0.9)}};  // chair
+  std::vector<Vec2<T>> kp;
+  for (int v = 160; v < 215; v += 10)
+    for (int u = 125; u < 185; u += 10) kp.emplace_back(T(u), T(v));  // on the chair
+  const std::size_t on_chair = kp.size();
+  for (int u = 10; u < 300; u += 7) kp.emplace_back(T(u), T(10));  // wall: keeps the guard quiet
+  PipelineOptions<T> o = box_rule_and_depth_mask<T>();
+  o.assign_overlaps_by_depth = true;
+  auto chair_share = [&](float chair_depth, double margin) {
+    const std::vector<float> depth = scene(chair_depth);
+    CullingFrame<T, std::vector<Vec2<T>>> frame;
+    frame.keypoints = &kp;
+    frame.detections = &dets;
+    frame.depth = DepthView<float>{depth.data(), W, H, 0, 1.f, 0.f, 1e30f};
+    frame.camera = centred_camera<T>(W, H);
+    o.overlap_high_level_margin_m = margin;
+    PipelineState<T> state;
+    const PipelineResult<T>& r = cull_frame(frame, o, &state);
+    EXPECT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
+    std::size_t chair = 0;
+    for (std::size_t i = 0; i < on_chair; ++i) chair += state.object_box_bits[i] == 2u;
+    return double(chair) / double(on_chair);
+  };
+  EXPECT_EQ(chair_share(2.4f, 0.0), 1.0) << "nearest d_c: the chair";
+  EXPECT_EQ(chair_share(2.4f, 0.15), 0.0) << "within the margin: the person";
+  EXPECT_EQ(chair_share(1.9f, 0.15), 1.0) << "0.6 m in front: the chair";
+}
+
 // A walker passing in front of a TV, covering the TV box's centre: 002/004's rule shelters the walker's
 // features inside the TV box. With low_override_by_depth they lose the shelter (the TV's depth, re-read
 // from its pixels beside the walker, is 1.5 m behind them) and are culled; the TV's own features stay

@@ -107,6 +107,10 @@ struct PipelineOptions {
   /// feature in a person's box but only in a chair's mask. false: the box rule's label (highest level
   /// of the rectangles holding it) stands.
   bool assign_overlaps_by_depth = false;
+  /// With assign_overlaps_by_depth: a high-level object (a person) takes the feature unless another
+  /// object's d_c is nearer its depth by more than this. A seated person's torso and its chair hold the
+  /// same depths (the chair's centre sample often lands on the sitter's thighs); 0 = nearest d_c only.
+  double overlap_high_level_margin_m = 0;
   /// A low-level box (a TV) shelters a feature that a dynamic-class object's depth mask holds only when
   /// the feature's depth is at least as near the low-level object's depth as that object's d_c: a walker
   /// passing in front of a TV is not on it, and 002/004's rule would keep its features. The low-level
@@ -336,13 +340,14 @@ std::size_t unshelter_by_depth(const Keypoints& kp, const DepthView<Raw>& depth,
 }
 
 /// PipelineOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
-/// masks hold them, keeps one mask bit (the box with d_c nearest the feature's depth; ties and missing
-/// depth: the highest level, then the first box) and sets the semantic label from that box's level.
+/// masks hold them, keeps one mask bit (the box with d_c nearest the feature's depth, a high-level box's
+/// gap counted `high_level_margin_m` smaller; ties and missing depth: the highest level, then the first
+/// box) and sets the semantic label from that box's level.
 template <class T, class Keypoints, class Raw>
 void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, const DepthMaskResult& dm,
                               const std::vector<Detection<T>>& dyn_boxes, const MotionLevelTable& levels,
                               std::vector<std::uint32_t>* bits, std::vector<FeatureLabel>* labels,
-                              std::vector<CullReason>* reasons) {
+                              std::vector<CullReason>* reasons, double high_level_margin_m = 0) {
   const std::size_t n = bits->size();
   const std::size_t nb = std::min<std::size_t>({dyn_boxes.size(), dm.boxes.size(), 32});
   for (std::size_t i = 0; i < n; ++i) {
@@ -361,7 +366,8 @@ void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, 
       if (!(b & (std::uint32_t(1) << k))) continue;
       const MotionLevel lv = levels.level(dyn_boxes[k].class_id);
       const double dc = dm.boxes[k].d_c_m;
-      const double gap = d > 0.f && dc > 0 ? std::abs(static_cast<double>(d) - dc) : 0.0;
+      double gap = d > 0.f && dc > 0 ? std::abs(static_cast<double>(d) - dc) : 0.0;
+      if (lv == MotionLevel::High && d > 0.f && dc > 0) gap -= high_level_margin_m;
       const bool better = best == nb || gap < best_gap ||
                           (gap == best_gap && lv == MotionLevel::High && best_level != MotionLevel::High);
       if (better) {
@@ -525,7 +531,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
                                      &s.shelter_boxes, &s.object_box_bits, &s.sem_labels, &s.sem_reasons, &s.in_dyn_box);
         if (options.assign_overlaps_by_depth && options.use_box_rule)
           detail::assign_overlaps_by_depth(kp, frame.depth, dm, s.dyn_boxes, options.levels, &s.object_box_bits,
-                                           &s.sem_labels, &s.sem_reasons);
+                                           &s.sem_labels, &s.sem_reasons, options.overlap_high_level_margin_m);
         for (std::size_t i = 0; i < n; ++i) {
           s.in_object[i] = dm.labels[i] != FeatureLabel::Static;
           if (dm.labels[i] == FeatureLabel::Dynamic && dm.reasons[i] == CullReason::InvalidInput) {
