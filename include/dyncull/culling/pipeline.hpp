@@ -108,8 +108,8 @@ struct PipelineOptions {
   /// of the rectangles holding it) stands.
   bool assign_overlaps_by_depth = false;
   /// With assign_overlaps_by_depth: a high-level object (a person) takes the feature unless another
-  /// object's d_c is nearer its depth by more than this. A seated person's torso and its chair hold the
-  /// same depths (the chair's centre sample often lands on the sitter's thighs); 0 = nearest d_c only.
+  /// object's d_c is nearer its depth by more than this: a seated person's torso and its chair lie at
+  /// nearly the same depth, and the torso's features would go to the chair. 0 = nearest d_c only.
   double overlap_high_level_margin_m = 0;
   /// A low-level box (a TV) shelters a feature that a dynamic-class object's depth mask holds only when
   /// the feature's depth is at least as near the low-level object's depth as that object's d_c: a walker
