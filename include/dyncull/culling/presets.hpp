@@ -98,7 +98,7 @@ PipelineOptions<T> zhang_2023() {
 
 /// Recommended: the box rule with the low-level override (002/004) for features at the low-level object's
 /// depth, limited to the object's depth band (000, eps 0.5 m), each feature in overlapping masks given to
-/// the object nearest its depth, verified per region by the geometric check fitted outside boxes (003 +
+/// the object nearest its depth (a person unless the other is nearer by 0.15 m), verified per region by the geometric check fitted outside boxes (003 +
 /// SG-SLAM: the RGB-D reprojection check when the caller gives 3-D points, with the depth residual, else
 /// the epipolar one; flags within 8 px of a depth edge are not evidence) and the evidence-aware sub-box
 /// vote (keeps a seated person's still legs; not on a one-frame baseline; a person's cell whose residuals
