@@ -98,13 +98,13 @@ PipelineOptions<T> zhang_2023() {
 
 /// Recommended: the box rule with the low-level override (002/004) for features at the low-level object's
 /// depth, limited to the object's depth band (000, eps 0.5 m), each feature in overlapping masks given to
-/// the object nearest its depth (a person unless the other is nearer by 0.15 m), verified per region by the geometric check fitted outside boxes (003 +
-/// SG-SLAM: the RGB-D reprojection check when the caller gives 3-D points, with the depth residual, else
-/// the epipolar one; flags within 8 px of a depth edge are not evidence) and the evidence-aware sub-box
-/// vote (keeps a seated person's still legs; not on a one-frame baseline; a person's cell whose residuals
-/// move together counts as flagged), medium-level objects culled only when their own features are flagged,
-/// each box's sub-boxes voted by and acting on its own depth-mask object only, a tracker for missed
-/// (dynamic-class) boxes, and the survivor guard.
+/// the object nearest its depth (a person unless the other is nearer by 0.15 m), verified per region by the
+/// geometric check fitted outside boxes (003 + SG-SLAM: the RGB-D reprojection check when the caller gives
+/// 3-D points, with the depth residual, else the epipolar one; flags within 8 px of a depth edge are not
+/// evidence) and the evidence-aware sub-box vote (keeps a seated person's still legs; not on a one-frame
+/// baseline; a person's cell whose residuals move together counts as flagged), medium-level objects culled
+/// only when their own features are flagged, each box's sub-boxes voted by and acting on its own depth-mask
+/// object only, a tracker for missed (dynamic-class) boxes, and the survivor guard.
 /// Tracks: give as prev_keypoints the features' positions in a reference frame a few frames back (the
 /// front end's keyframe), not the previous frame: slow movers (a seated person) build up a measurable
 /// epipolar distance only over several frames, hence the 1 px in-box threshold (0.5 px suits
