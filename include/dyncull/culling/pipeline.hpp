@@ -475,9 +475,11 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     BoxTrackerResult<T> t = s.tracker.update(s.boxes, W, H);
     r.tracker.status = t.status;
     r.tracker.reason = t.reason;
-    if (t.ok()) s.boxes = t.boxes;
     s.box_track_id.assign(s.boxes.size(), -1);
-    if (t.ok()) s.box_track_id = t.track_id;
+    if (t.ok()) {
+      s.boxes = t.boxes;
+      s.box_track_id = t.track_id;
+    }
     s.boxes.insert(s.boxes.end(), s.untracked_boxes.begin(), s.untracked_boxes.end());
     s.box_track_id.resize(s.boxes.size(), -1);
   } else {
