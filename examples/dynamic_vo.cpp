@@ -51,7 +51,10 @@ void usage(const char* argv0) {
       "                      instead of the synthetic sequences\n"
       "  --detections PATH   YOLO detections for --tum: a directory of <rgb stem>.txt files or one file of\n"
       "                      '<rgb timestamp> class cx cy w h [conf]' lines (normalised coordinates)\n"
-      "  --strategies LIST   subset of strategies, comma separated (default: none + every preset; --list)\n"
+      "  --strategies LIST   subset of strategies, comma separated (default: none + every preset + oracle;\n"
+      "                      --list). recommended_no_false_culls / recommended_no_misses (sim only, when\n"
+      "                      named): the recommended preset with its false culls / missed movers undone by\n"
+      "                      the truth, to measure what each kind of error costs the pose\n"
       "  --list              print the strategies and exit\n"
       "  --out DIR           output directory (default ./dynamic_vo_out)\n"
       "  --quick             fewer frames, for smoke tests\n"
@@ -164,12 +167,14 @@ int main(int argc, char** argv) {
   std::vector<vo::StrategySpec> all = vo::all_strategies();
   if (args.list) {
     for (const auto& s : all)
-      std::printf("%-22s %s%s\n", s.name.c_str(), s.description.c_str(), s.needs_detections ? " [needs detections]" : "");
+      std::printf("%-26s %s%s%s\n", s.name.c_str(), s.description.c_str(), s.needs_detections ? " [needs detections]" : "",
+                  s.in_default ? "" : " [only when named]");
     return 0;
   }
   std::vector<vo::StrategySpec> chosen;
   if (args.strategies.empty()) {
-    chosen = all;
+    for (const auto& s : all)
+      if (s.in_default) chosen.push_back(s);
   } else {
     for (const std::string& name : args.strategies) {
       bool found = false;
@@ -210,12 +215,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
       return 1;
     }
-    // A TUM directory has no per-pixel motion truth: the oracle cannot run there.
+    // A TUM directory has no per-pixel motion truth: the oracle and the truth-repaired strategies cannot run there.
     std::vector<vo::StrategySpec> run;
     if (!source.has_detections())
       std::printf("No detections given (--detections): running only the strategies that need none.\n");
     for (const auto& s : chosen)
-      if (!s.oracle && (source.has_detections() || !s.needs_detections)) run.push_back(s);
+      if (!s.needs_truth() && (source.has_detections() || !s.needs_detections)) run.push_back(s);
     std::string name = std::filesystem::path(args.tum).filename().string();
     if (name.empty()) name = std::filesystem::path(args.tum).parent_path().filename().string();
     vo::SequenceReport rep;

@@ -1,7 +1,8 @@
 /// @file culling.hpp
 /// The culling strategies the dynamic_vo demo compares: no culling, each dyncull preset
 /// (culling/presets.hpp, run by culling/pipeline.hpp's cull_frame) and a truth oracle on the sim,
-/// applied to the current frame's tracked features before PnP.
+/// applied to the current frame's tracked features before PnP; on request, the recommended preset with
+/// one kind of error repaired by the sim's truth (what each kind costs the pose).
 #pragma once
 
 #include "dyncull/core/camera.hpp"
@@ -21,6 +22,13 @@
 namespace dyncull {
 namespace vo {
 
+/// Which of a preset's errors the sim's truth repairs (diagnostic strategies, never in the default run).
+enum class TruthRepair : std::uint8_t {
+  None,
+  RestoreFalseCulls,  ///< static features it culled are kept: precision 1, recall unchanged
+  CullMisses,         ///< moving features it kept are culled: recall 1, precision unchanged
+};
+
 /// One strategy: a name for the table and how to build its culling.
 struct StrategySpec {
   std::string name;
@@ -35,9 +43,15 @@ struct StrategySpec {
   /// use the previous frame and no 3-D points.
   bool tracks_from_keyframe = false;
   PipelineOptions<float> pipeline{};
+  TruthRepair truth_repair = TruthRepair::None;
+  bool in_default = true;  ///< run when --strategies does not name the strategies
+
+  /// Needs the sim's per-pixel motion truth (cannot run on a TUM directory).
+  bool needs_truth() const { return oracle || truth_repair != TruthRepair::None; }
 };
 
-/// "none" first (the reference of the improvement column), then the presets, then the oracle.
+/// "none" first (the reference of the improvement column), then the presets, then the oracle, then the
+/// truth-repaired copies of the recommended preset (only when named in --strategies).
 inline std::vector<StrategySpec> all_strategies() {
   std::vector<StrategySpec> out;
   auto add = [&](const char* name, const char* description, bool culls, bool dets, bool rec, bool oracle,
@@ -57,6 +71,20 @@ inline std::vector<StrategySpec> all_strategies() {
       true, true, true, false, presets::recommended<float>());
   add("oracle", "culls exactly the features on moving surfaces (sim truth): the best any culling can do", true, false,
       false, true, presets::none<float>());
+  // The recommended preset with one kind of error undone by the truth: how much of its ATE gap to the oracle
+  // its false culls cause, and how much its missed movers.
+  const StrategySpec recommended = out[out.size() - 2];
+  for (const TruthRepair repair : {TruthRepair::RestoreFalseCulls, TruthRepair::CullMisses}) {
+    StrategySpec spec = recommended;
+    const bool restore = repair == TruthRepair::RestoreFalseCulls;
+    spec.name = restore ? "recommended_no_false_culls" : "recommended_no_misses";
+    spec.description = restore ? "recommended, but the static features it culls are kept (sim truth; diagnostic)"
+                               : "recommended, but the moving features it keeps are culled (sim truth; diagnostic)";
+    spec.recommended = false;
+    spec.truth_repair = repair;
+    spec.in_default = false;
+    out.push_back(spec);
+  }
   return out;
 }
 
@@ -105,6 +133,7 @@ class Culler {
       *keep = r.keep;
       reasons_ = r.reasons;
       explain_kept(r);
+      if (spec_.truth_repair != TruthRepair::None) repair_by_truth(frame, tracks, keep);
     }
   }
 
@@ -114,6 +143,20 @@ class Culler {
   const std::vector<KeptWhy>& kept_why() const { return kept_why_; }
 
  private:
+  /// TruthRepair: flips the labels of one kind of error to the truth's (the pixel nearest each track).
+  /// reasons() and kept_why() keep the preset's own decision, so --diagnose still says what it decided.
+  void repair_by_truth(const SequenceFrame& frame, const Tracks& tracks, std::vector<std::uint8_t>* keep) const {
+    if (frame.moving.empty()) return;
+    const bool restore = spec_.truth_repair == TruthRepair::RestoreFalseCulls;
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      const int u = cvRound(tracks.cur_px[i].x), v = cvRound(tracks.cur_px[i].y);
+      if (u < 0 || v < 0 || u >= frame.moving.cols || v >= frame.moving.rows) continue;
+      const bool moving = frame.moving.at<std::uint8_t>(v, u) != 0;
+      if (restore && !moving) (*keep)[i] = 1;
+      if (!restore && moving) (*keep)[i] = 0;
+    }
+  }
+
   /// Reads the pipeline's per-stage scratch of this frame (PipelineState): which stage left a kept track
   /// static. Diagnostic only (dynamic_vo --diagnose).
   void explain_kept(const PipelineResult<float>& r) {

@@ -8,6 +8,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -67,6 +68,50 @@ TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
   EXPECT_GT(b.labels.recall(), 0.8);
   // No culling never culls: its counts have no positives at all.
   EXPECT_EQ(a.labels.true_positive + a.labels.false_positive, 0u);
+}
+
+// The diagnostic copies of the recommended preset undo one kind of error by the truth: no false culls leaves
+// no static feature culled, no misses leaves no moving feature kept. They are not in the default run and
+// need the sim's truth.
+TEST(DynamicVo, TruthRepairedStrategiesUndoOneKindOfError) {
+  const auto all = vo::all_strategies();
+  const vo::StrategySpec* preset = find_spec(all, true);
+  ASSERT_NE(preset, nullptr);
+  std::vector<vo::StrategySpec> run{*preset};
+  for (const char* name : {"recommended_no_false_culls", "recommended_no_misses"}) {
+    const auto it = std::find_if(all.begin(), all.end(), [&](const vo::StrategySpec& s) { return s.name == name; });
+    ASSERT_NE(it, all.end()) << name;
+    EXPECT_FALSE(it->in_default) << name;
+    EXPECT_TRUE(it->needs_truth()) << name;
+    EXPECT_FALSE(it->recommended) << name << ": only the preset itself is the table's default row";
+    EXPECT_TRUE(it->tracks_from_keyframe) << name << ": must see the tracks the preset sees";
+    run.push_back(*it);
+  }
+  EXPECT_FALSE(preset->needs_truth());
+
+  sim::SceneOptions so;
+  so.motion = sim::CameraMotion::Xyz;
+  so.num_frames = 30;
+  vo::SimSource source(so);
+  vo::RunnerOptions ro;
+  ro.max_frames = 30;
+  ro.write_outputs = false;
+  ro.print_progress = false;
+  vo::SequenceReport report;
+  std::string error;
+  ASSERT_TRUE(vo::run_sequence("xyz", source, run, ro, &report, &error)) << error;
+  ASSERT_EQ(report.runs.size(), 3u);
+  const vo::LabelCounts& plain = report.runs[0].labels;
+  const vo::LabelCounts& no_false_culls = report.runs[1].labels;
+  const vo::LabelCounts& no_misses = report.runs[2].labels;
+  // The preset itself makes both kinds of error here, so the repairs have something to undo.
+  EXPECT_GT(plain.false_positive, 0u);
+  EXPECT_GT(plain.false_negative, 0u);
+  EXPECT_EQ(no_false_culls.false_positive, 0u);
+  EXPECT_GT(no_false_culls.false_negative, 0u) << "its misses must stay";
+  EXPECT_GT(no_false_culls.true_positive, 0u);
+  EXPECT_EQ(no_misses.false_negative, 0u);
+  EXPECT_GT(no_misses.false_positive, 0u) << "its false culls must stay";
 }
 
 // A static camera must stay put: every frame's estimate within a few centimetres of the truth.
