@@ -47,13 +47,20 @@ struct SubBoxOptions {
   /// 0.3 tolerates the 15-25 % false flags of still parts noted at merge_ratio.
   bool static_needs_evidence = false;
   T static_max_dynamic_ratio = T(0.3);
+  /// The whole-box rule (sigma2) spares a cell whose own vote is clearly static: at least
+  /// whole_box_spare_min_points labelled features, at most whole_box_spare_max_ratio of them flagged (our
+  /// extension; 0 = off, the paper: every cell of the box turns dynamic). A seated person's still legs
+  /// outvote the flags there while its swaying upper body fills the other cells.
+  std::size_t whole_box_spare_min_points = 0;
+  T whole_box_spare_max_ratio = T(0.1);
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
 };
 
 /// Per-box vote. Cell (row, col) is cells[row * grid + col]; state 1 = dynamic.
 struct SubBoxVote {
   bool whole_box = false;       ///< more than sigma2 dynamic sub-boxes: the whole box is dynamic
-  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (after whole_box: grid*grid)
+  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (whole_box: grid*grid less spared)
+  int num_spared_cells = 0;     ///< clearly static cells the whole-box rule left static (whole_box_spare_min_points)
   int num_merged_cells = 0;     ///< static or empty cells merged because they touch a dynamic one
 };
 
@@ -199,9 +206,11 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
   if (g < 1 || g > 8 || !(options.sigma1 >= T(0)) || options.sigma2 < 0 ||
-      (options.static_needs_evidence && !(options.static_max_dynamic_ratio >= T(0)))) {
+      (options.static_needs_evidence && !(options.static_max_dynamic_ratio >= T(0))) ||
+      (options.whole_box_spare_min_points > 0 && !(options.whole_box_spare_max_ratio >= T(0)))) {
     r.status = Status::InvalidInput;
-    r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0, sigma2 >= 0 and static_max_dynamic_ratio >= 0 required";
+    r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0, sigma2 >= 0, static_max_dynamic_ratio >= 0 and "
+               "whole_box_spare_max_ratio >= 0 required";
     r.votes.clear();
     return;
   }
@@ -258,9 +267,15 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
     for (std::size_t c = 0; c < cells_per_box; ++c) vote.num_dynamic_cells += cells[c];
     if (vote.num_dynamic_cells > options.sigma2) {
       vote.whole_box = true;
-      vote.num_dynamic_cells = static_cast<int>(cells_per_box);
-      std::fill(cells, cells + cells_per_box, std::uint8_t(1));
       ++r.num_whole_boxes;
+      for (std::size_t c = 0; c < cells_per_box; ++c) {
+        const std::uint32_t total = dc[c] + sc[c];
+        const bool spared = options.whole_box_spare_min_points > 0 && total >= options.whole_box_spare_min_points &&
+                            T(dc[c]) <= options.whole_box_spare_max_ratio * T(total);
+        cells[c] = spared ? 0 : 1;
+        vote.num_spared_cells += spared;
+      }
+      vote.num_dynamic_cells = static_cast<int>(cells_per_box) - vote.num_spared_cells;
     }
     if (options.static_needs_evidence && !vote.whole_box)
       for (std::size_t c = 0; c < cells_per_box; ++c) {
