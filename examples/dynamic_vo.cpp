@@ -167,8 +167,8 @@ int main(int argc, char** argv) {
   std::vector<vo::StrategySpec> all = vo::all_strategies();
   if (args.list) {
     for (const auto& s : all)
-      std::printf("%-26s %s%s%s\n", s.name.c_str(), s.description.c_str(), s.needs_detections ? " [needs detections]" : "",
-                  s.in_default ? "" : " [only when named]");
+      std::printf("%-26s %s%s%s\n", s.name.c_str(), s.description.c_str(),
+                  s.needs_detections ? " [needs detections]" : "", s.in_default ? "" : " [only when named]");
     return 0;
   }
   std::vector<vo::StrategySpec> chosen;
