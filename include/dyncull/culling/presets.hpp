@@ -170,7 +170,8 @@ PipelineOptions<T> recommended() {
   o.subbox.static_max_dynamic_ratio = T(0.3);
   // The whole-box rule stays (sigma2 = 4): without it (sigma2 = 9) precision rose by 0.01-0.02 but summed ATE
   // went 59.8 -> 65.6 cm over twelve seeds: it also culls movers their own cell's static vote missed
-  // (docs/results.md, session 14).
+  // (docs/results.md, session 14). Sparing its clearly static cells (whole_box_spare_min_points 6, ratio 0.1)
+  // raised precision by 0.012-0.022 but cost recall up to 0.008 for the same summed ATE (session 16).
   o.subbox.sigma2 = 4;
   // A person's sub-box whose residuals share a significant median (10 standard errors, at least 0.5 px)
   // counts as flagged: a seated person's sway stays under the per-track thresholds. Twelve seeds, session
