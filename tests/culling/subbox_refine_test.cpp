@@ -33,6 +33,15 @@ std::vector<FeatureLabel> noisy_geometric_labels(const test::CullingScene<T>& s,
   return g;
 }
 
+// Appends n_static then n_dynamic labelled features on a short diagonal from (x, y) (one sub-box).
+template <class T>
+void add_votes(std::vector<Vec2<T>>* pts, std::vector<FeatureLabel>* geo, T x, T y, int n_static, int n_dynamic) {
+  for (int k = 0; k < n_static + n_dynamic; ++k) {
+    pts->emplace_back(x + T(2 * k), y + T(k));
+    geo->push_back(k < n_static ? FeatureLabel::Static : FeatureLabel::Dynamic);
+  }
+}
+
 template <class T>
 std::vector<Detection<T>> person_boxes(const test::CullingScene<T>& s) {
   std::vector<Detection<T>> out;
@@ -162,12 +171,7 @@ TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
   using T = TypeParam;
   std::vector<Vec2<T>> pts;
   std::vector<FeatureLabel> geo;
-  auto add = [&](T x, T y, int n_static, int n_dynamic) {
-    for (int k = 0; k < n_static + n_dynamic; ++k) {
-      pts.emplace_back(x + T(2 * k), y + T(k));
-      geo.push_back(k < n_static ? FeatureLabel::Static : FeatureLabel::Dynamic);
-    }
-  };
+  auto add = [&](T x, T y, int n_static, int n_dynamic) { add_votes(&pts, &geo, x, y, n_static, n_dynamic); };
   add(T(5), T(5), 5, 0);    // cell 0: unanimous static
   add(T(65), T(5), 4, 1);   // cell 2: 1 of 5 flagged (ratio 0.2)
   add(T(5), T(65), 3, 2);   // cell 6: 2 of 5 flagged (0.4, under sigma1 0.5)
@@ -209,12 +213,7 @@ TYPED_TEST(SubBoxTest, WholeBoxRuleSparesClearlyStaticCells) {
   using T = TypeParam;
   std::vector<Vec2<T>> pts;
   std::vector<FeatureLabel> geo;
-  auto add = [&](T x, T y, int n_static, int n_dynamic) {
-    for (int k = 0; k < n_static + n_dynamic; ++k) {
-      pts.emplace_back(x + T(2 * k), y + T(k));
-      geo.push_back(k < n_static ? FeatureLabel::Static : FeatureLabel::Dynamic);
-    }
-  };
+  auto add = [&](T x, T y, int n_static, int n_dynamic) { add_votes(&pts, &geo, x, y, n_static, n_dynamic); };
   for (int c = 0; c < 6; ++c) add(T(5 + 30 * (c % 3)), T(5 + 30 * (c / 3)), 0, 5);  // cells 0-5: all flagged
   add(T(2), T(62), 9, 1);   // cell 6: 1 of 10 flagged
   add(T(32), T(62), 6, 2);  // cell 7: 2 of 8 flagged (0.25)

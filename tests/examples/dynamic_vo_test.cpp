@@ -29,6 +29,22 @@ const vo::StrategySpec* find_spec(const std::vector<vo::StrategySpec>& all, bool
   return nullptr;
 }
 
+// Runs the strategies on the first `frames` frames of the sim's xyz walking sequence (no files, no progress).
+bool run_short_xyz(int frames, const std::vector<vo::StrategySpec>& strategies, vo::SequenceReport* report,
+                   std::string* error) {
+  sim::SceneOptions so;
+  so.motion = sim::CameraMotion::Xyz;
+  so.num_frames = frames;
+  vo::SimSource source(so);
+  vo::RunnerOptions ro;
+  ro.max_frames = frames;
+  ro.write_outputs = false;
+  ro.print_progress = false;
+  if (!vo::run_sequence("xyz", source, strategies, ro, report, error)) return false;
+  vo::evaluate_against_recorded_truth(report, ro);
+  return true;
+}
+
 // 45 frames of the sim's xyz walking sequence, where the two slow walkers crossing close to the
 // camera pull the un-culled front end off (measured: 106 mm ATE after 1.5 s, `dynamic_vo --sequences xyz
 // --frames 45 --seeds 1`, session 11): the recommended preset must cut that ATE by a clear margin
@@ -42,18 +58,9 @@ TEST(DynamicVo, RecommendedPresetBeatsNoCullingOnShortXyz) {
   ASSERT_NE(none, nullptr);
   ASSERT_NE(preset, nullptr) << "no recommended preset in vo::all_strategies()";
 
-  sim::SceneOptions so;
-  so.motion = sim::CameraMotion::Xyz;
-  so.num_frames = 45;
-  vo::SimSource source(so);
-  vo::RunnerOptions ro;
-  ro.max_frames = 45;
-  ro.write_outputs = false;
-  ro.print_progress = false;
   vo::SequenceReport report;
   std::string error;
-  ASSERT_TRUE(vo::run_sequence("xyz", source, {*none, *preset}, ro, &report, &error)) << error;
-  vo::evaluate_against_recorded_truth(&report, ro);
+  ASSERT_TRUE(run_short_xyz(45, {*none, *preset}, &report, &error)) << error;
   ASSERT_EQ(report.runs.size(), 2u);
   const vo::StrategyRun& a = report.runs[0];
   const vo::StrategyRun& b = report.runs[1];
@@ -89,17 +96,9 @@ TEST(DynamicVo, TruthRepairedStrategiesUndoOneKindOfError) {
   }
   EXPECT_FALSE(preset->needs_truth());
 
-  sim::SceneOptions so;
-  so.motion = sim::CameraMotion::Xyz;
-  so.num_frames = 30;
-  vo::SimSource source(so);
-  vo::RunnerOptions ro;
-  ro.max_frames = 30;
-  ro.write_outputs = false;
-  ro.print_progress = false;
   vo::SequenceReport report;
   std::string error;
-  ASSERT_TRUE(vo::run_sequence("xyz", source, run, ro, &report, &error)) << error;
+  ASSERT_TRUE(run_short_xyz(30, run, &report, &error)) << error;
   ASSERT_EQ(report.runs.size(), 3u);
   const vo::LabelCounts& plain = report.runs[0].labels;
   const vo::LabelCounts& no_false_culls = report.runs[1].labels;
