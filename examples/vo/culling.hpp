@@ -15,6 +15,7 @@
 #include "report.hpp"
 #include "sources.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -73,7 +74,8 @@ inline std::vector<StrategySpec> all_strategies() {
       false, true, presets::none<float>());
   // The recommended preset with one kind of error undone by the truth: how much of its ATE gap to the oracle
   // its false culls cause, and how much its missed movers.
-  const StrategySpec recommended = out[out.size() - 2];
+  const StrategySpec recommended =
+      *std::find_if(out.begin(), out.end(), [](const StrategySpec& s) { return s.recommended; });
   for (const TruthRepair repair : {TruthRepair::RestoreFalseCulls, TruthRepair::CullMisses}) {
     StrategySpec spec = recommended;
     const bool restore = repair == TruthRepair::RestoreFalseCulls;
