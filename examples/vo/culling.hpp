@@ -109,12 +109,8 @@ class Culler {
     ++frame_index_;
     if (!spec_.culls) return;
     if (spec_.oracle) {
-      if (frame.moving.empty()) return;
-      for (std::size_t i = 0; i < tracks.size(); ++i) {
-        const int u = cvRound(tracks.cur_px[i].x), v = cvRound(tracks.cur_px[i].y);
-        if (u >= 0 && v >= 0 && u < frame.moving.cols && v < frame.moving.rows && frame.moving.at<std::uint8_t>(v, u))
-          (*keep)[i] = 0;
-      }
+      for (std::size_t i = 0; i < tracks.size(); ++i)
+        if (truth_at(frame, tracks.cur_px[i]) == 1) (*keep)[i] = 0;
       return;
     }
     ids_.assign(tracks.ids.begin(), tracks.ids.end());
@@ -148,15 +144,19 @@ class Culler {
   /// TruthRepair: flips the labels of one kind of error to the truth's (the pixel nearest each track).
   /// reasons() and kept_why() keep the preset's own decision, so --diagnose still says what it decided.
   void repair_by_truth(const SequenceFrame& frame, const Tracks& tracks, std::vector<std::uint8_t>* keep) const {
-    if (frame.moving.empty()) return;
     const bool restore = spec_.truth_repair == TruthRepair::RestoreFalseCulls;
     for (std::size_t i = 0; i < tracks.size(); ++i) {
-      const int u = cvRound(tracks.cur_px[i].x), v = cvRound(tracks.cur_px[i].y);
-      if (u < 0 || v < 0 || u >= frame.moving.cols || v >= frame.moving.rows) continue;
-      const bool moving = frame.moving.at<std::uint8_t>(v, u) != 0;
-      if (restore && !moving) (*keep)[i] = 1;
-      if (!restore && moving) (*keep)[i] = 0;
+      const int truth = truth_at(frame, tracks.cur_px[i]);
+      if (restore && truth == 0) (*keep)[i] = 1;
+      if (!restore && truth == 1) (*keep)[i] = 0;
     }
+  }
+
+  /// The sim's motion truth at the pixel nearest p: 1 moving, 0 static, -1 none (no truth, outside).
+  static int truth_at(const SequenceFrame& frame, const cv::Point2f& p) {
+    const int u = cvRound(p.x), v = cvRound(p.y);
+    if (frame.moving.empty() || u < 0 || v < 0 || u >= frame.moving.cols || v >= frame.moving.rows) return -1;
+    return frame.moving.at<std::uint8_t>(v, u) != 0 ? 1 : 0;
   }
 
   /// Reads the pipeline's per-stage scratch of this frame (PipelineState): which stage left a kept track
