@@ -1,0 +1,110 @@
+// Static history: what counts as a still frame, what restarts the count, what leaves it alone, and which
+// tracks are forgotten.
+#include "dyncull/culling/static_history.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace dyncull {
+namespace {
+
+template <class T>
+class StaticHistoryTest : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(StaticHistoryTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
+
+constexpr FeatureLabel S = FeatureLabel::Static, D = FeatureLabel::Dynamic, C = FeatureLabel::Candidate;
+
+TYPED_TEST(StaticHistoryTest, CountsStillFramesAndRestartsOnAFlagOrALargeResidual) {
+  using T = TypeParam;
+  StaticHistory history;
+  const std::vector<std::int64_t> ids = {10, 20, 30, 40};
+  std::vector<std::uint16_t> counts;
+  // Track 10 still; 20 still but at the residual limit (not below it); 30 flagged; 40 without evidence.
+  const std::vector<FeatureLabel> labels = {S, S, D, C};
+  const std::vector<T> residuals = {T(0.2), T(0.8), T(0.1), T(0.1)};
+  for (int f = 1; f <= 3; ++f) {
+    history.update(ids, labels.data(), residuals.data(), true, T(0.8), &counts);
+    EXPECT_EQ(counts, (std::vector<std::uint16_t>{static_cast<std::uint16_t>(f), 0, 0, 0})) << "frame " << f;
+  }
+  EXPECT_EQ(history.count(10), 3);
+  EXPECT_EQ(history.num_tracks(), 4u);
+
+  // Frames that are no evidence (too short a baseline, or no labels) carry the counts over.
+  history.update(ids, labels.data(), residuals.data(), false, T(0.8), &counts);
+  EXPECT_EQ(counts[0], 3);
+  history.update<T>(ids, nullptr, nullptr, true, T(0.8), &counts);
+  EXPECT_EQ(counts[0], 3);
+
+  // A Candidate label (no point this frame) leaves the count; a flag, or a residual above the limit, restarts it.
+  const std::vector<T> small(4, T(0.1));
+  history.update(ids, std::vector<FeatureLabel>{C, S, S, S}.data(), small.data(), true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{3, 1, 1, 1}));
+  history.update(ids, std::vector<FeatureLabel>{D, S, S, S}.data(), small.data(), true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{0, 2, 2, 2}));
+  history.update(ids, std::vector<FeatureLabel>{S, S, S, S}.data(), std::vector<T>{T(0.1), T(0.9), T(0.1), T(0.1)}.data(),
+                 true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{1, 0, 3, 3}));
+  // A non-finite residual is no proof of stillness.
+  history.update(ids, std::vector<FeatureLabel>{S, S, S, S}.data(),
+                 std::vector<T>{std::numeric_limits<T>::quiet_NaN(), T(0.1), std::numeric_limits<T>::infinity(), T(0.1)}.data(),
+                 true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{0, 1, 0, 4}));
+}
+
+TYPED_TEST(StaticHistoryTest, TracksMissingFromAFrameAreForgottenAndOrderDoesNotMatter) {
+  using T = TypeParam;
+  StaticHistory history;
+  std::vector<std::uint16_t> counts;
+  const std::vector<T> small(3, T(0.1));
+  const std::vector<FeatureLabel> still(3, S);
+  history.update(std::vector<std::int64_t>{5, 3, 9}, still.data(), small.data(), true, T(0.8), &counts);
+  history.update(std::vector<std::int64_t>{9, 5, 3}, still.data(), small.data(), true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{2, 2, 2})) << "ids are matched, not positions";
+  // Track 3 is lost; 11 is new.
+  history.update(std::vector<std::int64_t>{11, 9, 5}, still.data(), small.data(), true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{1, 3, 3}));
+  EXPECT_EQ(history.count(3), 0) << "forgotten";
+  EXPECT_EQ(history.num_tracks(), 3u);
+  // An id given twice in one frame gets a defined count (each from the same history).
+  history.update(std::vector<std::int64_t>{9, 9, 5}, still.data(), small.data(), true, T(0.8), &counts);
+  EXPECT_EQ(counts, (std::vector<std::uint16_t>{4, 4, 4}));
+  EXPECT_EQ(history.count(9), 4);
+  // No tracks: everything forgotten.
+  history.update<T>({}, nullptr, nullptr, true, T(0.8), &counts);
+  EXPECT_TRUE(counts.empty());
+  EXPECT_EQ(history.num_tracks(), 0u);
+  history.update(std::vector<std::int64_t>{9}, still.data(), small.data(), true, T(0.8), &counts);
+  EXPECT_EQ(counts[0], 1);
+  history.clear();
+  EXPECT_EQ(history.num_tracks(), 0u);
+  EXPECT_EQ(history.count(9), 0);
+}
+
+// Tracks in creation order (ascending ids) take a merge walk instead of a binary search each: the counts must
+// not depend on the order the tracks come in.
+TYPED_TEST(StaticHistoryTest, AscendingAndShuffledIdsGiveTheSameCounts) {
+  using T = TypeParam;
+  const std::vector<std::vector<std::int64_t>> frames = {{1, 2, 4, 7}, {1, 4, 7, 8}, {4, 4, 8, 9}, {2, 8, 9, 12}};
+  const std::vector<std::vector<FeatureLabel>> labels = {{S, S, D, S}, {S, S, C, S}, {S, S, S, D}, {S, S, S, S}};
+  const std::vector<T> residuals = {T(0.1), T(0.2), T(0.3), T(0.4)};
+  StaticHistory ascending, reversed;
+  std::vector<std::uint16_t> a, r;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    ascending.update(frames[f], labels[f].data(), residuals.data(), true, T(0.8), &a);
+    const std::vector<std::int64_t> rev_ids(frames[f].rbegin(), frames[f].rend());
+    const std::vector<FeatureLabel> rev_labels(labels[f].rbegin(), labels[f].rend());
+    const std::vector<T> rev_res(residuals.rbegin(), residuals.rend());
+    reversed.update(rev_ids, rev_labels.data(), rev_res.data(), true, T(0.8), &r);
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], r[a.size() - 1 - i]) << "frame " << f << " track " << i;
+  }
+  // Last frame ({2, 8, 9, 12}): 2 is new again (lost in the second), 8 still in all three frames it was in,
+  // 9 flagged in the third and still in this one, 12 new.
+  EXPECT_EQ(a, (std::vector<std::uint16_t>{1, 3, 1, 1}));
+}
+
+}  // namespace
+}  // namespace dyncull
