@@ -77,6 +77,7 @@ void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options
   state.counters["multiview_ran"] = r.multiview.ran();
   state.counters["subbox_ran"] = r.subbox.ran();
   state.counters["reprojection_ran"] = r.reprojection.ran();
+  state.counters["history_kept"] = double(r.history_kept);
 }
 
 void BM_Pipeline_Recommended(benchmark::State& state) { run_pipeline(state, presets::recommended<float>()); }
@@ -87,6 +88,13 @@ void BM_Pipeline_RecommendedWithPoints(benchmark::State& state) {
   run_pipeline(state, presets::recommended<float>(), true);
 }
 BENCHMARK(BM_Pipeline_RecommendedWithPoints)->Unit(benchmark::kMicrosecond);
+
+// With points and track ids, as dynamic_vo runs the preset: its static history runs too (the same frame
+// repeated, so from the 6th iteration on it keeps the tracks still in all of them).
+void BM_Pipeline_RecommendedWithPointsAndIds(benchmark::State& state) {
+  run_pipeline(state, presets::recommended<float>(), true, true);
+}
+BENCHMARK(BM_Pipeline_RecommendedWithPointsAndIds)->Unit(benchmark::kMicrosecond);
 
 // With points and the sub-box memory option (15 frames, track ids): the memory's bookkeeping per frame.
 void BM_Pipeline_RecommendedWithPointsAndMemory(benchmark::State& state) {

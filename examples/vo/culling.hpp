@@ -170,7 +170,9 @@ class Culler {
     for (std::size_t i = 0; i < n; ++i) {
       if (!r.keep[i] || r.reasons[i] != CullReason::None) continue;
       KeptWhy& why = kept_why_[i];
-      if (i >= s.in_dyn_box.size() || !s.in_dyn_box[i]) {
+      if (i < s.history_kept.size() && s.history_kept[i]) {
+        why = KeptWhy::StaticHistory;
+      } else if (i >= s.in_dyn_box.size() || !s.in_dyn_box[i]) {
         why = KeptWhy::OutsideBoxes;
       } else if (masks && !s.in_object[i]) {
         why = KeptWhy::OutsideObjectBand;

@@ -90,6 +90,7 @@ enum class KeptWhy : std::uint8_t {
   NoGeometricEvidence,    ///< in the object, without a geometric label (no track / point, depth edge)
   NotFlagged,             ///< in the object, the geometric check said static, and so did its sub-box
   FlaggedInStaticSubBox,  ///< in the object, flagged by the geometric check, but its sub-box voted static
+  StaticHistory,          ///< its region was culled, but its own residual stayed small over its last frames
 };
 
 constexpr const char* to_string(KeptWhy w) noexcept {
@@ -101,6 +102,7 @@ constexpr const char* to_string(KeptWhy w) noexcept {
     case KeptWhy::NoGeometricEvidence: return "(no geometric evidence)";
     case KeptWhy::NotFlagged: return "(not flagged)";
     case KeptWhy::FlaggedInStaticSubBox: return "(flagged, static sub-box)";
+    case KeptWhy::StaticHistory: return "(static history)";
   }
   return "";
 }
@@ -109,7 +111,7 @@ constexpr const char* to_string(KeptWhy w) noexcept {
 /// low precision or recall can be traced to the actor and the stage (dynamic_vo --diagnose). A kept
 /// feature's reason is None; `kept_why` (optional) then says at which stage it stayed static.
 struct LabelBreakdown {
-  static constexpr int kInstances = 8, kReasons = 12, kKeptWhy = 7;
+  static constexpr int kInstances = 8, kReasons = 12, kKeptWhy = 8;
   static constexpr int kCells = kReasons + kKeptWhy;  ///< reasons, then None split by KeptWhy
   std::array<std::size_t, kInstances * 2 * 2 * kCells> counts{};
 

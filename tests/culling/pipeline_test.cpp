@@ -244,6 +244,95 @@ TYPED_TEST(PipelineTest, CoherentMotionFlagsASwayTheResidualsMiss) {
   EXPECT_NE(rn.coherent_motion.reason.find("reprojection"), std::string::npos) << rn.coherent_motion.reason;
 }
 
+// The seated person's sway fills enough cells for the whole-box rule (sigma2 lowered to 1 here), which culls
+// its still legs with the rest of the box. With track ids, a track the reprojection check finds still (under
+// 0.8 px, not flagged) in each of its last 6 frames is kept from its 6th frame on; the flagged upper body stays
+// culled, and a leg track flagged once starts counting again. Without track ids, or with the option off, the
+// legs stay culled, and the stage says why.
+TYPED_TEST(PipelineTest, StaticHistoryKeepsTracksProvenStillInACulledRegion) {
+  using T = TypeParam;
+  SceneConfig config;
+  config.walking = false;
+  config.num_per_object = 200;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  std::vector<std::int64_t> ids(s.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i) + 100;
+  auto frame = frame_of(s, dets);
+  frame.points_3d = &s.prev_points_world;
+  frame.track_ids = &ids;
+  PipelineOptions<T> o = presets::recommended<T>();
+  ASSERT_EQ(o.static_history.min_frames, 6);
+  o.subbox.sigma2 = 1;
+  // One leg track, flagged in frame 3 by a point 3 px off (the depth residual off, so only the pixel counts).
+  o.reprojection.max_depth_residual_sigmas = T(0);
+  std::size_t leg = s.size();
+  for (std::size_t i = 0; i < s.size() && leg == s.size(); ++i)
+    if (s.kind[i] == SceneKind::SittingLower && std::isfinite(double(s.prev_points_world[i].x()))) leg = i;
+  ASSERT_LT(leg, s.size());
+  std::vector<Vec3<T>> leg_moved = s.prev_points_world;
+  leg_moved[leg] += Vec3<T>(T(0.02), T(0), T(0));  // ~3 px at the seated person's depth
+
+  PipelineState<T> state;
+  std::vector<double> lower, upper;
+  std::vector<std::size_t> kept;
+  std::vector<FeatureLabel> leg_label;
+  for (int k = 1; k <= 8; ++k) {
+    frame.points_3d = k == 3 ? &leg_moved : &s.prev_points_world;
+    const PipelineResult<T>& r = cull_frame(frame, o, &state);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    ASSERT_TRUE(r.static_history.ran()) << r.static_history.reason;
+    lower.push_back(dynamic_rate(s, r, SceneKind::SittingLower));
+    upper.push_back(dynamic_rate(s, r, SceneKind::SittingUpper));
+    kept.push_back(r.history_kept);
+    leg_label.push_back(r.labels[leg]);
+    EXPECT_NE(r.static_history.reason.find(std::to_string(r.history_kept)), std::string::npos) << r.static_history.reason;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (!state.history_kept[i]) continue;
+      EXPECT_EQ(r.labels[i], FeatureLabel::Static);
+      EXPECT_GE(state.still_frames[i], 6);
+      EXPECT_NE(state.reprojection.labels[i], FeatureLabel::Dynamic);
+    }
+  }
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_GT(lower[k], 0.8) << "frame " << k + 1 << ": the whole box is culled";  // measured 1.0
+    EXPECT_EQ(kept[k], 0u) << "frame " << k + 1;
+  }
+  for (int k = 5; k < 8; ++k) {
+    EXPECT_LT(lower[k], 0.2) << "frame " << k + 1 << ": the legs' history keeps them";  // measured 0.013
+    EXPECT_GT(upper[k], 0.9) << "frame " << k + 1;  // measured 0.987, as in frames 1-5
+    EXPECT_GT(kept[k], 0u);
+  }
+  EXPECT_EQ(leg_label[2], FeatureLabel::Dynamic) << "flagged itself in frame 3";
+  EXPECT_EQ(leg_label[5], FeatureLabel::Dynamic) << "frame 6: 3 still frames since its flag";
+  EXPECT_EQ(leg_label[7], FeatureLabel::Dynamic) << "frame 8: 5 still frames since its flag";
+
+  // Without track ids, or with the option off: the legs stay culled.
+  frame.points_3d = &s.prev_points_world;
+  auto no_ids = frame;
+  no_ids.track_ids = nullptr;
+  PipelineOptions<T> off = o;
+  off.static_history.min_frames = 0;
+  PipelineState<T> no_ids_state, off_state;
+  for (int k = 1; k <= 8; ++k) {
+    const PipelineResult<T>& rn = cull_frame(no_ids, o, &no_ids_state);
+    EXPECT_FALSE(rn.static_history.ran());
+    EXPECT_NE(rn.static_history.reason.find("track_ids"), std::string::npos) << rn.static_history.reason;
+    EXPECT_GT(dynamic_rate(s, rn, SceneKind::SittingLower), 0.8);
+    const PipelineResult<T>& ro = cull_frame(frame, off, &off_state);
+    EXPECT_FALSE(ro.static_history.enabled);
+    EXPECT_EQ(ro.history_kept, 0u);
+    EXPECT_GT(dynamic_rate(s, ro, SceneKind::SittingLower), 0.8);
+  }
+  // Without 3-D points the check does not run: the counts carry over, nothing is kept.
+  frame.points_3d = nullptr;
+  const PipelineResult<T>& rp = cull_frame(frame, o, &state);
+  EXPECT_FALSE(rp.static_history.ran());
+  EXPECT_NE(rp.static_history.reason.find("reprojection"), std::string::npos) << rp.static_history.reason;
+  EXPECT_EQ(rp.history_kept, 0u);
+  EXPECT_GE(state.static_history.count(ids[leg]), 5);
+}
+
 // Recommended: a medium-level candidate is culled only on its own geometric evidence (flagged itself in a
 // dynamic sub-box, or by the multi-view check), never by its sub-box's vote alone; the pushed chair,
 // whose features are flagged, is still culled.
@@ -284,8 +373,11 @@ TYPED_TEST(PipelineTest, SubBoxMemoryBridgesAPauseOfASlowMover) {
     }
     return std::make_pair(upper, lower);
   };
-  const PipelineOptions<T> without = presets::recommended<T>();
+  PipelineOptions<T> without = presets::recommended<T>();
   ASSERT_EQ(without.subbox_memory_frames, 0);
+  // The preset's static history would keep the paused tracks from their 6th still frame on, memory or not
+  // (StaticHistoryKeepsTracksProvenStillInACulledRegion): this test is about the memory alone.
+  without.static_history.min_frames = 0;
   PipelineOptions<T> with_memory = without;
   with_memory.subbox_memory_frames = 15;
   const auto [mem_upper, mem_lower] = run_sequence(with_memory, true);

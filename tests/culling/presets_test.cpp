@@ -38,6 +38,15 @@ TEST(Presets, EachPaperRunsItsStrategies) {
   const auto zhang = presets::zhang_2023<float>();
   EXPECT_EQ(zhang.candidates, CandidatePolicy::Cull);
   EXPECT_FALSE(zhang.use_moving_consistency);
+  // Our additions stay out of the papers' presets.
+  for (const auto& paper : {dld, rtd}) {
+    EXPECT_EQ(paper.static_history.min_frames, 0);
+    EXPECT_FALSE(paper.use_coherent_motion);
+  }
+  for (const auto& paper : {zhu, dfd, zhang}) {
+    EXPECT_EQ(paper.static_history.min_frames, 0);
+    EXPECT_FALSE(paper.use_coherent_motion);
+  }
 }
 
 TEST(Presets, RecommendedCombinesThemWithTheGuard) {
@@ -60,6 +69,8 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_EQ(o.min_survivors, 30u);
   EXPECT_FLOAT_EQ(o.detections.box_padding_px, 5.f);
   EXPECT_DOUBLE_EQ(o.depth_mask.eps_m, 0.5);  // 000's range is 0.3-0.5 m; see the test below
+  EXPECT_EQ(o.static_history.min_frames, 6);  // session 17 (docs/results.md)
+  EXPECT_FLOAT_EQ(o.static_history.max_residual_px, 0.8f);
 }
 
 // The recommended preset's object band reaches 0.5 m behind the centre depth (000's eps range is 0.3-0.5 m):

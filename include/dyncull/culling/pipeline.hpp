@@ -21,6 +21,7 @@
 #include "dyncull/culling/moving_consistency.hpp"
 #include "dyncull/culling/reprojection_check.hpp"
 #include "dyncull/culling/multiview_check.hpp"
+#include "dyncull/culling/static_history.hpp"
 #include "dyncull/culling/subbox_memory.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 
@@ -151,6 +152,12 @@ struct PipelineOptions {
   /// with the sub-box refinement, on its grid.
   bool use_coherent_motion = false;
   CoherentMotionOptions<T> coherent_motion{};
+  /// Track history (static_history.hpp; off while min_frames is 0): a feature culled only for the region it
+  /// lies in (its box, its medium-level box, a tracked box or its sub-box) stays static when the reprojection
+  /// check said Static with a residual below max_residual_px in each of its last min_frames evaluated frames
+  /// (baseline of at least min_evidence_frames, or unknown) and does not flag it now. Needs
+  /// CullingFrame::track_ids and the reprojection check.
+  StaticHistoryOptions<T> static_history{};
 
   /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
   /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
@@ -182,6 +189,8 @@ struct PipelineResult {
   std::size_t num_features = 0, num_static = 0, num_dynamic = 0;
   StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, reprojection,
       coherent_motion, subbox, multiview;
+  StageReport static_history;       ///< PipelineOptions::static_history
+  std::size_t history_kept = 0;     ///< features the static history kept against a region's cull
   GuardAction guard = GuardAction::None;
   std::size_t guard_restored = 0;   ///< features the guard turned back to static
 };
@@ -193,6 +202,7 @@ struct PipelineState {
   BoxTracker<T> tracker;
   TrackStateStore track_states;      ///< K of 000 eq. 3, keyed by the caller's track ids
   SubBoxMemory subbox_memory;        ///< PipelineOptions::subbox_memory_frames
+  StaticHistory static_history;      ///< PipelineOptions::static_history
   KeyframeRing<T> keyframes;         ///< multi-view references (push with is_keyframe or by hand)
   std::uint64_t frame_index = 0;
 
@@ -206,6 +216,8 @@ struct PipelineState {
   std::vector<FeatureLabel> sem_labels;
   std::vector<CullReason> sem_reasons;
   std::vector<std::uint8_t> in_dyn_box, in_object, mv_dynamic, coherent_eligible;
+  std::vector<std::uint16_t> still_frames;    ///< static history count per feature this frame
+  std::vector<std::uint8_t> history_kept;     ///< 1: kept static by its history this frame
   std::vector<MotionLevel> prob_levels;
   std::vector<Vec2<T>> prob_prev;
   std::vector<T> keypoint_depth;
@@ -223,6 +235,7 @@ struct PipelineState {
     tracker = BoxTracker<T>(tracker_options_);
     track_states.clear();
     subbox_memory.clear();
+    static_history.clear();
     keyframes.clear();
     frame_index = 0;
   }
@@ -404,8 +417,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   r.reason.clear();
   r.guard = GuardAction::None;
   r.guard_restored = 0;
-  for (StageReport* st : {&r.detections, &r.tracker, &r.box_rule, &r.depth_mask, &r.probability,
-                          &r.moving_consistency, &r.reprojection, &r.coherent_motion, &r.subbox, &r.multiview}) {
+  r.history_kept = 0;
+  for (StageReport* st : {&r.detections, &r.tracker, &r.box_rule, &r.depth_mask, &r.probability, &r.moving_consistency,
+                          &r.reprojection, &r.coherent_motion, &r.subbox, &r.multiview, &r.static_history}) {
     st->status = Status::Skipped;
     st->reason.clear();
     st->num_dynamic = 0;
@@ -422,6 +436,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     r.coherent_motion.reason = "runs with the sub-box refinement, on the reprojection check's residuals";
   r.subbox.enabled = options.use_subbox;
   r.multiview.enabled = options.use_multiview;
+  r.static_history.enabled = options.static_history.min_frames > 0;
 
   if (!frame.keypoints) {
     r.status = Status::InvalidInput;
@@ -833,6 +848,40 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     }
     r.labels[i] = lab;
     r.reasons[i] = lab == FeatureLabel::Static ? CullReason::None : why;
+  }
+
+  // 8b. Static history: a track proven still over its last frames outweighs its region's cull.
+  s.history_kept.assign(n, 0);
+  if (r.static_history.enabled) {
+    if (!frame.track_ids || frame.track_ids->size() != n) {
+      r.static_history.reason = "needs CullingFrame::track_ids";
+    } else {
+      const bool checked = r.reprojection.ran() && s.reprojection.labels.size() == n && s.reprojection.residual_px.size() == n;
+      // A baseline too short to vote (min_evidence_frames) is too short to prove a slow mover still.
+      const bool evaluated = checked && (frame.evidence_frames <= 0 || frame.evidence_frames >= std::max(1, options.min_evidence_frames));
+      s.static_history.update(*frame.track_ids, checked ? s.reprojection.labels.data() : nullptr,
+                              checked ? s.reprojection.residual_px.data() : nullptr, evaluated,
+                              options.static_history.max_residual_px, &s.still_frames);
+      if (!checked) {
+        r.static_history.reason = "needs the reprojection check (use_reprojection, points_3d), which did not run: counts carried over";
+      } else {
+        const auto min_frames = static_cast<std::uint16_t>(std::min(options.static_history.min_frames, 0xFFFF));
+        for (std::size_t i = 0; i < n; ++i) {
+          const CullReason why = r.reasons[i];
+          const bool regional = why == CullReason::SubBox || why == CullReason::HighLevelBox ||
+                                why == CullReason::TrackedBox || why == CullReason::MediumLevelBox;
+          if (r.labels[i] != FeatureLabel::Dynamic || !regional || s.still_frames[i] < min_frames ||
+              s.reprojection.labels[i] == FeatureLabel::Dynamic)
+            continue;
+          r.labels[i] = FeatureLabel::Static;
+          r.reasons[i] = CullReason::None;
+          s.history_kept[i] = 1;
+          ++r.history_kept;
+        }
+        r.static_history.status = Status::Ok;
+        r.static_history.reason = std::to_string(r.history_kept) + " feature(s) kept static by their history";
+      }
+    }
   }
 
   // 9. Minimum-survivor guard.
