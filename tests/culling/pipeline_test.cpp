@@ -251,10 +251,7 @@ TYPED_TEST(PipelineTest, CoherentMotionFlagsASwayTheResidualsMiss) {
 // legs stay culled, and the stage says why.
 TYPED_TEST(PipelineTest, StaticHistoryKeepsTracksProvenStillInACulledRegion) {
   using T = TypeParam;
-  SceneConfig config;
-  config.walking = false;
-  config.num_per_object = 200;
-  const auto s = test::make_culling_scene<T>(config);
+  const auto s = test::make_culling_scene<T>(test::seated_person_config());
   const auto dets = detections_of(s);
   std::vector<std::int64_t> ids(s.size());
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i) + 100;

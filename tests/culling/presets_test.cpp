@@ -39,14 +39,11 @@ TEST(Presets, EachPaperRunsItsStrategies) {
   EXPECT_EQ(zhang.candidates, CandidatePolicy::Cull);
   EXPECT_FALSE(zhang.use_moving_consistency);
   // Our additions stay out of the papers' presets.
-  for (const auto& paper : {dld, rtd}) {
-    EXPECT_EQ(paper.static_history.min_frames, 0);
-    EXPECT_FALSE(paper.use_coherent_motion);
-  }
-  for (const auto& paper : {zhu, dfd, zhang}) {
-    EXPECT_EQ(paper.static_history.min_frames, 0);
-    EXPECT_FALSE(paper.use_coherent_motion);
-  }
+  const auto without_our_additions = [](const auto& paper) {
+    return paper.static_history.min_frames == 0 && !paper.use_coherent_motion;
+  };
+  EXPECT_TRUE(without_our_additions(dld) && without_our_additions(rtd) && without_our_additions(zhu) &&
+              without_our_additions(dfd) && without_our_additions(zhang));
 }
 
 TEST(Presets, RecommendedCombinesThemWithTheGuard) {

@@ -53,10 +53,7 @@ std::vector<Detection<T>> person_boxes(const test::CullingScene<T>& s) {
 
 TYPED_TEST(SubBoxTest, SittingPersonKeepsStaticLegsAndCullsTheMovingUpperBody) {
   using T = TypeParam;
-  SceneConfig config;
-  config.walking = false;
-  config.num_per_object = 200;
-  const auto s = test::make_culling_scene<T>(config);
+  const auto s = test::make_culling_scene<T>(test::seated_person_config());
   const auto geo = noisy_geometric_labels(s);
   const auto boxes = person_boxes(s);
   ASSERT_EQ(boxes.size(), 1u);
@@ -88,10 +85,7 @@ TYPED_TEST(SubBoxTest, PaperMergeRuleCullsTheWholeSittingPerson) {
   // Documents why merge_ratio defaults to 0.35: merging every static neighbour (the paper's literal
   // rule) turns the middle row dynamic, 6 > sigma2 = 4 cells, and the whole person is culled.
   using T = TypeParam;
-  SceneConfig config;
-  config.walking = false;
-  config.num_per_object = 200;
-  const auto s = test::make_culling_scene<T>(config);
+  const auto s = test::make_culling_scene<T>(test::seated_person_config());
   const auto geo = noisy_geometric_labels(s);
   SubBoxOptions<T> paper;
   paper.merge_ratio = T(0);

@@ -49,6 +49,14 @@ struct SceneConfig {
   PinholeCamera<double> camera = PinholeCamera<double>::tum_fr3();
 };
 
+/// The seated person's scene: no walker, 200 extra features in each object's box (its cells well filled).
+inline SceneConfig seated_person_config() {
+  SceneConfig config;
+  config.walking = false;
+  config.num_per_object = 200;
+  return config;
+}
+
 /// One frame pair with truth. All per-feature vectors are parallel.
 template <class T>
 struct CullingScene {
