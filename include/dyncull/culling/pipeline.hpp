@@ -856,14 +856,17 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     if (!frame.track_ids || frame.track_ids->size() != n) {
       r.static_history.reason = "needs CullingFrame::track_ids";
     } else {
-      const bool checked = r.reprojection.ran() && s.reprojection.labels.size() == n && s.reprojection.residual_px.size() == n;
+      const bool checked =
+          r.reprojection.ran() && s.reprojection.labels.size() == n && s.reprojection.residual_px.size() == n;
       // A baseline too short to vote (min_evidence_frames) is too short to prove a slow mover still.
-      const bool evaluated = checked && (frame.evidence_frames <= 0 || frame.evidence_frames >= std::max(1, options.min_evidence_frames));
+      const bool evaluated = checked && (frame.evidence_frames <= 0 ||
+                                         frame.evidence_frames >= std::max(1, options.min_evidence_frames));
       s.static_history.update(*frame.track_ids, checked ? s.reprojection.labels.data() : nullptr,
                               checked ? s.reprojection.residual_px.data() : nullptr, evaluated,
                               options.static_history.max_residual_px, &s.still_frames);
       if (!checked) {
-        r.static_history.reason = "needs the reprojection check (use_reprojection, points_3d), which did not run: counts carried over";
+        r.static_history.reason =
+            "needs the reprojection check (use_reprojection, points_3d), which did not run: counts carried over";
       } else {
         const auto min_frames = static_cast<std::uint16_t>(std::min(options.static_history.min_frames, 0xFFFF));
         for (std::size_t i = 0; i < n; ++i) {

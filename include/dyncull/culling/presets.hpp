@@ -104,8 +104,8 @@ PipelineOptions<T> zhang_2023() {
 /// evidence) and the evidence-aware sub-box vote (keeps a seated person's still legs; not on a one-frame
 /// baseline; a person's cell whose residuals move together counts as flagged), a track its own residual showed
 /// still over its last frames kept against its region's cull (needs CullingFrame::track_ids), medium-level
-/// objects culled only when their own features are flagged, each box's sub-boxes voted by and acting on its own depth-mask
-/// object only, a tracker for missed (dynamic-class) boxes, and the survivor guard.
+/// objects culled only when their own features are flagged, each box's sub-boxes voted by and acting on its own
+/// depth-mask object only, a tracker for missed (dynamic-class) boxes, and the survivor guard.
 /// Tracks: give as prev_keypoints the features' positions in a reference frame a few frames back (the
 /// front end's keyframe), not the previous frame: slow movers (a seated person) build up a measurable
 /// epipolar distance only over several frames, hence the 1 px in-box threshold (0.5 px suits
@@ -181,8 +181,9 @@ PipelineOptions<T> recommended() {
   o.use_coherent_motion = true;
   // ... and a track the check found still (residual under 0.8 px, not flagged) in each of its last 6 frames of
   // at least 2 frames' baseline stays static whatever its box or cell says: a seated person's legs and chair
-  // share the cells its sway votes dynamic. Twelve seeds, session 17: summed ATE 57.8 -> 52.9 cm (every
-  // sequence lower), held-out median cut xyz 83.9 -> 85.7 %, precision 0.841-0.916 -> 0.854-0.945, recall
+  // share the cells its sway votes dynamic. Twelve seeds, session 17: summed ATE 57.8 -> 52.9 cm (xyz, rpy
+  // and halfsphere lower, static 4.7 -> 4.8 cm; rpy is the noisiest: 6 frames was the one setting tried that
+  // lowered it), held-out median cut xyz 83.9 -> 85.7 %, precision 0.841-0.916 -> 0.854-0.945, recall
   // 0.872-0.914 -> 0.861-0.904 (docs/results.md, session 17).
   o.static_history.min_frames = 6;
   o.static_history.max_residual_px = T(0.8);
