@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -702,6 +703,7 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
   const PinholeCamera<T> camera = centred_camera<T>(W, H);
 
   PipelineOptions<T> o = box_rule_and_depth_mask<T>();
+  std::size_t unsheltered = 0;
   auto rates = [&](const std::vector<float>& depth, const PipelineOptions<T>& opt, std::vector<double>* out) {
     CullingFrame<T, std::vector<Vec2<T>>> frame;
     frame.keypoints = &kp;
@@ -711,6 +713,7 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
     PipelineState<T> state;
     const PipelineResult<T>& r = cull_frame(frame, opt, &state);
     ASSERT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
+    unsheltered = r.unsheltered;
     out->assign(4, 0.0);
     std::vector<double> count(4, 0.0);
     for (std::size_t i = 0; i < kp.size(); ++i) {
@@ -724,14 +727,18 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
   rates(behind, o, &d);
   EXPECT_EQ(d[0], 0.0) << "premise: the TV box shelters the walker (002 Table 2)";
   EXPECT_EQ(d[1], 1.0);
+  EXPECT_EQ(unsheltered, 0u);
   o.low_override_by_depth = true;
   rates(behind, o, &d);
   EXPECT_EQ(d[0], 1.0) << "the walker is 1.5 m in front of the TV";
+  const auto walker_in_tv_box = static_cast<std::size_t>(std::count(kind.begin(), kind.end(), 0));
+  EXPECT_EQ(unsheltered, walker_in_tv_box) << "the result counts the features that lost the shelter";
   EXPECT_EQ(d[1], 1.0);
   EXPECT_EQ(d[2], 0.0);
   EXPECT_EQ(d[3], 0.0);
   rates(level, o, &d);
   EXPECT_EQ(d[0], 0.0) << "at the TV's depth the shelter stands";
+  EXPECT_EQ(unsheltered, 0u);
   EXPECT_EQ(d[1], 1.0);
   EXPECT_EQ(d[2], 0.0);
 }

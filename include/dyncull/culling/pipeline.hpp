@@ -191,6 +191,7 @@ struct PipelineResult {
       coherent_motion, subbox, multiview;
   StageReport static_history;       ///< PipelineOptions::static_history
   std::size_t history_kept = 0;     ///< features the static history kept against a region's cull
+  std::size_t unsheltered = 0;      ///< features low_override_by_depth took out of a low-level box's shelter
   GuardAction guard = GuardAction::None;
   std::size_t guard_restored = 0;   ///< features the guard turned back to static
 };
@@ -418,6 +419,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   r.guard = GuardAction::None;
   r.guard_restored = 0;
   r.history_kept = 0;
+  r.unsheltered = 0;
   for (StageReport* st : {&r.detections, &r.tracker, &r.box_rule, &r.depth_mask, &r.probability, &r.moving_consistency,
                           &r.reprojection, &r.coherent_motion, &r.subbox, &r.multiview, &r.static_history}) {
     st->status = Status::Skipped;
@@ -544,7 +546,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
         r.depth_mask.num_dynamic = dm.num_dynamic;
         s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
         if (options.low_override_by_depth && options.use_box_rule)
-          detail::unshelter_by_depth(kp, frame.depth, dm, s.dyn_boxes, s.boxes, options.levels, options.depth_mask,
+          r.unsheltered = detail::unshelter_by_depth(kp, frame.depth, dm, s.dyn_boxes, s.boxes, options.levels, options.depth_mask,
                                      &s.shelter_boxes, &s.object_box_bits, &s.sem_labels, &s.sem_reasons, &s.in_dyn_box);
         if (options.assign_overlaps_by_depth && options.use_box_rule)
           detail::assign_overlaps_by_depth(kp, frame.depth, dm, s.dyn_boxes, options.levels, &s.object_box_bits,
