@@ -546,8 +546,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
         r.depth_mask.num_dynamic = dm.num_dynamic;
         s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
         if (options.low_override_by_depth && options.use_box_rule)
-          r.unsheltered = detail::unshelter_by_depth(kp, frame.depth, dm, s.dyn_boxes, s.boxes, options.levels, options.depth_mask,
-                                     &s.shelter_boxes, &s.object_box_bits, &s.sem_labels, &s.sem_reasons, &s.in_dyn_box);
+          r.unsheltered = detail::unshelter_by_depth(kp, frame.depth, dm, s.dyn_boxes, s.boxes, options.levels,
+                                                     options.depth_mask, &s.shelter_boxes, &s.object_box_bits,
+                                                     &s.sem_labels, &s.sem_reasons, &s.in_dyn_box);
         if (options.assign_overlaps_by_depth && options.use_box_rule)
           detail::assign_overlaps_by_depth(kp, frame.depth, dm, s.dyn_boxes, options.levels, &s.object_box_bits,
                                            &s.sem_labels, &s.sem_reasons, options.overlap_high_level_margin_m);
