@@ -274,6 +274,13 @@ inline bool is_soft_cull(CullReason r) {
          r == CullReason::MediumLevelBox || r == CullReason::TrackedBox;
 }
 
+/// Culls for the region a feature lies in (its box, tracked box or sub-box), not for its own evidence: the
+/// ones a track's static history may overrule (PipelineOptions::static_history).
+inline bool is_regional_cull(CullReason r) {
+  return r == CullReason::SubBox || r == CullReason::HighLevelBox || r == CullReason::TrackedBox ||
+         r == CullReason::MediumLevelBox;
+}
+
 template <class T, class Keypoints>
 bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u, int* v) {
   const T x = point_x<T>(kp[i]), y = point_y<T>(kp[i]);
@@ -873,11 +880,8 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
       } else {
         const auto min_frames = static_cast<std::uint16_t>(std::min(options.static_history.min_frames, 0xFFFF));
         for (std::size_t i = 0; i < n; ++i) {
-          const CullReason why = r.reasons[i];
-          const bool regional = why == CullReason::SubBox || why == CullReason::HighLevelBox ||
-                                why == CullReason::TrackedBox || why == CullReason::MediumLevelBox;
-          if (r.labels[i] != FeatureLabel::Dynamic || !regional || s.still_frames[i] < min_frames ||
-              s.reprojection.labels[i] == FeatureLabel::Dynamic)
+          if (r.labels[i] != FeatureLabel::Dynamic || !detail::is_regional_cull(r.reasons[i]) ||
+              s.still_frames[i] < min_frames || s.reprojection.labels[i] == FeatureLabel::Dynamic)
             continue;
           r.labels[i] = FeatureLabel::Static;
           r.reasons[i] = CullReason::None;
