@@ -150,6 +150,92 @@ TYPED_TEST(BoxRule, MatchesScalarOracleOnRandomScenes) {
   }
 }
 
+// Points and boxes with NaN, +-Inf and huge finite values mixed with ordinary ones.
+template <class T>
+T awkward_value(Random& rng) {
+  const T inf = std::numeric_limits<T>::infinity(), big = std::numeric_limits<T>::max();
+  switch (rng.index(8)) {
+    case 0: return std::numeric_limits<T>::quiet_NaN();
+    case 1: return rng.index(2) ? inf : -inf;
+    case 2: return rng.index(2) ? big : -big;
+    case 3: return T(4294967306.0);  // 2^32 + 10
+    default: return T(rng.uniform(-20, 120));
+  }
+}
+
+// Every vector path of the membership kernel against its scalar loop, at every size around the
+// vector widths (4 and 16 floats), with flags already set (the kernel must only OR into them).
+TYPED_TEST(BoxRule, VectorPathMatchesScalarPathOnAwkwardValues) {
+  using T = TypeParam;
+  Random rng(11);
+  for (std::size_t n = 0; n <= 40; ++n) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<T> xs(n), ys(n);
+      std::vector<std::uint8_t> pre(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        xs[i] = awkward_value<T>(rng);
+        ys[i] = awkward_value<T>(rng);
+        pre[i] = static_cast<std::uint8_t>(rng.index(16));
+      }
+      std::vector<Box<T>> boxes;
+      std::vector<std::uint8_t> bits;
+      const std::uint8_t kinds[] = {detail::kInHigh, detail::kInMedium, detail::kInLow};
+      for (std::size_t b = 0, nb = rng.index(5); b < nb; ++b) {
+        const T x = T(rng.uniform(-10, 100)), y = T(rng.uniform(-10, 100));
+        boxes.push_back(rng.index(4) == 0 ? Box<T>{-std::numeric_limits<T>::max(), y, std::numeric_limits<T>::max(), y + T(40)}
+                                          : Box<T>{x, y, x + T(rng.uniform(0, 60)), y + T(rng.uniform(0, 60))});
+        bits.push_back(kinds[rng.index(3)]);
+      }
+      std::vector<std::uint8_t> fast = pre, slow = pre;
+      detail::mark_points(xs.data(), ys.data(), n, boxes, bits, fast.data());
+      for (std::size_t b = 0; b < boxes.size(); ++b)
+        detail::mark_points_in_box(xs.data(), ys.data(), 0, n, boxes[b], bits[b], slow.data());
+      ASSERT_EQ(fast, slow) << "n = " << n << ", trial " << trial;
+    }
+  }
+}
+
+TYPED_TEST(BoxRule, NanPointsStayNonFiniteOnTheVectorPath) {
+  using T = TypeParam;
+  Random rng(5);
+  const MotionLevelTable table = MotionLevelTable::coco80();
+  const int classes[] = {kPerson, kChair, kTv};
+  for (std::size_t n = 0; n <= 40; ++n) {
+    std::vector<Vec2<T>> pts(n);
+    for (auto& p : pts) p = Vec2<T>(awkward_value<T>(rng), awkward_value<T>(rng));
+    std::vector<Detection<T>> dets;
+    for (int b = 0; b < 3; ++b) {
+      const T x = T(rng.uniform(-10, 100)), y = T(rng.uniform(-10, 100));
+      dets.push_back({Box<T>{x, y, x + T(rng.uniform(0, 60)), y + T(rng.uniform(0, 60))}, classes[b], T(1)});
+    }
+    dets.push_back({Box<T>{-std::numeric_limits<T>::max(), T(0), std::numeric_limits<T>::max(), T(50)}, kPerson, T(1)});
+    const BoxRuleResult<T> r = apply_box_rule(pts, dets, table);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const T x = pts[i].x(), y = pts[i].y();
+      if (!std::isfinite(x) || !std::isfinite(y)) {
+        ++bad;
+        EXPECT_EQ(r.labels[i], FeatureLabel::Dynamic) << "n = " << n << ", point " << i;
+        EXPECT_EQ(r.reasons[i], CullReason::InvalidInput) << "n = " << n << ", point " << i;
+        continue;
+      }
+      bool high = false, medium = false, low = false;
+      for (const auto& d : dets) {
+        if (!d.box.contains(x, y)) continue;
+        const MotionLevel l = table.level(d.class_id);
+        high |= l == MotionLevel::High;
+        medium |= l == MotionLevel::Medium;
+        low |= l == MotionLevel::Low;
+      }
+      const FeatureLabel want = low ? FeatureLabel::Static
+                                    : (high ? FeatureLabel::Dynamic : (medium ? FeatureLabel::Candidate : FeatureLabel::Static));
+      EXPECT_EQ(r.labels[i], want) << "n = " << n << ", point " << i;
+    }
+    EXPECT_EQ(r.num_non_finite, bad) << "n = " << n;
+  }
+}
+
 #ifdef DYNCULL_HAS_OPENCV
 TEST(BoxRuleOpenCV, KeyPointsAndPoint2fWithoutCopies) {
   const std::vector<Detection<float>> dets = {{Box<float>{10, 10, 50, 50}, kPerson, 1.f}};

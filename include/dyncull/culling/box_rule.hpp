@@ -93,7 +93,8 @@ void mark_points(const T* xs, const T* ys, std::size_t n, const std::vector<Box<
         x[k] = _mm_loadu_ps(xs + done + 4 * k);
         y[k] = _mm_loadu_ps(ys + done + 4 * k);
       }
-      __m128i acc = _mm_setzero_si128();
+      // Start from the flags already set (kNonFinite): the kernel only ORs membership bits in.
+      __m128i acc = _mm_loadu_si128(reinterpret_cast<const __m128i*>(flags + done));
       for (std::size_t b = 0; b < boxes.size(); ++b) {
         const __m128 x0 = _mm_set1_ps(boxes[b].x0), x1 = _mm_set1_ps(boxes[b].x1);
         const __m128 y0 = _mm_set1_ps(boxes[b].y0), y1 = _mm_set1_ps(boxes[b].y1);
