@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <climits>
 #include <limits>
 
 namespace {
@@ -94,6 +95,59 @@ TYPED_TEST(BoxTest, PaddedClippedAndAccessors) {
   const auto d = b.template cast<double>();
   EXPECT_EQ(d.x1, 30.0);
   EXPECT_FALSE((dyncull::Box<T>{std::numeric_limits<T>::quiet_NaN(), T(0), T(1), T(1)}.finite()));
+}
+
+// Finite boxes far beyond the int range: clamped in floating point, never cast out of range
+// (undefined behaviour, caught by UBSan) and never wrapped back into the image.
+TYPED_TEST(BoxTest, PixelRectOfHugeFiniteBoxes) {
+  using T = TypeParam;
+  const T big = std::numeric_limits<T>::max();
+  EXPECT_TRUE(dyncull::pixel_rect(dyncull::Box<T>{T(5e9), T(10), T(6e9), T(20)}, 640, 480).empty());
+  EXPECT_TRUE(dyncull::pixel_rect(dyncull::Box<T>{T(10), T(5e9), T(20), T(6e9)}, 640, 480).empty());
+  EXPECT_TRUE(dyncull::pixel_rect(dyncull::Box<T>{T(-6e9), T(10), T(-5e9), T(20)}, 640, 480).empty());
+  EXPECT_TRUE(dyncull::pixel_rect(dyncull::Box<T>{T(4294967306.0), T(0), T(4294967316.0), T(20)}, 640, 480).empty());
+  EXPECT_TRUE(dyncull::pixel_rect(dyncull::Box<T>{big / T(2), big / T(2), big, big}, 640, 480).empty());
+  const auto all = dyncull::pixel_rect(dyncull::Box<T>{-big, -big, big, big}, 640, 480);
+  EXPECT_EQ(all.c0, 0);
+  EXPECT_EQ(all.r0, 0);
+  EXPECT_EQ(all.c1, 640);
+  EXPECT_EQ(all.r1, 480);
+  const auto part = dyncull::pixel_rect(dyncull::Box<T>{T(-5e9), T(100), T(10), T(5e9)}, 640, 480);
+  EXPECT_EQ(part.c0, 0);
+  EXPECT_EQ(part.c1, 11);
+  EXPECT_EQ(part.r0, 100);
+  EXPECT_EQ(part.r1, 480);
+  // Image sizes at the ends of the int range.
+  const auto wide = dyncull::pixel_rect(dyncull::Box<T>{T(0), T(0), big, T(5)}, INT_MAX, 10);
+  EXPECT_EQ(wide.c1, INT_MAX);
+  EXPECT_TRUE(dyncull::pixel_rect(dyncull::Box<T>{T(0), T(0), T(5), T(5)}, INT_MIN, -1).empty());
+}
+
+// Clipping is the intersection with the pixel centres [0, width-1] x [0, height-1]: an empty
+// image or a box that misses the image gives an invalid (inverted) box, never a valid sliver.
+TYPED_TEST(BoxTest, ClippingToAnEmptyImageOrMissingItIsInvalid) {
+  using T = TypeParam;
+  const dyncull::Box<T> b{T(10), T(20), T(30), T(60)};
+  for (const auto& c : {b.clipped(0, 0), b.clipped(0, 480), b.clipped(640, 0), b.clipped(-3, -3),
+                        b.clipped(INT_MIN, INT_MIN)}) {
+    EXPECT_FALSE(c.valid()) << c.x0 << " " << c.y0 << " " << c.x1 << " " << c.y1;
+    EXPECT_EQ(c.area(), T(0));
+    EXPECT_TRUE(dyncull::pixel_rect(c, 640, 480).empty());
+  }
+  EXPECT_FALSE((dyncull::Box<T>{T(700), T(10), T(800), T(20)}.clipped(640, 480).valid()));
+  EXPECT_FALSE((dyncull::Box<T>{T(10), T(-50), T(20), T(-1)}.clipped(640, 480).valid()));
+  EXPECT_FALSE((dyncull::Box<T>{std::numeric_limits<T>::quiet_NaN(), T(0), T(5), T(5)}.clipped(640, 480).valid()));
+  // A box touching the last column keeps it.
+  const auto edge = dyncull::Box<T>{T(639), T(10), T(800), T(20)}.clipped(640, 480);
+  EXPECT_TRUE(edge.valid());
+  EXPECT_EQ(edge.x0, T(639));
+  EXPECT_EQ(edge.x1, T(639));
+  // A one-pixel image.
+  const auto one = b.clipped(1, 1);
+  EXPECT_FALSE(one.valid());  // b starts at x = 10: misses pixel 0
+  const auto cover = dyncull::Box<T>{T(-5), T(-5), T(5), T(5)}.clipped(1, 1);
+  EXPECT_TRUE(cover.valid());
+  EXPECT_EQ(cover.x1, T(0));
 }
 
 TEST(Detection, Defaults) {

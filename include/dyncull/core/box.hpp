@@ -24,11 +24,15 @@ struct Box {
   bool valid() const { return finite() && x1 >= x0 && y1 >= y0; }
   /// Grown by `pad` pixels on every side (negative shrinks).
   Box padded(T pad) const { return Box{x0 - pad, y0 - pad, x1 + pad, y1 + pad}; }
-  /// Clipped to the pixel centres of a width x height image: [0, width-1] x [0, height-1].
+  /// Intersection with the pixel centres of a width x height image, [0, width-1] x [0, height-1].
+  /// A box that misses the image, an empty image (width or height <= 0) and a non-finite box give an
+  /// invalid box (inverted or NaN, area 0).
   Box clipped(int width, int height) const {
-    const T xmax = T(width - 1), ymax = T(height - 1);
-    return Box{std::clamp(x0, T(0), xmax), std::clamp(y0, T(0), ymax), std::clamp(x1, T(0), xmax),
-               std::clamp(y1, T(0), ymax)};
+    if (width <= 0 || height <= 0) return Box{T(0), T(0), T(-1), T(-1)};
+    const T xmax = T(width) - T(1), ymax = T(height) - T(1);
+    // max/min, not clamp: a corner beyond the far edge must stay there so the box inverts.
+    // std::max(NaN, 0) returns the NaN, which keeps a NaN box invalid.
+    return Box{std::max(x0, T(0)), std::max(y0, T(0)), std::min(x1, xmax), std::min(y1, ymax)};
   }
   template <class U> Box<U> cast() const { return Box<U>{U(x0), U(y0), U(x1), U(y1)}; }
 };
@@ -55,13 +59,16 @@ struct PixelRect {
 template <class T>
 PixelRect pixel_rect(const Box<T>& box, int width, int height) {
   PixelRect r;
-  if (!box.valid()) return r;
+  if (!box.valid() || width <= 0 || height <= 0) return r;
   using std::ceil;
   using std::floor;
-  r.c0 = static_cast<int>(std::max(T(0), ceil(box.x0)));
-  r.r0 = static_cast<int>(std::max(T(0), ceil(box.y0)));
-  r.c1 = static_cast<int>(std::min(T(width), floor(box.x1) + T(1)));
-  r.r1 = static_cast<int>(std::min(T(height), floor(box.y1) + T(1)));
+  // Clamped to [0, size] in double before the cast: corners beyond the int range are finite
+  // user input, and casting them would be undefined. Double holds every float, double and int.
+  auto index = [](double v, int size) { return static_cast<int>(std::min(std::max(v, 0.0), double(size))); };
+  r.c0 = index(static_cast<double>(ceil(box.x0)), width);
+  r.r0 = index(static_cast<double>(ceil(box.y0)), height);
+  r.c1 = index(static_cast<double>(floor(box.x1)) + 1.0, width);
+  r.r1 = index(static_cast<double>(floor(box.y1)) + 1.0, height);
   if (r.c1 < r.c0) r.c1 = r.c0;
   if (r.r1 < r.r0) r.r1 = r.r0;
   return r;
