@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <bitset>
 #include <cmath>
+#include <limits>
+#include <string>
 #include <vector>
 
 namespace {
@@ -268,6 +270,138 @@ TYPED_TEST(MatchL2Test, RatioCrossCheckStrideAndBadInput) {
   const auto none = dyncull::match_l2(Q, dyncull::FloatDescriptors<T>{nullptr, 0, dim, 0});
   EXPECT_TRUE(none.ok());
   EXPECT_TRUE(none.matches.empty());
+}
+
+TYPED_TEST(MatchL2Test, NonFiniteDescriptorsNeverMatch) {
+  using T = TypeParam;
+  const int dim = 16;
+  const std::size_t nq = 6, nt = 9;
+  auto q = random_floats<T>(nq * dim, 11);
+  auto t = random_floats<T>(nt * dim, 12);
+  for (int d = 0; d < dim; ++d) t[4 * dim + d] = q[1 * dim + d];  // train 4 is an exact copy of query 1
+  const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+  t[2 * dim + 3] = nan;  // one NaN in train row 2
+  t[6 * dim + 0] = inf;  // one Inf in train row 6
+  q[3 * dim + 7] = nan;  // query 3 has a NaN
+  q[5 * dim + 1] = -inf;  // query 5 has an Inf
+  const dyncull::FloatDescriptors<T> Q{q.data(), nq, dim, 0}, R{t.data(), nt, dim, 0};
+  for (bool cross : {false, true}) {
+    dyncull::MatchOptions o;
+    o.ratio = 0.9;
+    o.cross_check = cross;
+    const auto r = dyncull::match_l2(Q, R, o);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    bool found_copy = false;
+    for (const auto& m : r.matches) {
+      EXPECT_NE(m.train, 2u) << "a NaN train row matched query " << m.query;
+      EXPECT_NE(m.train, 6u) << "an Inf train row matched query " << m.query;
+      EXPECT_NE(m.query, 3u) << "a NaN query matched train " << m.train;
+      EXPECT_NE(m.query, 5u) << "an Inf query matched train " << m.train;
+      EXPECT_TRUE(std::isfinite(m.distance));
+      found_copy |= m.query == 1 && m.train == 4;
+    }
+    EXPECT_TRUE(found_copy);
+    EXPECT_EQ(r.rejected_non_finite, 2u);  // the two corrupt queries have no finite distance at all
+  }
+  // Every train row corrupt: nothing matches.
+  for (std::size_t j = 0; j < nt; ++j) t[j * dim] = nan;
+  const auto none = dyncull::match_l2(Q, R);
+  ASSERT_TRUE(none.ok()) << none.reason;
+  EXPECT_TRUE(none.matches.empty());
+  EXPECT_EQ(none.rejected_non_finite, nq);
+}
+
+// A value for property tests: mostly normal, sometimes NaN, +-Inf, huge or tiny.
+template <class T>
+T wild_value(dyncull::Random& rng) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return std::numeric_limits<T>::infinity();
+  if (u < 0.04) return -std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.06) return T(rng.normal() * 1e18);
+  if (u < 0.07) return std::numeric_limits<T>::denorm_min();
+  return T(rng.normal());
+}
+
+TYPED_TEST(MatchL2Test, PropertyEveryMatchIsFiniteOrTheCallFails) {
+  using T = TypeParam;
+  dyncull::Random rng(2024);
+  for (int trial = 0; trial < 300; ++trial) {
+    // Sizes around the 64-query block and Eigen's packet widths.
+    const std::size_t nq = rng.index(140), nt = rng.index(140);
+    const int dim = 1 + static_cast<int>(rng.index(20));
+    const bool sparse = rng.uniform() < 0.5;  // half the trials have no corrupt value at all
+    std::vector<T> q(nq * static_cast<std::size_t>(dim)), t(nt * static_cast<std::size_t>(dim));
+    for (auto& v : q) v = sparse ? T(rng.normal()) : wild_value<T>(rng);
+    for (auto& v : t) v = sparse ? T(rng.normal()) : wild_value<T>(rng);
+    dyncull::MatchOptions o;
+    const double pick = rng.uniform();
+    o.ratio = pick < 0.1 ? std::nan("") : pick < 0.2 ? rng.uniform(-2, 3) : rng.uniform(0, 1);
+    o.cross_check = rng.uniform() < 0.5;
+    const double md = rng.uniform();
+    o.max_distance = md < 0.1 ? std::nan("") : md < 0.2 ? -1.0 : md < 0.6 ? rng.uniform(0, 10) : o.max_distance;
+    const dyncull::FloatDescriptors<T> Q{q.data(), nq, dim, 0}, R{t.data(), nt, dim, 0};
+    const auto r = dyncull::match_l2(Q, R, o);
+    if (!r.ok()) {
+      EXPECT_EQ(r.status, Status::InvalidInput);
+      EXPECT_FALSE(r.reason.empty());
+      EXPECT_NE(o.validate(), Status::Ok);
+      continue;
+    }
+    EXPECT_EQ(o.validate(), Status::Ok);
+    auto row_finite = [dim](const std::vector<T>& v, std::size_t i) {
+      for (int d = 0; d < dim; ++d) {
+        if (!std::isfinite(v[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)])) return false;
+      }
+      return true;
+    };
+    std::size_t previous = 0;
+    for (std::size_t k = 0; k < r.matches.size(); ++k) {
+      const auto& m = r.matches[k];
+      ASSERT_LT(m.query, nq);
+      ASSERT_LT(m.train, nt);
+      if (k > 0) {
+        EXPECT_GT(m.query, previous);
+      }
+      previous = m.query;
+      EXPECT_TRUE(std::isfinite(m.distance));
+      EXPECT_TRUE(row_finite(q, m.query)) << "trial " << trial;
+      EXPECT_TRUE(row_finite(t, m.train)) << "trial " << trial;
+    }
+    if (nt > 0) {
+      EXPECT_EQ(r.matches.size() + r.rejected_distance + r.rejected_ratio + r.rejected_cross_check +
+                    r.rejected_non_finite,
+                nq);
+    }
+  }
+}
+
+TEST(DescriptorSwitch, OptionsAreValidated) {
+  std::string why;
+  dyncull::DescriptorSwitchOptions s;
+  EXPECT_EQ(s.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  for (double bad : {-1.0, 181.0, std::nan(""), HUGE_VAL}) {
+    s.switch_angle_deg = bad;
+    EXPECT_EQ(s.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find("switch_angle_deg"), std::string::npos);
+    EXPECT_EQ(dyncull::choose_descriptor(90.0, s), DescriptorKind::Learned);
+  }
+  dyncull::MatchOptions m;
+  EXPECT_EQ(m.validate(&why), Status::Ok);
+  m.max_distance = std::nan("");
+  EXPECT_EQ(m.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("max_distance"), std::string::npos);
+  const std::vector<std::uint8_t> bytes(64, 0);
+  const dyncull::BinaryDescriptors b{bytes.data(), 2, 32};
+  const auto r = dyncull::match_hamming256(b, b, m);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("max_distance"), std::string::npos);
+  m.max_distance = 1;
+  m.ratio = 2;
+  EXPECT_EQ(m.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("ratio"), std::string::npos);
 }
 
 TYPED_TEST(MatchL2Test, NearestKeyframesEquationEighteen) {

@@ -35,20 +35,34 @@ inline const char* to_string(DescriptorKind k) noexcept { return k == Descriptor
 
 struct DescriptorSwitchOptions {
   /// Rotation (eq. 16 angle) above which learned descriptors are abandoned. The paper sets 20° because
-  /// its matching degraded from about 15°.
+  /// its matching degraded from about 15°. In [0, 180].
   double switch_angle_deg = 20.0;
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    if (!(switch_angle_deg >= 0.0 && switch_angle_deg <= 180.0)) {
+      if (reason) *reason = "DescriptorSwitchOptions: switch_angle_deg must be in [0, 180]";
+      return Status::InvalidInput;
+    }
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// ORB when a rotation was found and its eq. 16 angle exceeds the threshold; learned descriptors
 /// otherwise, including when no rotation was found (Algorithm 2 line 16: "rotation did not happen").
+/// The decision has no status to carry a reason: invalid options (see validate()) select Learned, the
+/// choice that needs no rotation estimate.
 template <class T>
 DescriptorKind choose_descriptor(const RotationCentreResult<T>& rotation, const DescriptorSwitchOptions& options = {}) {
+  if (options.validate() != Status::Ok) return DescriptorKind::Learned;
   return rotation.ok() && static_cast<double>(rotation.angle_deg()) > options.switch_angle_deg ? DescriptorKind::Orb
                                                                                                  : DescriptorKind::Learned;
 }
 
-/// Same decision from an angle in degrees (NaN selects Learned).
+/// Same decision from an angle in degrees (NaN selects Learned; so do invalid options).
 inline DescriptorKind choose_descriptor(double rotation_angle_deg, const DescriptorSwitchOptions& options = {}) {
+  if (options.validate() != Status::Ok) return DescriptorKind::Learned;
   return std::abs(rotation_angle_deg) > options.switch_angle_deg ? DescriptorKind::Orb : DescriptorKind::Learned;
 }
 
@@ -132,6 +146,18 @@ struct MatchOptions {
   bool cross_check = false;  ///< keep i -> j only if i is also j's nearest query (cv::BFMatcher crossCheck)
   /// Matches farther than this are dropped (bits for Hamming, L2 units otherwise). ORB-SLAM: TH_LOW = 50.
   double max_distance = std::numeric_limits<double>::infinity();
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(ratio >= 0.0 && ratio <= 1.0)) return bad("MatchOptions: ratio must be in [0, 1] (0 disables the test)");
+    if (!(max_distance >= 0.0)) return bad("MatchOptions: max_distance must be >= 0 (+inf disables it)");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 struct DescriptorMatch {
@@ -147,6 +173,9 @@ struct MatchResult {
   std::size_t rejected_distance = 0;     ///< nearest neighbour farther than max_distance
   std::size_t rejected_ratio = 0;        ///< failed the ratio test
   std::size_t rejected_cross_check = 0;  ///< not mutual nearest neighbours
+  /// Queries with no finite distance to any train row (NaN / Inf in the query, or in every train row):
+  /// a non-finite descriptor never matches.
+  std::size_t rejected_non_finite = 0;
   bool ok() const { return status == Status::Ok; }
 };
 
@@ -210,6 +239,10 @@ void collect_matches(const NearestTracker<D>& t, const MatchOptions& o, bool hav
   const std::size_t nq = t.best.size();
   out->matches.reserve(nq);
   for (std::size_t i = 0; i < nq; ++i) {
+    if (t.best[i] == std::numeric_limits<D>::max()) {  // every distance was NaN: no neighbour
+      ++out->rejected_non_finite;
+      continue;
+    }
     const double d1 = to_distance(t.best[i]);
     if (!(d1 <= o.max_distance)) {
       ++out->rejected_distance;
@@ -296,9 +329,10 @@ inline MatchResult match_hamming256(const BinaryDescriptors& query, const Binary
     out.reason = "match_hamming256: null data or a row stride below 32 bytes";
     return out;
   }
-  if (!(options.ratio >= 0 && options.ratio <= 1)) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
     out.status = Status::InvalidInput;
-    out.reason = "match_hamming256: ratio must be in [0, 1] (0 disables the test)";
+    out.reason = "match_hamming256: " + why;
     return out;
   }
   if (query.rows > std::numeric_limits<std::uint32_t>::max() || train.rows > std::numeric_limits<std::uint32_t>::max()) {
@@ -335,9 +369,15 @@ MatchResult match_l2(const FloatDescriptors<T>& query, const FloatDescriptors<T>
     out.reason = "match_l2: dims must be equal and positive, data non-null, strides >= dim";
     return out;
   }
-  if (!(options.ratio >= 0 && options.ratio <= 1)) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
     out.status = Status::InvalidInput;
-    out.reason = "match_l2: ratio must be in [0, 1] (0 disables the test)";
+    out.reason = "match_l2: " + why;
+    return out;
+  }
+  if (query.rows > std::numeric_limits<std::uint32_t>::max() || train.rows > std::numeric_limits<std::uint32_t>::max()) {
+    out.status = Status::InvalidInput;
+    out.reason = "match_l2: more than 2^32 rows";
     return out;
   }
   const Eigen::Index nq = static_cast<Eigen::Index>(query.rows), nt = static_cast<Eigen::Index>(train.rows);
@@ -364,7 +404,10 @@ MatchResult match_l2(const FloatDescriptors<T>& query, const FloatDescriptors<T>
         T b1 = best[i], b2 = second[i];
         std::uint32_t bi = best_index[i];
         for (Eigen::Index j = 0; j < nt; ++j) {
-          const T d = std::max(T(0), q_sq + train_sq[j] - T(2) * drow[j]);
+          // NaN / Inf in either descriptor gives a NaN (or +inf) here, which fails every comparison
+          // below: a non-finite descriptor never becomes a neighbour. max(0, NaN) would give 0.
+          const T e = q_sq + train_sq[j] - T(2) * drow[j];
+          const T d = e < T(0) ? T(0) : e;
           if (d < b1) {
             b2 = b1;
             b1 = d;
