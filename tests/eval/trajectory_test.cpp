@@ -5,10 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <clocale>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <tuple>
+#include <unistd.h>
 #include <vector>
 
 namespace {
@@ -106,6 +111,206 @@ TYPED_TEST(TrajectoryIoTest, WriteReadRoundTripIsLossless) {
     EXPECT_EQ(r.trajectory.poses[i].t, traj.poses[i].t);
     EXPECT_TRUE(r.trajectory.poses[i].R.isApprox(traj.poses[i].R, rot_tol)) << i;
   }
+}
+
+// Sets a locale whose decimal separator is a comma for the test's scope (the C library's strtod then
+// reads "0,5" and rejects "0.5"); GTEST_SKIP when none is installed.
+class CommaDecimalLocale {
+ public:
+  CommaDecimalLocale() {
+    const char* saved = std::setlocale(LC_ALL, nullptr);
+    saved_ = saved ? saved : "C";
+    for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "de_DE", "fr_FR.UTF-8", "nl_NL.UTF-8"}) {
+      if (std::setlocale(LC_ALL, name) && std::localeconv()->decimal_point[0] == ',') {
+        active_ = true;
+        return;
+      }
+    }
+    std::setlocale(LC_ALL, saved_.c_str());
+  }
+  ~CommaDecimalLocale() { std::setlocale(LC_ALL, saved_.c_str()); }
+  bool active() const { return active_; }
+
+ private:
+  std::string saved_;
+  bool active_ = false;
+};
+
+TYPED_TEST(TrajectoryIoTest, ParsingIgnoresTheCLocale) {
+  using T = TypeParam;
+  CommaDecimalLocale locale;
+  if (!locale.active()) GTEST_SKIP() << "no comma-decimal locale installed (locale-gen de_DE.UTF-8)";
+  const auto r = parse_tum_trajectory<T>("1.5 0.25 0 0 0 0 0 1\n", "f");
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.trajectory.size(), 1u);
+  EXPECT_EQ(r.trajectory.poses[0].t.x(), T(0.25));
+  std::string text;
+  Trajectory<T> traj;
+  traj.push_back(1.5, Rigid3<T>{});
+  traj.poses[0].t.x() = T(0.25);
+  ASSERT_TRUE(format_tum_trajectory(traj, &text).ok());
+  EXPECT_EQ(text.find(','), std::string::npos) << text;
+  EXPECT_EQ(text.rfind("1.500000 0.25 ", 0), 0u) << text;
+}
+
+TEST(TrajectoryIo, NumbersFollowPythonFloat) {
+  // Accepted as Python's float() accepts them.
+  const char* const good[] = {"1_000", "1_0.2_5", "1e1_0", "+5", "-.5", "5.", "1E3", "inf", "-Infinity",
+                              "INF", "nAn", "+nan", "-0"};
+  for (const char* tok : good) {
+    const auto r = parse_tum_trajectory<double>(std::string("1 ") + tok + " 0 0 0 0 0 1\n", "f");
+    EXPECT_TRUE(r.ok()) << tok << ": " << r.reason;
+  }
+  EXPECT_EQ(parse_tum_trajectory<double>("1 1_000 0 0 0 0 0 1\n").trajectory.poses.at(0).t.x(), 1000.0);
+  EXPECT_EQ(parse_tum_trajectory<double>("1 1_0.2_5 0 0 0 0 0 1\n").trajectory.poses.at(0).t.x(), 10.25);
+  // Rejected as Python rejects them.
+  const char* const bad[] = {"+-5", "-+5", "--5", "1__0", "_1", "1_", "1_.5", "1._5", "1e", "1e+", ".", ".e5",
+                             "e5", "0x10", "infinit", "nana", "1,5e", "1.5.2", "1e5.0", "i"};
+  for (const char* tok : bad) {
+    const auto r = parse_tum_trajectory<double>(std::string("1 ") + tok + " 0 0 0 0 0 1\n", "f");
+    EXPECT_EQ(r.status, Status::ParseError) << tok;
+  }
+}
+
+TEST(TrajectoryIo, OverflowIsInfinityAndSkipsTheLineUnderflowIsZero) {
+  const auto r = parse_tum_trajectory<double>("1 1e400 0 0 0 0 0 1\n2 -1e99999999999999999999 0 0 0 0 0 1\n"
+                                              "3 1e-400 0 0 0 0 0 1\n4 0 0 0 0 0 0 1\n", "f");
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.num_skipped, 2u);
+  EXPECT_EQ(r.first_skipped, "f:1: non-finite value");
+  ASSERT_EQ(r.trajectory.size(), 2u);
+  EXPECT_EQ(r.trajectory.poses[0].t.x(), 0.0);
+  EXPECT_EQ(r.trajectory.stamps[1], 4.0);
+}
+
+TEST(TrajectoryIo, FloatTranslationOutOfRangeIsAReasonNotInfinity) {
+  const std::string text = "1 1e39 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n";
+  const auto f = parse_tum_trajectory<float>(text, "f");
+  ASSERT_TRUE(f.ok()) << f.reason;
+  ASSERT_EQ(f.trajectory.size(), 1u);
+  EXPECT_EQ(f.num_skipped, 1u);
+  EXPECT_NE(f.first_skipped.find("f:1: tx"), std::string::npos) << f.first_skipped;
+  EXPECT_NE(f.first_skipped.find("out of range for float"), std::string::npos) << f.first_skipped;
+  for (const auto& p : f.trajectory.poses) EXPECT_TRUE(p.t.allFinite());
+  TrajectoryReadOptions strict;
+  strict.skip_invalid_poses = false;
+  EXPECT_EQ(parse_tum_trajectory<float>(text, "f", strict).status, Status::ParseError);
+  const auto d = parse_tum_trajectory<double>(text, "f");
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d.trajectory.size(), 2u);  // 1e39 is a finite double
+}
+
+TEST(TrajectoryIo, ReasonQuotesABoundedEscapedPrefixOfTheToken) {
+  std::string huge(600, '7');
+  huge += 'x';
+  auto r = parse_tum_trajectory<double>("1 " + huge + " 0 0 0 0 0 1\n", "f");
+  EXPECT_EQ(r.status, Status::ParseError);
+  EXPECT_LT(r.reason.size(), 200u) << r.reason.substr(0, 300);
+  EXPECT_EQ(r.reason.rfind("f:1: tx '7777", 0), 0u) << r.reason.substr(0, 300);
+  EXPECT_NE(r.reason.find("(601 bytes)"), std::string::npos) << r.reason.substr(0, 300);
+  r = parse_tum_trajectory<double>("1 0 0 0 0 0 0 " + std::string(1u << 20, '1') + "\n", "f");
+  EXPECT_EQ(r.status, Status::ParseError);
+  EXPECT_LT(r.reason.size(), 200u) << r.reason.substr(0, 300);
+
+  const std::string nul_token = std::string("1") + '\0' + "5";
+  r = parse_tum_trajectory<double>("1 " + nul_token + " 0 0 0 0 0 1 \n", "f");
+  EXPECT_EQ(r.status, Status::ParseError);
+  EXPECT_EQ(r.reason.find('\0'), std::string::npos);
+  EXPECT_NE(r.reason.find("1\\x005"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("is not a number"), std::string::npos) << r.reason;  // the message goes on past the NUL
+}
+
+TEST(TrajectoryIo, OverlongDataLineIsAnErrorAndLongCommentsAreSkipped) {
+  const std::string spaces(100000, ' ');
+  auto r = parse_tum_trajectory<double>("1 0 0 0" + spaces + "0 0 0 1\n", "f");
+  EXPECT_EQ(r.status, Status::ParseError);
+  EXPECT_NE(r.reason.find("f:1: line"), std::string::npos) << r.reason.substr(0, 200);
+  EXPECT_LT(r.reason.size(), 200u);
+  r = parse_tum_trajectory<double>("#" + spaces + "\n1 0 0 0 0 0 0 1\n", "f");
+  ASSERT_TRUE(r.ok()) << r.reason.substr(0, 200);
+  EXPECT_EQ(r.trajectory.size(), 1u);
+}
+
+TEST(TrajectoryIo, DirectoryIsIoError) {
+  const std::string dir = ::testing::TempDir() + "/dyncull_traj_dir_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const auto r = read_tum_trajectory<double>(dir);
+  EXPECT_EQ(r.status, Status::IoError) << r.reason;
+  EXPECT_NE(r.reason.find(dir), std::string::npos) << r.reason;
+  const WriteResult w = write_tum_trajectory(dir, synthetic::make_loop<double>(3));
+  EXPECT_EQ(w.status, Status::IoError) << w.reason;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(TrajectoryIo, UnreadableFileIsIoError) {
+  if (::geteuid() == 0) GTEST_SKIP() << "running as root: every file is readable";
+  const std::string file = ::testing::TempDir() + "/dyncull_traj_noread_" + std::to_string(::getpid()) + ".txt";
+  std::ofstream(file) << "1 0 0 0 0 0 0 1\n";
+  std::filesystem::permissions(file, std::filesystem::perms::none);
+  const auto u = read_tum_trajectory<double>(file);
+  EXPECT_EQ(u.status, Status::IoError) << u.reason;
+  std::filesystem::remove(file);
+}
+
+TYPED_TEST(TrajectoryIoTest, LongValuesAreNeverCutAndDigitsAreValidated) {
+  using T = TypeParam;
+  Trajectory<T> traj;
+  for (int i = 0; i < 2; ++i) {
+    Rigid3<T> p;
+    p.t = Vec3<T>(T(1) / T(3), T(-2) / T(7), std::numeric_limits<T>::max());
+    traj.push_back(1e300 + i * 1e290, p);  // a 301-digit stamp with %f
+  }
+  std::string text;
+  TrajectoryWriteOptions options;
+  options.stamp_decimals = 9;
+  options.value_digits = 17;
+  const WriteResult w = format_tum_trajectory(traj, &text, options);
+  ASSERT_TRUE(w.ok()) << w.reason;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2);
+  const auto r = parse_tum_trajectory<T>(text, "f");
+  ASSERT_TRUE(r.ok()) << r.reason.substr(0, 200);
+  ASSERT_EQ(r.trajectory.size(), 2u);
+  EXPECT_EQ(r.trajectory.poses[1].t, traj.poses[1].t);
+
+  for (int bad_digits : {-1, 18, 120}) {
+    TrajectoryWriteOptions o;
+    o.value_digits = bad_digits;
+    const WriteResult b = format_tum_trajectory(traj, &text, o);
+    EXPECT_EQ(b.status, Status::InvalidInput) << bad_digits;
+    EXPECT_NE(b.reason.find("value_digits"), std::string::npos) << b.reason;
+  }
+  for (int bad_decimals : {-1, 10}) {
+    TrajectoryWriteOptions o;
+    o.stamp_decimals = bad_decimals;
+    const WriteResult b = format_tum_trajectory(traj, &text, o);
+    EXPECT_EQ(b.status, Status::InvalidInput) << bad_decimals;
+    EXPECT_NE(b.reason.find("stamp_decimals"), std::string::npos) << b.reason;
+  }
+}
+
+TYPED_TEST(TrajectoryIoTest, NonFinitePoseIsAnErrorAndNothingIsWritten) {
+  using T = TypeParam;
+  const std::string path = ::testing::TempDir() + "/dyncull_traj_nan_" + std::to_string(sizeof(T)) + ".txt";
+  std::filesystem::remove(path);
+  for (int which = 0; which < 3; ++which) {
+    Trajectory<T> traj = synthetic::make_loop<T>(4);
+    if (which == 0) traj.poses[2].t.y() = std::numeric_limits<T>::quiet_NaN();
+    if (which == 1) traj.poses[2].R(0, 0) = std::numeric_limits<T>::infinity();
+    if (which == 2) traj.stamps[2] = std::numeric_limits<double>::quiet_NaN();
+    const WriteResult w = write_tum_trajectory(path, traj);
+    EXPECT_EQ(w.status, Status::NonFinite) << which;
+    EXPECT_NE(w.reason.find("pose 2"), std::string::npos) << w.reason;
+    EXPECT_FALSE(std::filesystem::exists(path)) << which;
+    std::string text;
+    EXPECT_EQ(format_tum_trajectory(traj, &text).status, Status::NonFinite);
+  }
+  Trajectory<T> zero = synthetic::make_loop<T>(2);
+  zero.poses[1].R.setZero();  // no rotation: its quaternion is meaningless
+  std::string text;
+  const WriteResult z = format_tum_trajectory(zero, &text);
+  EXPECT_EQ(z.status, Status::InvalidInput);
+  EXPECT_EQ(z.reason, "pose 1: rotation is not orthonormal");
+  EXPECT_TRUE(text.empty());
 }
 
 // associate.py, literally: O(n m) candidate list, sort by (diff, a, b) tuples, greedy, sort by a.

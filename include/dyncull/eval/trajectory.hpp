@@ -4,6 +4,7 @@
 #pragma once
 
 #include "dyncull/core/status.hpp"
+#include "dyncull/core/text.hpp"
 #include "dyncull/core/types.hpp"
 
 #include <Eigen/Geometry>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -49,7 +51,8 @@ struct Trajectory {
 
 /// Parsing policy.
 struct TrajectoryReadOptions {
-  /// Lines whose values contain NaN/Inf or whose quaternion is (near) zero are skipped and counted,
+  /// Lines whose values contain NaN/Inf (1e400 included), whose quaternion is (near) zero or whose
+  /// translation is outside T's range are skipped and counted,
   /// as evaluate_rpe.py's read_trajectory does; false turns them into a ParseError.
   bool skip_invalid_poses = true;
 };
@@ -65,8 +68,8 @@ struct TrajectoryReadResult {
 };
 
 struct TrajectoryWriteOptions {
-  int stamp_decimals = 6;  ///< TUM writes microseconds
-  int value_digits = 0;    ///< significant digits of tx..qw; 0 = max_digits10 of T (lossless round trip)
+  int stamp_decimals = 6;  ///< in [0, 9]; TUM writes microseconds
+  int value_digits = 0;    ///< in [0, 17]: significant digits of tx..qw; 0 = max_digits10 of T (lossless round trip)
 };
 
 struct WriteResult {
@@ -94,16 +97,31 @@ struct AssociationResult {
   std::size_t size() const { return first.size(); }
 };
 
-/// Parses TUM text. `source` names the text in error messages ("path:line: ...").
+/// Parses TUM text. `source` names the text in error messages ("path:line: ..."). Numbers follow
+/// Python's float() whatever the locale (core/text.hpp): 1e400 is inf (the line is then skipped as
+/// non-finite), "1_000" is 1000, "+-5" is an error. Separators: space, tab, comma. A data line longer
+/// than text::kMaxLineChars or a number longer than text::kMaxNumberChars is a ParseError; reasons
+/// quote at most 32 characters of a bad token, escaped. A translation outside T's range (1e39 for
+/// float) is an invalid pose, skipped or rejected as TrajectoryReadOptions says.
 template <class T>
 TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::string& source = "<memory>",
                                              const TrajectoryReadOptions& options = {});
 
-/// Reads a TUM file; IoError when it cannot be opened, ParseError with "path:line: ..." otherwise.
+/// Reads a TUM file; IoError when it is a directory or cannot be opened or read, ParseError with
+/// "path:line: ..." otherwise.
 template <class T = double>
 TrajectoryReadResult<T> read_tum_trajectory(const std::string& path, const TrajectoryReadOptions& options = {});
 
-/// TUM text of a trajectory (qw >= 0, one line per pose, no header).
+/// TUM text of a trajectory (qw >= 0, one line per pose, no header), in the C locale's number format
+/// whatever the process locale. InvalidInput for options out of range or stamps/poses of different
+/// sizes or a rotation that is not orthonormal (zero, scaled); NonFinite for a pose whose stamp,
+/// translation or rotation is not finite. The whole call fails and `out` is left empty: never a file
+/// with a gap the reader would skip.
+template <class T>
+WriteResult format_tum_trajectory(const Trajectory<T>& trajectory, std::string* out,
+                                  const TrajectoryWriteOptions& options = {});
+
+/// The same text, or "" when format_tum_trajectory above fails.
 template <class T>
 std::string format_tum_trajectory(const Trajectory<T>& trajectory, const TrajectoryWriteOptions& options = {});
 
@@ -156,14 +174,11 @@ inline std::size_t sorted_unique_stamp_order(const double* stamps, std::size_t n
 
 inline bool is_separator(char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r' || c == '\v' || c == '\f'; }
 
-/// One number as Python's float() would accept it in a TUM file (decimal, exponent, nan, inf).
-inline bool parse_double(std::string_view token, double* out) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* begin = token.data();
-  const char* end = begin + token.size();
-  const auto res = std::from_chars(begin, end, *out);
-  return res.ec == std::errc() && res.ptr == end;
+/// Appends `v` in C-locale %.*f (fixed) or %.*g (general) form: std::to_chars never consults the locale.
+inline void append_number(std::string* out, double v, std::chars_format format, int precision) {
+  char buf[400];  // fixed DBL_MAX with 9 decimals is 319 characters; precision is validated to <= 17
+  const std::to_chars_result res = std::to_chars(buf, buf + sizeof(buf), v, format, precision);
+  if (res.ec == std::errc()) out->append(buf, static_cast<std::size_t>(res.ptr - buf));
 }
 
 }  // namespace detail
@@ -174,14 +189,20 @@ TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::s
   TrajectoryReadResult<T> result;
   std::size_t line_number = 0;
   std::size_t pos = 0;
-  std::string_view tokens[9];
+  std::string_view tokens[8];
+  const auto where = [&]() { return source + ":" + std::to_string(line_number) + ": "; };
+  const auto fail = [&](const std::string& why) {
+    result.status = Status::ParseError;
+    result.reason = where() + why;
+    result.trajectory.clear();
+    return result;
+  };
   while (pos <= text.size()) {
     std::size_t eol = text.find('\n', pos);
     if (eol == std::string_view::npos) eol = text.size();
     const std::string_view line = text.substr(pos, eol - pos);
     pos = eol + 1;
     ++line_number;
-    const std::string where = source + ":" + std::to_string(line_number) + ": ";
 
     std::size_t num_tokens = 0;
     std::size_t k = 0;
@@ -190,27 +211,30 @@ TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::s
       if (eol == text.size()) break;
       continue;  // blank line or comment
     }
+    if (line.size() > text::kMaxLineChars) {
+      return fail("line is " + std::to_string(line.size()) + " bytes long (limit " +
+                  std::to_string(text::kMaxLineChars) + ")");
+    }
     while (k < line.size()) {
       const std::size_t start = k;
       while (k < line.size() && !detail::is_separator(line[k])) ++k;
-      if (num_tokens < 9) tokens[num_tokens] = line.substr(start, k - start);
+      if (num_tokens < 8) tokens[num_tokens] = line.substr(start, k - start);
       ++num_tokens;
       while (k < line.size() && detail::is_separator(line[k])) ++k;
     }
     if (num_tokens != 8) {
-      result.status = Status::ParseError;
-      result.reason = where + "expected 8 values (timestamp tx ty tz qx qy qz qw), found " + std::to_string(num_tokens);
-      result.trajectory.clear();
-      return result;
+      return fail("expected 8 values (timestamp tx ty tz qx qy qz qw), found " + std::to_string(num_tokens));
     }
     double v[8];
     static const char* const kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
     for (int c = 0; c < 8; ++c) {
-      if (!detail::parse_double(tokens[c], &v[c])) {
-        result.status = Status::ParseError;
-        result.reason = where + kNames[c] + " '" + std::string(tokens[c]) + "' is not a number";
-        result.trajectory.clear();
-        return result;
+      const text::NumberStatus parsed = text::parse_python_float(tokens[c], &v[c]);
+      if (parsed == text::NumberStatus::TooLong) {
+        return fail(std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is longer than " +
+                    std::to_string(text::kMaxNumberChars) + " characters");
+      }
+      if (parsed != text::NumberStatus::Ok) {
+        return fail(std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is not a number");
       }
     }
     std::string invalid;
@@ -223,15 +247,18 @@ TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::s
       // TUM skips all-zero quaternions (a common "lost tracking" marker); a near-zero one has no
       // meaningful direction either.
       invalid = "zero quaternion";
+    } else {
+      for (int c = 1; c < 4 && invalid.empty(); ++c) {
+        // A finite double beyond T's range would become inf (undefined behaviour in the cast).
+        if (!text::fits_scalar<T>(v[c])) {
+          invalid = std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is out of range for " +
+                    text::scalar_name<T>();
+        }
+      }
     }
     if (!invalid.empty()) {
-      if (!options.skip_invalid_poses) {
-        result.status = Status::ParseError;
-        result.reason = where + invalid;
-        result.trajectory.clear();
-        return result;
-      }
-      if (result.num_skipped == 0) result.first_skipped = where + invalid;
+      if (!options.skip_invalid_poses) return fail(invalid);
+      if (result.num_skipped == 0) result.first_skipped = where() + invalid;
       ++result.num_skipped;
       if (eol == text.size()) break;
       continue;
@@ -249,56 +276,103 @@ TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::s
 
 template <class T>
 TrajectoryReadResult<T> read_tum_trajectory(const std::string& path, const TrajectoryReadOptions& options) {
+  TrajectoryReadResult<T> result;
+  result.status = Status::IoError;
+  std::error_code ec;
+  // An ifstream opens a directory on POSIX and then reads nothing: that is not an empty trajectory.
+  if (std::filesystem::is_directory(path, ec)) {
+    result.reason = path + ": is a directory, not a trajectory file";
+    return result;
+  }
   std::ifstream file(path, std::ios::in | std::ios::binary);
   if (!file) {
-    TrajectoryReadResult<T> result;
-    result.status = Status::IoError;
     result.reason = path + ": cannot open for reading";
     return result;
   }
-  std::ostringstream buffer;
-  buffer << file.rdbuf();
-  if (file.bad()) {
-    TrajectoryReadResult<T> result;
-    result.status = Status::IoError;
+  std::string text;
+  char chunk[1 << 16];
+  while (file.read(chunk, sizeof(chunk)) || file.gcount() > 0) text.append(chunk, static_cast<std::size_t>(file.gcount()));
+  if (file.bad() || !file.eof()) {
     result.reason = path + ": read error";
     return result;
   }
-  const std::string text = buffer.str();
   return parse_tum_trajectory<T>(text, path, options);
 }
 
 template <class T>
-std::string format_tum_trajectory(const Trajectory<T>& trajectory, const TrajectoryWriteOptions& options) {
+WriteResult format_tum_trajectory(const Trajectory<T>& trajectory, std::string* out,
+                                  const TrajectoryWriteOptions& options) {
+  WriteResult result;
+  out->clear();
+  if (options.value_digits < 0 || options.value_digits > 17) {
+    result.status = Status::InvalidInput;
+    result.reason = "value_digits must be in [0, 17] (0: max_digits10), got " + std::to_string(options.value_digits);
+    return result;
+  }
+  if (options.stamp_decimals < 0 || options.stamp_decimals > 9) {
+    result.status = Status::InvalidInput;
+    result.reason = "stamp_decimals must be in [0, 9], got " + std::to_string(options.stamp_decimals);
+    return result;
+  }
+  if (trajectory.stamps.size() != trajectory.poses.size()) {
+    result.status = Status::InvalidInput;
+    result.reason = "trajectory has " + std::to_string(trajectory.stamps.size()) + " stamps but " +
+                    std::to_string(trajectory.poses.size()) + " poses";
+    return result;
+  }
   const int digits = options.value_digits > 0 ? options.value_digits : std::numeric_limits<T>::max_digits10;
-  const int decimals = options.stamp_decimals >= 0 ? options.stamp_decimals : 6;
-  std::string out;
-  out.reserve(trajectory.size() * 128);
-  char line[512];
-  const std::size_t n = std::min(trajectory.stamps.size(), trajectory.poses.size());
-  for (std::size_t i = 0; i < n; ++i) {
+  out->reserve(trajectory.size() * 128);
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
     const Rigid3<T>& p = trajectory.poses[i];
     Eigen::Quaternion<double> q(p.R.template cast<double>());
     q.normalize();
     if (q.w() < 0) q.coeffs() = -q.coeffs();  // one of the two equivalent signs, deterministically
-    const int len = std::snprintf(line, sizeof(line), "%.*f %.*g %.*g %.*g %.*g %.*g %.*g %.*g\n", decimals,
-                                  trajectory.stamps[i], digits, static_cast<double>(p.t.x()), digits,
-                                  static_cast<double>(p.t.y()), digits, static_cast<double>(p.t.z()), digits, q.x(),
-                                  digits, q.y(), digits, q.z(), digits, q.w());
-    if (len > 0) out.append(line, static_cast<std::size_t>(std::min<int>(len, static_cast<int>(sizeof(line)) - 1)));
+    // A NaN pose in a TUM file reads back as a skipped line, a silent gap in the evaluation: refuse it.
+    const char* bad = !std::isfinite(trajectory.stamps[i]) ? "stamp"
+                      : !p.t.allFinite()                    ? "translation"
+                      : !(p.R.allFinite() && q.coeffs().allFinite()) ? "rotation"
+                                                                      : nullptr;
+    if (bad) {
+      result.status = Status::NonFinite;
+      result.reason = "pose " + std::to_string(i) + ": non-finite " + bad;
+      out->clear();
+      return result;
+    }
+    // The quaternion of a matrix that is not a rotation (zero, scaled) is meaningless, not an error.
+    const Eigen::Matrix3d R = p.R.template cast<double>();
+    if (!((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-2)) {
+      result.status = Status::InvalidInput;
+      result.reason = "pose " + std::to_string(i) + ": rotation is not orthonormal";
+      out->clear();
+      return result;
+    }
+    detail::append_number(out, trajectory.stamps[i], std::chars_format::fixed, options.stamp_decimals);
+    const double values[7] = {static_cast<double>(p.t.x()), static_cast<double>(p.t.y()),
+                              static_cast<double>(p.t.z()), q.x(), q.y(), q.z(), q.w()};
+    for (double x : values) {
+      out->push_back(' ');
+      detail::append_number(out, x, std::chars_format::general, digits);
+    }
+    out->push_back('\n');
   }
+  return result;
+}
+
+template <class T>
+std::string format_tum_trajectory(const Trajectory<T>& trajectory, const TrajectoryWriteOptions& options) {
+  std::string out;
+  if (!format_tum_trajectory(trajectory, &out, options).ok()) out.clear();
   return out;
 }
 
 template <class T>
 WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& trajectory,
                                  const TrajectoryWriteOptions& options) {
-  WriteResult result;
-  if (trajectory.stamps.size() != trajectory.poses.size()) {
-    result.status = Status::InvalidInput;
-    result.reason = path + ": trajectory has " + std::to_string(trajectory.stamps.size()) + " stamps but " +
-                    std::to_string(trajectory.poses.size()) + " poses";
-    return result;
+  std::string text;
+  WriteResult result = format_tum_trajectory(trajectory, &text, options);
+  if (!result.ok()) {
+    result.reason = path + ": " + result.reason;
+    return result;  // nothing written
   }
   std::ofstream file(path, std::ios::out | std::ios::binary | std::ios::trunc);
   if (!file) {
@@ -306,7 +380,7 @@ WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& t
     result.reason = path + ": cannot open for writing";
     return result;
   }
-  file << "# timestamp tx ty tz qx qy qz qw\n" << format_tum_trajectory(trajectory, options);
+  file << "# timestamp tx ty tz qx qy qz qw\n" << text;
   file.flush();
   if (!file) {
     result.status = Status::IoError;

@@ -1,0 +1,164 @@
+/// @file text.hpp
+/// Locale-independent, bounded number parsing for dyncull's text readers (TUM trajectories, YOLO
+/// labels): the grammar of Python's float() (no paper equation; both formats are written by Python).
+#pragma once
+
+#include <charconv>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+namespace dyncull::text {
+
+/// Longest number token accepted: the longest double that printf("%.9f") writes is 319 characters.
+constexpr std::size_t kMaxNumberChars = 512;
+/// Longest data line accepted by the line readers (comment lines are skipped whatever their length).
+constexpr std::size_t kMaxLineChars = 8192;
+/// Characters of a bad token quoted in a reason.
+constexpr std::size_t kQuotedTokenChars = 32;
+
+enum class NumberStatus : std::uint8_t { Ok = 0, Empty, TooLong, Invalid };
+
+namespace detail {
+inline bool is_digit(char c) { return c >= '0' && c <= '9'; }
+inline bool iequals(std::string_view a, const char* lower) {
+  std::size_t i = 0;
+  for (; i < a.size() && lower[i] != '\0'; ++i) {
+    const char c = (a[i] >= 'A' && a[i] <= 'Z') ? static_cast<char>(a[i] - 'A' + 'a') : a[i];
+    if (c != lower[i]) return false;
+  }
+  return i == a.size() && lower[i] == '\0';
+}
+}  // namespace detail
+
+/// One number as Python's float() reads it, whatever the C or C++ locale: [sign] then digits with
+/// single underscores between them ("1_000"), an optional '.' and fraction, an optional exponent
+/// (e/E, sign, digits), or inf / infinity / nan in any case. Values beyond the double range become
+/// +-inf, values below it +-0, as in Python. ASCII digits only; no surrounding whitespace; at most
+/// kMaxNumberChars characters (TooLong otherwise: the token is never copied).
+inline NumberStatus parse_python_float(std::string_view token, double* out) {
+  if (token.empty()) return NumberStatus::Empty;
+  if (token.size() > kMaxNumberChars) return NumberStatus::TooLong;
+  std::size_t j = 0;
+  const bool negative = token[0] == '-';
+  if (token[0] == '+' || token[0] == '-') ++j;
+  const std::string_view body = token.substr(j);
+  if (detail::iequals(body, "inf") || detail::iequals(body, "infinity")) {
+    *out = negative ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+    return NumberStatus::Ok;
+  }
+  if (detail::iequals(body, "nan")) {
+    *out = std::numeric_limits<double>::quiet_NaN();
+    return NumberStatus::Ok;
+  }
+  // The digits without underscores, for from_chars (which never consults the locale).
+  char buf[kMaxNumberChars + 1];
+  std::size_t n = 0;
+  if (negative) buf[n++] = '-';
+  const std::size_t size = token.size();
+  std::size_t num_int = 0;          // integer digits
+  std::ptrdiff_t first_nonzero = -1;  // position of the first non-zero mantissa digit
+  std::size_t num_mantissa = 0;
+  // digitpart ::= digit (["_"] digit)*
+  const auto digitpart = [&](bool mantissa) {
+    if (j >= size || !detail::is_digit(token[j])) return false;
+    while (j < size) {
+      if (detail::is_digit(token[j])) {
+        if (mantissa) {
+          if (first_nonzero < 0 && token[j] != '0') first_nonzero = static_cast<std::ptrdiff_t>(num_mantissa);
+          ++num_mantissa;
+        }
+        buf[n++] = token[j++];
+      } else if (token[j] == '_' && j + 1 < size && detail::is_digit(token[j + 1])) {
+        ++j;
+      } else if (token[j] == '_') {
+        return false;
+      } else {
+        break;
+      }
+    }
+    return true;
+  };
+  bool has_digits = false;
+  if (j < size && detail::is_digit(token[j])) {
+    if (!digitpart(true)) return NumberStatus::Invalid;
+    num_int = num_mantissa;
+    has_digits = true;
+  }
+  if (j < size && token[j] == '.') {
+    buf[n++] = token[j++];
+    if (j < size && detail::is_digit(token[j])) {
+      if (!digitpart(true)) return NumberStatus::Invalid;
+      has_digits = true;
+    }
+  }
+  if (!has_digits) return NumberStatus::Invalid;
+  long long exponent = 0;
+  if (j < size && (token[j] == 'e' || token[j] == 'E')) {
+    buf[n++] = token[j++];
+    bool exp_negative = false;
+    if (j < size && (token[j] == '+' || token[j] == '-')) {
+      exp_negative = token[j] == '-';
+      buf[n++] = token[j++];
+    }
+    const std::size_t exp_start = n;
+    if (!digitpart(false)) return NumberStatus::Invalid;
+    for (std::size_t k = exp_start; k < n; ++k) {
+      if (exponent < 1000000000LL) exponent = exponent * 10 + (buf[k] - '0');  // saturates: only the sign matters
+    }
+    if (exp_negative) exponent = -exponent;
+  }
+  if (j != size) return NumberStatus::Invalid;
+  double value = 0;
+  const std::from_chars_result res = std::from_chars(buf, buf + n, value);
+  if (res.ec == std::errc::result_out_of_range) {
+    // Overflow or underflow: the decimal magnitude of the leading digit says which.
+    const long long magnitude =
+        static_cast<long long>(num_int) - 1 - static_cast<long long>(first_nonzero < 0 ? 0 : first_nonzero) + exponent;
+    const double big = magnitude > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+    value = negative ? -big : big;
+  } else if (res.ec != std::errc() || res.ptr != buf + n) {
+    return NumberStatus::Invalid;
+  }
+  *out = value;
+  return NumberStatus::Ok;
+}
+
+/// A bad token for a reason: at most `max_chars` characters between single quotes, bytes outside
+/// printable ASCII (and the quote and backslash) as \xHH, then "... (N bytes)" when cut.
+inline std::string quote_token(std::string_view token, std::size_t max_chars = kQuotedTokenChars) {
+  static const char* const kHex = "0123456789abcdef";
+  std::string out = "'";
+  const std::size_t shown = token.size() < max_chars ? token.size() : max_chars;
+  for (std::size_t i = 0; i < shown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(token[i]);
+    if (c >= 0x20 && c < 0x7f && c != '\'' && c != '\\') {
+      out += static_cast<char>(c);
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  out += '\'';
+  if (shown < token.size()) out += "... (" + std::to_string(token.size()) + " bytes)";
+  return out;
+}
+
+/// Name of a floating-point scalar type in reasons.
+template <class T>
+constexpr const char* scalar_name() {
+  return sizeof(T) == sizeof(float) ? "float" : (sizeof(T) == sizeof(double) ? "double" : "long double");
+}
+
+/// Whether a double fits T's finite range (non-finite values pass: they are reported as such).
+template <class T>
+bool fits_scalar(double v) {
+  return !(v > static_cast<double>(std::numeric_limits<T>::max()) ||
+           v < -static_cast<double>(std::numeric_limits<T>::max()));
+}
+
+}  // namespace dyncull::text
