@@ -88,7 +88,7 @@ TEST(SimScene, InvalidOptionsAndIndicesGiveAStatusNotACrash) {
   bad_rate.miss_rate = 1.5;
   EXPECT_EQ(Scene(bad_rate).status(), Status::InvalidInput);
   SceneOptions bad_people;
-  bad_people.actors.walking_people = 3;
+  bad_people.actors.walking_people = 5;  // at most 4
   EXPECT_EQ(Scene(bad_people).status(), Status::InvalidInput);
 }
 
@@ -606,6 +606,7 @@ TEST(SimScene, CameraMotionRangesPerType) {
         EXPECT_GT(max_angle_deg, 8.0);  // keeps the room centre 2.8 m away in view
         break;
       }
+      case CameraMotion::Recorded: break;  // needs a recording: tested in trajectory_test
     }
   }
 }

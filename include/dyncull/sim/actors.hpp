@@ -1,7 +1,8 @@
 /// @file actors.hpp
 /// The synthetic room and its actors as primitives at time t: static textured room and furniture,
-/// walking people (COCO 0), a pushed chair (56), a sitting person moving only the upper body, a TV (62).
-/// Layout and gait are modelled on the TUM fr3 walking sequences (no paper equation).
+/// walking people (COCO 0), a pushed chair (56), a sitting person moving only the upper body, a TV (62);
+/// optionally two people seated at a desk with its clutter, as in TUM fr3/sitting_* (Sturm et al. 2012).
+/// Layout and gait are modelled on the TUM fr3 walking and sitting sequences (no paper equation).
 #pragma once
 
 #include "dyncull/core/types.hpp"
@@ -16,8 +17,14 @@ namespace dyncull::sim {
 /// COCO-80 class indices used by the scene.
 struct CocoClass {
   static constexpr int kPerson = 0;
+  static constexpr int kBottle = 39;
+  static constexpr int kCup = 41;
   static constexpr int kChair = 56;
   static constexpr int kTv = 62;
+  static constexpr int kLaptop = 63;
+  static constexpr int kMouse = 64;
+  static constexpr int kKeyboard = 66;
+  static constexpr int kBook = 73;
 };
 
 /// Instance ids of the scene (0 = static background and furniture without a detector class).
@@ -29,7 +36,28 @@ struct SceneInstance {
   static constexpr std::uint16_t kPushedChair = 4;
   static constexpr std::uint16_t kSittingChair = 5;
   static constexpr std::uint16_t kTv = 6;
-  static constexpr int kCount = 7;  ///< ids are < kCount
+  static constexpr std::uint16_t kWalkerC = 7;       ///< third and fourth walkers (a crowd)
+  static constexpr std::uint16_t kWalkerD = 8;
+  static constexpr std::uint16_t kDeskPersonA = 9;   ///< people seated at the desk (fr3/sitting_*)
+  static constexpr std::uint16_t kDeskPersonB = 10;
+  static constexpr std::uint16_t kDeskChairA = 11;   ///< their swivel chairs
+  static constexpr std::uint16_t kDeskChairB = 12;
+  static constexpr std::uint16_t kMonitorA = 13;     ///< desk clutter: monitors (tv), then medium-level objects
+  static constexpr std::uint16_t kMonitorB = 14;
+  static constexpr std::uint16_t kKeyboardA = 15;
+  static constexpr std::uint16_t kKeyboardB = 16;
+  static constexpr std::uint16_t kMouseA = 17;
+  static constexpr std::uint16_t kMouseB = 18;
+  static constexpr std::uint16_t kBottle = 19;
+  static constexpr std::uint16_t kCup = 20;
+  static constexpr std::uint16_t kBook = 21;
+  static constexpr std::uint16_t kLaptop = 22;
+  static constexpr int kCount = 23;  ///< ids are < kCount
+
+  /// Walker w's id (w in 0..3).
+  static constexpr std::uint16_t walker(int w) noexcept {
+    return w <= 1 ? static_cast<std::uint16_t>(kWalkerA + w) : static_cast<std::uint16_t>(kWalkerC + (w - 2));
+  }
 };
 
 /// COCO class of an instance id, -1 for the background.
@@ -37,17 +65,33 @@ constexpr int instance_class(std::uint16_t instance) noexcept {
   switch (instance) {
     case SceneInstance::kWalkerA:
     case SceneInstance::kWalkerB:
+    case SceneInstance::kWalkerC:
+    case SceneInstance::kWalkerD:
+    case SceneInstance::kDeskPersonA:
+    case SceneInstance::kDeskPersonB:
     case SceneInstance::kSittingPerson: return CocoClass::kPerson;
     case SceneInstance::kPushedChair:
+    case SceneInstance::kDeskChairA:
+    case SceneInstance::kDeskChairB:
     case SceneInstance::kSittingChair: return CocoClass::kChair;
+    case SceneInstance::kMonitorA:
+    case SceneInstance::kMonitorB:
     case SceneInstance::kTv: return CocoClass::kTv;
+    case SceneInstance::kKeyboardA:
+    case SceneInstance::kKeyboardB: return CocoClass::kKeyboard;
+    case SceneInstance::kMouseA:
+    case SceneInstance::kMouseB: return CocoClass::kMouse;
+    case SceneInstance::kBottle: return CocoClass::kBottle;
+    case SceneInstance::kCup: return CocoClass::kCup;
+    case SceneInstance::kBook: return CocoClass::kBook;
+    case SceneInstance::kLaptop: return CocoClass::kLaptop;
     default: return -1;
   }
 }
 
 /// Which actors are present and how they move.
 struct ActorOptions {
-  int walking_people = 2;              ///< 0, 1 or 2 people walking an elliptic loop
+  int walking_people = 2;              ///< 0 to 4 people walking an elliptic loop, walker_gap_rad apart
   bool sitting_person = true;          ///< person on a chair moving head, torso and arms only
   bool pushed_chair = true;            ///< chair that slides once, pushed between push_start_s and push_end_s
   double walking_speed_mps = 0.4;      ///< mean walking speed along the loop (slow, like TUM fr3/walking_*)
@@ -59,6 +103,14 @@ struct ActorOptions {
   double push_end_s = 5.0;             ///< chair stops moving
   double wall_contrast = 0.4;          ///< texture contrast of walls, floor, ceiling in [0, 1]; lower = plainer, harder
   double texture_scale = 1.0;          ///< multiplies every texture cell size (smaller = more corners)
+  /// People seated at a desk in front of the camera rest pose (fr3/sitting_*): 0, 1 or 2. They sway,
+  /// turn their heads, gesture with their arms and now and then swivel their chairs; with 2 the
+  /// person boxes cover about half of the image from the rest pose.
+  int desk_people = 0;
+  double desk_motion_scale = 1.0;      ///< scales the desk people's sway, head turn, gesture and swivel (0 = still)
+  /// Desk clutter, static: two monitors (tv, low level) and keyboards, mice, a bottle, a cup, a book
+  /// and a laptop (medium level) on the desk. The desk itself is there when desk_people > 0 or this.
+  bool desk_clutter = false;
 };
 
 namespace detail {
@@ -176,6 +228,115 @@ inline void add_chair(PrimitiveSink& sink, const Rigid3<double>& world_from_chai
   }
 }
 
+/// Motion of one desk person at time t: angles in radians, all scaled by `scale`. `phase` (seconds)
+/// offsets the person's clocks so two people do not move in step.
+struct DeskMotion {
+  double sway_yaw = 0, sway_pitch = 0;  ///< upper body about the hips
+  double head_yaw = 0;                  ///< head about the neck, relative to the upper body
+  double arm[2] = {0, 0};               ///< shoulder pitch of the right (0) and left (1) arm, added to the rest pose
+  double swivel = 0;                    ///< chair (and whole person) about the vertical through the seat
+  bool swivel_moving = false;           ///< the swivel changes somewhere in (t - dt, t + dt)
+};
+
+/// Swivel profile over one 9 s cycle: out over 1.2 s, hold, back over 1.2 s, rest. Episodic, so
+/// legs and chair are still most of the time as in the real sequences.
+inline double desk_swivel_profile(double t) {
+  constexpr double kPeriod = 9.0;
+  double c = std::fmod(t, kPeriod);
+  if (c < 0) c += kPeriod;
+  auto ramp = [](double x) {
+    x = x < 0 ? 0 : (x > 1 ? 1 : x);
+    return x * x * (3.0 - 2.0 * x);
+  };
+  return ramp(c / 1.2) - ramp((c - 4.5) / 1.2);
+}
+
+inline DeskMotion desk_motion(double t, double dt, double phase, double scale) {
+  constexpr double kTwoPi = 6.283185307179586;
+  const double u = t + phase;
+  DeskMotion m;
+  m.sway_yaw = scale * 0.08 * std::sin(kTwoPi * u / 5.3);
+  m.sway_pitch = scale * (0.05 * std::sin(kTwoPi * u / 3.7) + 0.02 * std::sin(kTwoPi * u / 1.3));
+  m.head_yaw = scale * 0.45 * std::sin(kTwoPi * u / 6.1) * std::sin(kTwoPi * u / 6.1);  // looks aside, returns
+  // Gestures come in bursts: the envelope is zero a third of each cycle.
+  const double envelope = std::max(0.0, std::sin(kTwoPi * u / 4.7));
+  m.arm[0] = scale * -0.9 * envelope * (0.6 + 0.4 * std::sin(kTwoPi * u / 1.1));
+  m.arm[1] = scale * -0.35 * std::max(0.0, std::sin(kTwoPi * u / 7.9 + 1.0));
+  m.swivel = scale * 0.3 * (desk_swivel_profile(u) - 0.5);
+  if (scale != 0) {
+    // Moving when the profile differs at either end of the window (sampled finely: ramps are 1.2 s).
+    const double p0 = desk_swivel_profile(u);
+    for (int k = -4; k <= 4 && !m.swivel_moving; ++k)
+      m.swivel_moving = desk_swivel_profile(u + dt * k / 4.0) != p0;
+  }
+  return m;
+}
+
+/// Person seated at the desk, facing x, on a swivel chair (origin on the floor under the seat).
+/// Legs and pelvis move only with the swivel; upper body, head and arms move all the time.
+inline void add_desk_person(PrimitiveSink& sink, const Rigid3<double>& world_from_seat, const DeskMotion& m,
+                            std::uint16_t instance, std::uint16_t chair_instance, const Clothes& c,
+                            std::uint32_t chair_seed) {
+  constexpr double kCloth = 0.04, kSkin = 0.04;
+  const Mat3<double> I = Mat3<double>::Identity();
+  const Rigid3<double> world_from_person = world_from_seat * make_pose(rot_z(m.swivel), Vec3<double>::Zero());
+  add_chair(sink, world_from_person, chair_instance, m.swivel_moving, chair_seed);
+  auto W = [&](const Rigid3<double>& person_from_part) { return world_from_person * person_from_part; };
+  const bool legs_move = m.swivel_moving;
+  sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0, 0, 0.58})), {0.13, 0.17, 0.10}, instance, legs_move,
+           c.seed + 1, kCloth, c.trousers);
+  for (int side = -1; side <= 1; side += 2) {
+    const double s = static_cast<double>(side);
+    sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0.22, 0.1 * s, 0.56})), {0.24, 0.075, 0.075}, instance,
+             legs_move, c.seed + 4, kCloth, c.trousers);
+    sink.add(PrimitiveShape::Ellipsoid, W(make_pose(I, {0.46, 0.1 * s, 0.27})), {0.06, 0.06, 0.27}, instance,
+             legs_move, c.seed + 6, kCloth, c.trousers);
+  }
+  const Rigid3<double> person_from_upper = make_pose(rot_z(m.sway_yaw) * rot_y(m.sway_pitch + 0.05), {0, 0, 0.62});
+  auto U = [&](const Rigid3<double>& upper_from_part) { return world_from_person * person_from_upper * upper_from_part; };
+  sink.add(PrimitiveShape::Ellipsoid, U(make_pose(I, {0, 0, 0.31})), {0.13, 0.21, 0.29}, instance, true, c.seed + 2,
+           kCloth, c.shirt);
+  sink.add(PrimitiveShape::Ellipsoid, U(make_pose(rot_z(m.head_yaw), {0, 0, 0.72})), {0.10, 0.085, 0.12}, instance,
+           true, c.seed + 3, kSkin, c.skin);
+  for (int side = -1; side <= 1; side += 2) {
+    const double s = static_cast<double>(side);
+    const double pitch = -0.35 + m.arm[side > 0 ? 1 : 0];  // arms rest forward on the lap
+    sink.add(PrimitiveShape::Ellipsoid, U(limb({0, 0.25 * s, 0.52}, rot_y(pitch) * rot_x(-0.12 * s), 0.64)),
+             {0.055, 0.055, 0.32}, instance, true, c.seed + 5, kCloth, c.shirt);
+  }
+}
+
+/// Static desk clutter on a desk whose top is at height `top` (world frame of the desk: x along the
+/// desk, y away from the camera, origin on the floor under the desk centre).
+inline void add_desk_clutter(PrimitiveSink& sink, const Rigid3<double>& world_from_desk, double top,
+                             std::uint32_t seed) {
+  const Mat3<double> I = Mat3<double>::Identity();
+  auto W = [&](const Mat3<double>& R, const Vec3<double>& centre) { return world_from_desk * make_pose(R, centre); };
+  auto box = [&](const Mat3<double>& R, const Vec3<double>& centre, const Vec3<double>& half, std::uint16_t id,
+                 std::uint32_t k, double cell, const Vec3<double>& albedo) {
+    sink.add(PrimitiveShape::Box, W(R, centre), half, id, false, seed + k, cell, albedo);
+  };
+  const Vec3<double> dark(0.25, 0.25, 0.28), screen(0.45, 0.55, 0.75), grey(0.6, 0.6, 0.62);
+  for (int k = 0; k < 2; ++k) {
+    const double x = k == 0 ? -0.55 : 0.55;
+    const Mat3<double> R = rot_z(k == 0 ? 0.25 : -0.25);  // turned towards the desk's middle
+    const auto id = static_cast<std::uint16_t>(SceneInstance::kMonitorA + k);
+    box(R, {x, 0.22, top + 0.38}, {0.28, 0.025, 0.19}, id, 10u + k, 0.05, screen);  // screen
+    box(I, {x, 0.24, top + 0.1}, {0.04, 0.03, 0.1}, id, 12u + k, 0.05, dark);      // stand
+    box(I, {x, 0.22, top + 0.01}, {0.12, 0.09, 0.01}, id, 14u + k, 0.05, dark);    // foot
+    box(R, {x, -0.12, top + 0.016}, {0.23, 0.08, 0.016}, static_cast<std::uint16_t>(SceneInstance::kKeyboardA + k),
+        16u + k, 0.02, grey);
+    box(I, {x + 0.34, -0.12, top + 0.022}, {0.04, 0.06, 0.022}, static_cast<std::uint16_t>(SceneInstance::kMouseA + k),
+        18u + k, 0.02, dark);
+  }
+  box(I, {1.05, 0.05, top + 0.13}, {0.04, 0.04, 0.13}, SceneInstance::kBottle, 20u, 0.03, {0.4, 0.7, 0.5});
+  box(I, {0.1, 0.0, top + 0.055}, {0.045, 0.045, 0.055}, SceneInstance::kCup, 21u, 0.02, {0.9, 0.9, 0.85});
+  box(rot_z(0.4), {-1.05, -0.05, top + 0.025}, {0.12, 0.16, 0.025}, SceneInstance::kBook, 22u, 0.03, {0.8, 0.3, 0.3});
+  // Laptop: base on the desk, lid open at 110 degrees.
+  box(I, {-0.05, 0.12, top + 0.01}, {0.17, 0.12, 0.01}, SceneInstance::kLaptop, 23u, 0.03, grey);
+  box(rot_x(-0.35), {-0.05, 0.27, top + 0.12}, {0.17, 0.01, 0.115}, SceneInstance::kLaptop, 24u, 0.03, dark);
+}
+
 inline double smoothstep(double x) {
   x = x < 0 ? 0 : (x > 1 ? 1 : x);
   return x * x * (3.0 - 2.0 * x);
@@ -253,12 +414,34 @@ inline void build_scene(double t, double frame_dt, std::uint64_t seed, const Act
     detail::add_chair(sink, pushed_chair_pose(t, options), SceneInstance::kPushedChair,
                       chair_moving_near(t, frame_dt, options), tex + 400);
   }
-  const detail::Clothes clothes[2] = {{{0.9, 0.4, 0.35}, {0.35, 0.4, 0.75}, {0.9, 0.75, 0.6}, tex + 500},
-                                      {{0.4, 0.8, 0.45}, {0.55, 0.5, 0.45}, {0.8, 0.65, 0.5}, tex + 600}};
-  for (int w = 0; w < options.walking_people && w < 2; ++w) {
+  const detail::Clothes clothes[4] = {{{0.9, 0.4, 0.35}, {0.35, 0.4, 0.75}, {0.9, 0.75, 0.6}, tex + 500},
+                                      {{0.4, 0.8, 0.45}, {0.55, 0.5, 0.45}, {0.8, 0.65, 0.5}, tex + 600},
+                                      {{0.85, 0.8, 0.35}, {0.3, 0.3, 0.35}, {0.7, 0.55, 0.45}, tex + 700},
+                                      {{0.6, 0.45, 0.8}, {0.5, 0.35, 0.3}, {0.95, 0.8, 0.7}, tex + 800}};
+  for (int w = 0; w < options.walking_people && w < 4; ++w) {
     double gait = 0;
     const Rigid3<double> pose = walker_pose(t, w, options, seed, &gait);
-    detail::add_walker(sink, pose, gait, static_cast<std::uint16_t>(SceneInstance::kWalkerA + w), clothes[w]);
+    detail::add_walker(sink, pose, gait, SceneInstance::walker(w), clothes[w]);
+  }
+  if (options.desk_people > 0 || options.desk_clutter) {
+    // Desk across the view 2.1 m in front of the rest pose, top at 0.73 m; its people sit in front
+    // of it, turned towards each other and the desk.
+    const Rigid3<double> world_from_desk = make_pose(I, {0.05, 2.05, 0.0});
+    constexpr double kTop = 0.73;
+    sink.add(PrimitiveShape::Box, world_from_desk * make_pose(I, {0, 0, 0.5 * kTop}), {1.3, 0.35, 0.5 * kTop}, kBg,
+             false, tex + 900, 0.07, {0.75, 0.7, 0.6});
+    if (options.desk_clutter) detail::add_desk_clutter(sink, world_from_desk, kTop, tex + 1000);
+    const detail::Clothes desk_clothes[2] = {{{0.3, 0.35, 0.6}, {0.25, 0.25, 0.3}, {0.85, 0.7, 0.55}, tex + 1100},
+                                             {{0.8, 0.75, 0.7}, {0.35, 0.3, 0.25}, {0.75, 0.6, 0.5}, tex + 1200}};
+    const Rigid3<double> seats[2] = {make_pose(detail::rot_z(0.55), {-0.75, 1.15, 0.0}),
+                                     make_pose(detail::rot_z(3.141592653589793 - 0.75), {0.6, 1.25, 0.0})};
+    for (int k = 0; k < options.desk_people && k < 2; ++k) {
+      const double phase = 2.3 * k + 0.37 * static_cast<double>(seed % 13);
+      const detail::DeskMotion m = detail::desk_motion(t, frame_dt, phase, options.desk_motion_scale);
+      detail::add_desk_person(sink, seats[k], m, static_cast<std::uint16_t>(SceneInstance::kDeskPersonA + k),
+                              static_cast<std::uint16_t>(SceneInstance::kDeskChairA + k), desk_clothes[k],
+                              tex + 1300 + 100 * static_cast<std::uint32_t>(k));
+    }
   }
 }
 

@@ -1,24 +1,33 @@
 /// @file trajectory.hpp
 /// Camera trajectories of the synthetic scene, shaped like TUM RGB-D fr3 walking_{static,xyz,rpy,
-/// halfsphere}: smooth sums of sines (no paper equation; amplitudes from the TUM sequence descriptions).
+/// halfsphere}: smooth sums of sines (no paper equation; amplitudes from the TUM sequence descriptions),
+/// or a recorded TUM ground truth (Sturm et al. 2012) re-anchored at the rest pose and resampled.
 #pragma once
 
 #include "dyncull/core/types.hpp"
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace dyncull::sim {
 
-enum class CameraMotion { Static, Xyz, Rpy, Halfsphere };
+/// Recorded: the camera follows TrajectoryOptions::recorded_* (a real hand-held trajectory).
+enum class CameraMotion { Static, Xyz, Rpy, Halfsphere, Recorded };
 
-/// Stable lower-case name ("static", "xyz", "rpy", "halfsphere").
+/// Stable lower-case name ("static", "xyz", "rpy", "halfsphere", "recorded").
 constexpr const char* to_string(CameraMotion motion) noexcept {
   switch (motion) {
     case CameraMotion::Static: return "static";
     case CameraMotion::Xyz: return "xyz";
     case CameraMotion::Rpy: return "rpy";
     case CameraMotion::Halfsphere: return "halfsphere";
+    case CameraMotion::Recorded: return "recorded";
   }
   return "unknown";
 }
@@ -36,6 +45,44 @@ struct TrajectoryOptions {
   double halfsphere_radius_m = 0.5;           ///< Halfsphere: ~1 m diameter
   double halfsphere_azimuth_deg = 70.0;       ///< Halfsphere: azimuth swing (< 90 keeps one hemisphere)
   double halfsphere_elevation_deg = 35.0;     ///< Halfsphere: elevation swing
+  /// Recorded: stamps (seconds, strictly increasing) and world_from_cam poses of a real trajectory,
+  /// e.g. a TUM groundtruth.txt read by the caller with eval::read_tum_trajectory. The pose at
+  /// recorded_start_s becomes the rest pose (eye_m looking at target_m); later frames move relative
+  /// to it exactly as the recording does, interpolated at the frame times (slerp / linear). Past the
+  /// recording's end the camera holds its last pose.
+  std::vector<double> recorded_stamps_s;
+  std::vector<Rigid3<double>> recorded_poses;
+  double recorded_start_s = 0.0;              ///< Recorded: seconds after the first stamp where frame 0 starts
+
+  /// Ok-ness of the recorded trajectory: true when it is usable (or empty and not needed); otherwise
+  /// false with a reason naming the field and index. `required` = the motion is Recorded.
+  bool validate_recorded(bool required, std::string* reason = nullptr) const {
+    auto bad = [&](const std::string& why) {
+      if (reason) *reason = why;
+      return false;
+    };
+    const std::size_t n = recorded_stamps_s.size();
+    if (n != recorded_poses.size())
+      return bad("trajectory.recorded_stamps_s has " + std::to_string(n) + " stamps but trajectory.recorded_poses has " +
+                 std::to_string(recorded_poses.size()) + " poses");
+    if (n == 0) return required ? bad("trajectory.recorded_poses is empty but the motion is recorded") : true;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!std::isfinite(recorded_stamps_s[k]))
+        return bad("trajectory.recorded_stamps_s[" + std::to_string(k) + "] is not finite");
+      if (k > 0 && !(recorded_stamps_s[k] > recorded_stamps_s[k - 1]))
+        return bad("trajectory.recorded_stamps_s[" + std::to_string(k) + "] is not after the previous stamp");
+      const Rigid3<double>& p = recorded_poses[k];
+      if (!p.R.allFinite() || !p.t.allFinite())
+        return bad("trajectory.recorded_poses[" + std::to_string(k) + "] is not finite");
+      // 1e-6: a quaternion read from 4-decimal text and normalised is orthonormal to ~1e-15.
+      if ((p.R.transpose() * p.R - Mat3<double>::Identity()).cwiseAbs().maxCoeff() > 1e-6 || p.R.determinant() < 0)
+        return bad("trajectory.recorded_poses[" + std::to_string(k) + "] has a rotation that is not orthonormal");
+    }
+    if (!std::isfinite(recorded_start_s) || recorded_start_s < 0 ||
+        recorded_start_s > recorded_stamps_s.back() - recorded_stamps_s.front())
+      return bad("trajectory.recorded_start_s must lie within the recording (0 to its duration)");
+    return true;
+  }
 };
 
 namespace detail {
@@ -71,10 +118,27 @@ inline Mat3<double> camera_rotation(double yaw, double pitch, double roll) {
       .toRotationMatrix();
 }
 
+/// Recorded world_from_cam at `stamp` (recording's clock): slerp of rotation and linear translation
+/// between the bracketing samples, clamped to the first/last pose outside. Assumes a valid recording.
+inline Rigid3<double> recorded_pose_at(const std::vector<double>& stamps, const std::vector<Rigid3<double>>& poses,
+                                       double stamp) {
+  if (stamp <= stamps.front()) return poses.front();
+  if (stamp >= stamps.back()) return poses.back();
+  const auto hi = static_cast<std::size_t>(std::upper_bound(stamps.begin(), stamps.end(), stamp) - stamps.begin());
+  const std::size_t lo = hi - 1;
+  const double s = (stamp - stamps[lo]) / (stamps[hi] - stamps[lo]);
+  const Eigen::Quaterniond q0(poses[lo].R), q1(poses[hi].R);
+  Rigid3<double> out;
+  out.R = q0.slerp(s, q1).normalized().toRotationMatrix();
+  out.t = (1.0 - s) * poses[lo].t + s * poses[hi].t;
+  return out;
+}
+
 }  // namespace detail
 
 /// Ground-truth world_from_cam at time t seconds from the start (TUM convention: camera x right,
 /// y down, z forward). Periods are below 10 s so a 300-frame sequence sweeps the full range.
+/// Recorded with an unusable recording (see TrajectoryOptions::validate_recorded) gives the rest pose.
 inline Rigid3<double> camera_pose(CameraMotion motion, double t, std::uint64_t seed,
                                   const TrajectoryOptions& options = {}) {
   constexpr double kTwoPi = 6.283185307179586;
@@ -114,6 +178,15 @@ inline Rigid3<double> camera_pose(CameraMotion motion, double t, std::uint64_t s
       const double e = options.halfsphere_elevation_deg * kDeg * wave(1, 5.9);
       const Vec3<double> dir = std::cos(e) * (std::sin(a) * right - std::cos(a) * forward) + std::sin(e) * up;
       return detail::look_at(centre + r * dir, options.target_m);
+    }
+    case CameraMotion::Recorded: {
+      if (!options.validate_recorded(true)) return world_from_rest;
+      const std::vector<double>& stamps = options.recorded_stamps_s;
+      const double t0 = stamps.front() + options.recorded_start_s;
+      const Rigid3<double> rec_start = detail::recorded_pose_at(stamps, options.recorded_poses, t0);
+      const Rigid3<double> rec_now = detail::recorded_pose_at(stamps, options.recorded_poses, t0 + t);
+      rest_from_cam = rec_start.inverse() * rec_now;
+      break;
     }
   }
   return world_from_rest * rest_from_cam;
