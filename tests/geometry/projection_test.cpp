@@ -8,6 +8,7 @@
 
 #include <limits>
 #include <map>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -113,6 +114,155 @@ TYPED_TEST(ProjectionTest, DepthToPointsBadInput) {
   EXPECT_TRUE(e.ok());
   EXPECT_TRUE(e.points.empty());
   EXPECT_EQ(e.num_missing, 48u);
+}
+
+TYPED_TEST(ProjectionTest, ProjectionAtInfinityIsNotValid) {
+  using T = TypeParam;
+  const PinholeCamera<T> cam = PinholeCamera<T>::tum_fr3();
+  // Just in front of the camera (z -> 0+) or far off-axis: x / z overflows, the pixel is not finite.
+  const T tiny = std::numeric_limits<T>::denorm_min();
+  const T big = std::numeric_limits<T>::max() / T(4);
+  const std::vector<Vec3<T>> world = {Vec3<T>(T(1), T(0.5), tiny), Vec3<T>(big, T(0), T(0.5)),
+                                      Vec3<T>(T(0), -big, T(1)), Vec3<T>(T(0.1), T(0.2), T(2))};
+  std::vector<Vec2<T>> px(world.size());
+  std::vector<std::uint8_t> valid(world.size(), 7);
+  std::vector<T> z(world.size());
+  const std::size_t n = dyncull::project_points(cam, Rigid3<T>{}, world, px.data(), valid.data(), z.data());
+  EXPECT_EQ(n, 1u);
+  for (std::size_t i = 0; i < world.size(); ++i) {
+    EXPECT_EQ(valid[i], i == 3 ? 1 : 0) << i;
+    EXPECT_EQ(px[i].allFinite(), i == 3) << i;
+  }
+  // Back-projection with a degenerate ray (tiny fx: 1 / fx is finite, (u - cx) z / fx is not) does not
+  // count an infinite point as finite.
+  PinholeCamera<T> thin = cam;
+  thin.fx = T(16) / std::numeric_limits<T>::max();
+  const std::vector<Vec2<T>> pix = {Vec2<T>(T(600), T(10)), Vec2<T>(thin.cx, T(10))};
+  const std::vector<T> depth = {T(3), T(3)};
+  std::vector<Vec3<T>> back(2);
+  EXPECT_EQ(dyncull::backproject_points(thin, pix, depth.data(), back.data()), 1u);
+  EXPECT_FALSE(back[0].allFinite());
+  EXPECT_TRUE(back[1].allFinite());
+}
+
+TYPED_TEST(ProjectionTest, DepthToPointsRejectsImagesBeyondThirtyTwoBitPixelIndices) {
+  using T = TypeParam;
+  // 70000 x 66000 pixels (4.6e9 > 2^32): the pixel index of the last rows would wrap. The data pointer
+  // is never read when the call rejects the size, so a one-row buffer stands in for the image.
+  const int w = 70000, h = 66000;
+  std::vector<std::uint16_t> row(static_cast<std::size_t>(w), 5000);
+  const auto view = dyncull::tum_depth_view(row.data(), w, h);
+  const PinholeCamera<T> cam{T(500), T(500), T(w / 2), T(h / 2), w, h};
+  const auto cloud = dyncull::depth_to_points(view, cam, dyncull::ConstMaskView{}, 1000);
+  EXPECT_EQ(cloud.status, Status::InvalidInput);
+  EXPECT_NE(cloud.reason.find("2^32"), std::string::npos) << cloud.reason;
+  EXPECT_TRUE(cloud.points.empty());
+}
+
+TYPED_TEST(ProjectionTest, DepthToPointsNeverReturnsNonFinitePoints) {
+  using T = TypeParam;
+  // fx so small that x / z overflows T at the image border: the camera cannot give finite rays.
+  std::vector<float> dm(48, 2.f);
+  const dyncull::DepthView<float> view{dm.data(), 8, 6};
+  PinholeCamera<T> cam{std::numeric_limits<T>::denorm_min(), T(400), T(3.5), T(2.5), 8, 6};
+  const auto bad = dyncull::depth_to_points(view, cam);
+  EXPECT_EQ(bad.status, Status::InvalidInput);
+  EXPECT_NE(bad.reason.find("fx"), std::string::npos) << bad.reason;
+  // Finite rays, but a huge (accepted: max_m is 1e30) depth times the ray overflows T: that pixel
+  // counts as missing instead of giving an infinite point.
+  cam.fx = std::is_same<T, float>::value ? T(1e-15) : T(1e-300);
+  dm[5] = 1e30f;
+  const auto cloud = dyncull::depth_to_points(view, cam);
+  ASSERT_TRUE(cloud.ok()) << cloud.reason;
+  for (const auto& p : cloud.points) EXPECT_TRUE(p.allFinite());
+  EXPECT_GE(cloud.num_missing, 1u);
+  EXPECT_EQ(cloud.points.size() + cloud.num_missing, 48u);
+}
+
+// A value for property tests: mostly ordinary, sometimes NaN, +-Inf, huge, tiny or zero.
+template <class T>
+T wild(Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.03) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.05) return std::numeric_limits<T>::infinity();
+  if (u < 0.07) return -std::numeric_limits<T>::infinity();
+  if (u < 0.10) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.12) return std::numeric_limits<T>::denorm_min();
+  if (u < 0.14) return T(0);
+  return T(rng.uniform(lo, hi));
+}
+
+TYPED_TEST(ProjectionTest, PropertyOutputsAreFiniteOrFlagged) {
+  using T = TypeParam;
+  Random rng(77);
+  for (int trial = 0; trial < 300; ++trial) {
+    PinholeCamera<T> cam{wild<T>(rng, 1, 1000), wild<T>(rng, 1, 1000), wild<T>(rng, -50, 700), wild<T>(rng, -50, 500),
+                         1 + static_cast<int>(rng.index(40)), 1 + static_cast<int>(rng.index(30))};
+    // project / backproject: a point counted valid has a finite pixel (finite camera point).
+    const std::size_t n = rng.index(40);
+    std::vector<Vec3<T>> world(n);
+    std::vector<Vec2<T>> pix(n);
+    std::vector<T> depth(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      world[i] = Vec3<T>(wild<T>(rng, -5, 5), wild<T>(rng, -5, 5), wild<T>(rng, -1, 8));
+      pix[i] = Vec2<T>(wild<T>(rng, -10, 700), wild<T>(rng, -10, 500));
+      depth[i] = wild<T>(rng, -1, 10);
+    }
+    std::vector<Vec2<T>> px(n);
+    std::vector<std::uint8_t> valid(n);
+    std::vector<Vec3<T>> back(n);
+    const std::size_t nv = dyncull::project_points(cam, Rigid3<T>{}, world, px.data(), valid.data());
+    const std::size_t nb = dyncull::backproject_points(cam, pix, depth.data(), back.data());
+    std::size_t count_v = 0, count_b = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      count_v += valid[i];
+      EXPECT_EQ(valid[i] != 0, px[i].allFinite()) << trial << " " << i;
+      count_b += back[i].allFinite();
+    }
+    EXPECT_EQ(nv, count_v);
+    EXPECT_EQ(nb, count_b);
+    // depth_to_points: non-Ok with a reason, or every point finite and every index in the image.
+    const int w = cam.width, h = cam.height;
+    std::vector<float> dm(static_cast<std::size_t>(w * h));
+    for (auto& d : dm) d = wild<float>(rng, 0, 12);
+    dyncull::DepthView<float> view{dm.data(), w, h};
+    if (rng.uniform() < 0.2) view.units_per_metre = wild<float>(rng, -2, 2);
+    if (rng.uniform() < 0.2) view.max_m = wild<float>(rng, 0, 1e30);
+    const int stride = rng.uniform() < 0.1 ? static_cast<int>(rng.index(3)) - 1 : 1 + static_cast<int>(rng.index(4));
+    const auto cloud = dyncull::depth_to_points(view, cam, dyncull::ConstMaskView{}, stride);
+    if (!cloud.ok()) {
+      EXPECT_EQ(cloud.status, Status::InvalidInput);
+      EXPECT_FALSE(cloud.reason.empty());
+      EXPECT_TRUE(cloud.points.empty());
+      continue;
+    }
+    ASSERT_EQ(cloud.points.size(), cloud.pixel_index.size());
+    for (std::size_t k = 0; k < cloud.points.size(); ++k) {
+      EXPECT_TRUE(cloud.points[k].allFinite()) << "trial " << trial;
+      EXPECT_LT(cloud.pixel_index[k], static_cast<std::uint32_t>(w * h));
+    }
+    // Voxel downsampling of whatever came out, with a random voxel size.
+    std::vector<Vec3<T>> vox;
+    std::string why;
+    const T voxel = wild<T>(rng, 0.01, 1);
+    if (dyncull::voxel_downsample(back, voxel, &vox, &why) != Status::Ok) {
+      EXPECT_FALSE(why.empty());
+    } else {
+      for (const auto& p : vox) EXPECT_TRUE(p.allFinite());
+    }
+  }
+}
+
+TYPED_TEST(ProjectionTest, VoxelCentroidOfHugeCoordinatesStaysFinite) {
+  using T = TypeParam;
+  // Two points near the largest finite value in one voxel: their sum overflows, their mean does not.
+  const T big = std::numeric_limits<T>::max() * T(0.75);
+  const std::vector<Vec3<T>> pts = {Vec3<T>(big, -big, big), Vec3<T>(big, -big, big)};
+  std::vector<Vec3<T>> out;
+  ASSERT_EQ(dyncull::voxel_downsample(pts, T(1), &out), Status::Ok);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(out[0].allFinite()) << out[0].transpose();
+  EXPECT_EQ(out[0].x(), big);
 }
 
 TYPED_TEST(ProjectionTest, VoxelDownsampleMatchesOracle) {

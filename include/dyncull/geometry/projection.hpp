@@ -21,8 +21,9 @@
 
 namespace dyncull {
 
-/// Projects world points through cam_from_world into pixels[0, n). Points with camera depth z <= 0 or
-/// non-finite coordinates get NaN pixels and valid[i] = 0 (valid and depth_m may be null).
+/// Projects world points through cam_from_world into pixels[0, n). Points with camera depth z <= 0,
+/// non-finite coordinates or a pixel that is not finite (z -> 0+ or far off-axis: x / z overflows) get
+/// NaN pixels and valid[i] = 0 (valid and depth_m may be null).
 /// Returns the number of valid projections. pixels must hold world.size() elements.
 template <class T, class Points3>
 std::size_t project_points(const PinholeCamera<T>& camera, const Rigid3<T>& cam_from_world, const Points3& world,
@@ -37,9 +38,11 @@ std::size_t project_points(const PinholeCamera<T>& camera, const Rigid3<T>& cam_
   std::size_t count = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3<T> p = R * to_vec3<T>(world[i]) + t;
-    const bool ok = p(2) > T(0) && p.allFinite();
     const T iz = T(1) / p(2);
-    pixels[i] = ok ? Vec2<T>(fx * p(0) * iz + cx, fy * p(1) * iz + cy) : Vec2<T>(nan, nan);
+    const Vec2<T> q(fx * p(0) * iz + cx, fy * p(1) * iz + cy);
+    // The pixel's own finiteness also covers a non-finite p: NaN / Inf propagate into q.
+    const bool ok = p(2) > T(0) && std::isfinite(p(2)) && std::isfinite(q(0)) && std::isfinite(q(1));
+    pixels[i] = ok ? q : Vec2<T>(nan, nan);
     if (valid) valid[i] = static_cast<std::uint8_t>(ok);
     if (depth_m) depth_m[i] = p(2);
     count += ok;
@@ -48,7 +51,8 @@ std::size_t project_points(const PinholeCamera<T>& camera, const Rigid3<T>& cam_
 }
 
 /// Back-projects pixels at depths (metres along the optical axis) into camera-frame points (eq. 6:
-/// x = (u - cx) z / fx, y = (v - cy) z / fy). Depth <= 0 or non-finite gives a NaN point.
+/// x = (u - cx) z / fx, y = (v - cy) z / fy). Depth <= 0, non-finite input or a point that overflows
+/// (degenerate intrinsics) gives a NaN point.
 /// Returns the number of finite points. out must hold pixels.size() elements.
 template <class T, class Points2>
 std::size_t backproject_points(const PinholeCamera<T>& camera, const Points2& pixels, const T* depths_m,
@@ -61,8 +65,9 @@ std::size_t backproject_points(const PinholeCamera<T>& camera, const Points2& pi
   for (std::size_t i = 0; i < n; ++i) {
     const T z = depths_m[i];
     const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
-    const bool ok = z > T(0) && std::isfinite(z) && std::isfinite(u) && std::isfinite(v);
-    out[i] = ok ? Vec3<T>((u - camera.cx) * z * ifx, (v - camera.cy) * z * ify, z) : Vec3<T>(nan, nan, nan);
+    const Vec3<T> p((u - camera.cx) * z * ifx, (v - camera.cy) * z * ify, z);
+    const bool ok = z > T(0) && p.allFinite();  // NaN / Inf in u, v or z propagate into p
+    out[i] = ok ? p : Vec3<T>(nan, nan, nan);
     count += ok;
   }
   return count;
@@ -83,8 +88,11 @@ struct DepthCloud {
 /// Depth image -> camera-frame points for every stride-th pixel in u and v that has a measurement
 /// (DepthView::depth_m() > 0) and is not set in `exclude` (dynamic pixels; empty = keep all).
 /// Depths pass through DepthView::to_metres(), which is float: double clouds carry float-precision
-/// depth (1e-7 relative, far below any sensor's noise). Reuses out's buffers. InvalidInput for an empty depth view, stride < 1, an invalid camera, or an
-/// exclude mask / camera whose size differs from the depth image.
+/// depth (1e-7 relative, far below any sensor's noise). Reuses out's buffers. InvalidInput for an empty
+/// or invalid depth view (DepthView::validate), stride < 1, an invalid camera or one whose rays (u - cx) / fx
+/// overflow T, an exclude mask / camera whose size differs from the depth image, or an image of more than
+/// 2^32 pixels (pixel_index is 32-bit). A depth whose point would overflow T counts as missing: every
+/// returned point is finite.
 template <class T, class Raw>
 Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& camera, ConstMaskView exclude,
                        int stride, DepthCloud<T>* out) {
@@ -100,13 +108,20 @@ Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& came
     return out->status;
   };
   if (depth.empty()) return fail("empty depth image");
+  {
+    std::string why;
+    if (depth.validate(&why) != Status::Ok) return fail(why);
+  }
   if (stride < 1) return fail("stride must be >= 1");
-  if (!camera.valid()) return fail("invalid camera intrinsics");
+  if (!camera.valid() || !std::isfinite(camera.fx) || !std::isfinite(camera.fy))
+    return fail("invalid camera intrinsics (fx, fy must be positive and finite, cx, cy finite)");
   if (camera.width != depth.width || camera.height != depth.height)
     return fail("camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                 " but the depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height));
   if (!exclude.empty() && (exclude.width != depth.width || exclude.height != depth.height))
     return fail("exclude mask size differs from the depth image");
+  if (static_cast<std::uint64_t>(depth.width) * static_cast<std::uint64_t>(depth.height) > (std::uint64_t{1} << 32))
+    return fail("the image has more than 2^32 pixels, beyond the 32-bit pixel_index");
   const int w = depth.width, h = depth.height;
   const std::size_t cols = static_cast<std::size_t>((w + stride - 1) / stride);
   const std::size_t rows = static_cast<std::size_t>((h + stride - 1) / stride);
@@ -117,11 +132,25 @@ Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& came
   Vec3<T>* P = out->points.data();
   std::uint32_t* I = out->pixel_index.data();
   std::vector<T> x_over_z(cols);
-  for (std::size_t c = 0; c < cols; ++c) x_over_z[c] = (T(c * static_cast<std::size_t>(stride)) - camera.cx) / camera.fx;
+  T max_ray = T(0);
+  for (std::size_t c = 0; c < cols; ++c) {
+    x_over_z[c] = (T(c * static_cast<std::size_t>(stride)) - camera.cx) / camera.fx;
+    max_ray = std::max(max_ray, std::abs(x_over_z[c]));
+  }
+  // The rows' rays are largest at the first and last sampled row.
+  const T y_first = (T(0) - camera.cy) / camera.fy;
+  const T y_last = (T((rows - 1) * static_cast<std::size_t>(stride)) - camera.cy) / camera.fy;
+  if (!std::isfinite(max_ray)) return fail("camera fx so small that (u - cx) / fx overflows");
+  if (!std::isfinite(y_first) || !std::isfinite(y_last)) return fail("camera fy so small that (v - cy) / fy overflows");
+  max_ray = std::max({max_ray, std::abs(y_first), std::abs(y_last), T(1)});
   // Multiply by the inverse scale: equal to DepthView::to_metres() up to one ulp. NaN fails every
   // comparison and +inf fails d <= max_m, so the range test also rejects non-finite raw values.
+  // Depths whose point would overflow T (ray * z > max) are capped into the same test: no per-pixel cost.
   const float inv_units = 1.f / depth.units_per_metre;
-  const float min_m = depth.min_m, max_m = depth.max_m;
+  const double z_cap = static_cast<double>(std::numeric_limits<T>::max()) / static_cast<double>(max_ray);
+  const float min_m = depth.min_m;
+  const float max_m = static_cast<double>(depth.max_m) < z_cap ? depth.max_m : static_cast<float>(std::min(
+      z_cap * (1.0 - 1e-6), static_cast<double>(std::numeric_limits<float>::max())));
   const bool use_mask = !exclude.empty();
   std::size_t k = 0, excluded = 0, missing = 0;
   for (int v = 0; v < h; v += stride) {
@@ -210,7 +239,14 @@ class VoxelDownsampler {
         sum += to_vec3<T>(in[keys_[b].second]).template cast<double>();
         ++b;
       }
-      out->push_back((sum / static_cast<double>(b - a)).template cast<T>());
+      Vec3<double> mean = sum / static_cast<double>(b - a);
+      if (!mean.allFinite()) {  // the sum of coordinates near the double limit overflowed: sum offsets
+        const Vec3<double> base = to_vec3<T>(in[keys_[a].second]).template cast<double>();
+        Vec3<double> off = Vec3<double>::Zero();
+        for (std::size_t k = a; k < b; ++k) off += to_vec3<T>(in[keys_[k].second]).template cast<double>() - base;
+        mean = base + off / static_cast<double>(b - a);
+      }
+      out->push_back(mean.template cast<T>());
       a = b;
     }
     return Status::Ok;
