@@ -4,6 +4,7 @@
 #pragma once
 
 #include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -157,8 +158,7 @@ constexpr const char* scalar_name() {
 /// Whether a double fits T's finite range (non-finite values pass: they are reported as such).
 template <class T>
 bool fits_scalar(double v) {
-  return !(v > static_cast<double>(std::numeric_limits<T>::max()) ||
-           v < -static_cast<double>(std::numeric_limits<T>::max()));
+  return !std::isfinite(v) || std::abs(v) <= static_cast<double>(std::numeric_limits<T>::max());
 }
 
 }  // namespace dyncull::text

@@ -6,17 +6,19 @@
 ///   Box<T> yolo_to_pixel_box(const YoloBox<T>&, int width, int height, const Letterbox<T>& = {});
 ///   DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>&, int w, int h, const DetectionOptions<T>&);
 ///   DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& pixel_boxes, int w, int h, const DetectionOptions<T>&);
-///   YoloParseResult<T> parse_yolo_lines(const std::string& text);   // "class cx cy w h [conf]" per line
+///   YoloParseResult<T> parse_yolo_lines(std::string_view text, const std::string& source = "");  // "class cx cy w h [conf]" per line
 #pragma once
 
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/status.hpp"
+#include "dyncull/core/text.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace dyncull {
@@ -213,85 +215,112 @@ DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, in
   return r;
 }
 
-/// One unparseable line of a YOLO text file (1-based line number).
+/// One unparseable line of a YOLO text file (1-based line number; message without "source:line: ").
 struct YoloParseError {
   int line = 0;
   std::string message;
 };
 
+/// Bad lines listed in YoloParseResult::errors; the rest are only counted.
+constexpr std::size_t kYoloMaxListedErrors = 16;
+
 template <class T>
 struct YoloParseResult {
   Status status = Status::Ok;
-  std::string reason;
+  std::string reason;  ///< "source:line: why (N bad lines)" of the first bad line ("line N: ..." without a source)
   bool ok() const { return status == Status::Ok; }
   std::vector<YoloBox<T>> boxes;  ///< every line that parsed, in file order
   std::vector<int> line_of_box;   ///< 1-based line number of each box
-  std::vector<YoloParseError> errors;
+  std::vector<YoloParseError> errors;  ///< the first kYoloMaxListedErrors bad lines
+  std::size_t num_bad_lines = 0;       ///< every bad line
 };
 
-/// Parses YOLO text ("class cx cy w h [conf]" per line; blank lines and '#' comments skipped).
-/// Bad lines are skipped and listed; status is ParseError when any line failed (the good boxes
-/// are still returned), with the first failing line in `reason`. Validity of the numbers
-/// (w > 0, finite) is left to convert_yolo_detections, which reports it per box.
+namespace detail {
+inline bool is_yolo_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+/// Why one YOLO line does not parse ("" when it does; then *box holds it).
 template <class T>
-YoloParseResult<T> parse_yolo_lines(const std::string& text) {
+std::string parse_yolo_line(std::string_view line, YoloBox<T>* box) {
+  if (line.size() > text::kMaxLineChars)
+    return "line is " + std::to_string(line.size()) + " bytes long (limit " + std::to_string(text::kMaxLineChars) + ")";
+  static const char* const kNames[6] = {"class", "cx", "cy", "w", "h", "conf"};
+  std::string_view tokens[6];
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < line.size();) {
+    while (k < line.size() && is_yolo_space(line[k])) ++k;
+    if (k == line.size()) break;
+    const std::size_t start = k;
+    while (k < line.size() && !is_yolo_space(line[k])) ++k;
+    if (n < 6) tokens[n] = line.substr(start, k - start);
+    ++n;
+  }
+  if (n < 5 || n > 6) return "expected 5 or 6 fields (class cx cy w h [conf]), got " + std::to_string(n);
+  double v[6] = {0, 0, 0, 0, 0, 1};
+  for (std::size_t c = 0; c < n; ++c) {
+    const text::NumberStatus st = text::parse_python_float(tokens[c], &v[c]);
+    if (st == text::NumberStatus::TooLong)
+      return std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is longer than " +
+             std::to_string(text::kMaxNumberChars) + " characters";
+    if (st != text::NumberStatus::Ok) return std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is not a number";
+    // A finite double beyond T's range would become inf through an undefined cast.
+    if (c > 0 && !text::fits_scalar<T>(v[c]))
+      return std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is out of range for " + text::scalar_name<T>();
+  }
+  if (!(v[0] == std::floor(v[0]) && v[0] >= 0 && v[0] <= 1e6))
+    return "class id " + text::quote_token(tokens[0]) + " must be an integer in [0, 1000000]";
+  box->class_id = static_cast<int>(v[0]);
+  box->cx = T(v[1]);
+  box->cy = T(v[2]);
+  box->w = T(v[3]);
+  box->h = T(v[4]);
+  box->confidence = T(v[5]);
+  return {};
+}
+}  // namespace detail
+
+/// Parses YOLO text ("class cx cy w h [conf]" per line, space or tab separated; blank lines and '#'
+/// comments skipped). Numbers follow Python's float() whatever the C locale ("0,5" is an error, 1e400
+/// is inf). Bad lines are skipped, counted and the first kYoloMaxListedErrors listed; status is
+/// ParseError when any line failed (the good boxes are still returned), `reason` names the first as
+/// "source:line: why". Bounded: a line over text::kMaxLineChars or a number over text::kMaxNumberChars
+/// characters is a bad line, and reasons quote at most 32 escaped characters of a token. A value
+/// outside T's finite range (1e39 for float) is a bad line; validity of the numbers (w > 0, finite)
+/// is left to convert_yolo_detections, which reports it per box.
+template <class T>
+YoloParseResult<T> parse_yolo_lines(std::string_view text, const std::string& source = "") {
   YoloParseResult<T> r;
   std::size_t pos = 0;
   int line_no = 0;
   while (pos <= text.size()) {
     std::size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(pos, end - pos);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view line = text.substr(pos, end - pos);
     ++line_no;
     pos = end + 1;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') {
+    std::size_t first = 0;
+    while (first < line.size() && detail::is_yolo_space(line[first])) ++first;
+    if (first == line.size() || line[first] == '#') {
       if (end == text.size()) break;
       continue;
     }
-    double v[6];
-    int n = 0;
-    const char* p = line.c_str();
-    bool bad = false;
-    while (true) {
-      while (*p == ' ' || *p == '\t') ++p;
-      if (*p == '\0') break;
-      if (n == 6) {
-        bad = true;
-        break;
-      }
-      char* q = nullptr;
-      v[n] = std::strtod(p, &q);
-      if (q == p || (*q != '\0' && *q != ' ' && *q != '\t')) {
-        bad = true;
-        break;
-      }
-      ++n;
-      p = q;
-    }
-    if (bad || n < 5) {
-      r.errors.push_back(YoloParseError{line_no, bad ? "expected numbers: class cx cy w h [conf]"
-                                                     : "expected 5 or 6 fields, got " + std::to_string(n)});
-    } else if (v[0] != std::floor(v[0]) || v[0] < 0 || v[0] > 1e6) {
-      r.errors.push_back(YoloParseError{line_no, "class id must be a non-negative integer"});
-    } else {
-      YoloBox<T> b;
-      b.class_id = static_cast<int>(v[0]);
-      b.cx = T(v[1]);
-      b.cy = T(v[2]);
-      b.w = T(v[3]);
-      b.h = T(v[4]);
-      b.confidence = n == 6 ? T(v[5]) : T(1);
+    YoloBox<T> b;
+    std::string why = detail::parse_yolo_line(line, &b);
+    if (why.empty()) {
       r.boxes.push_back(b);
       r.line_of_box.push_back(line_no);
+    } else {
+      if (r.num_bad_lines == 0) {
+        r.reason = (source.empty() ? "line " + std::to_string(line_no) : source + ":" + std::to_string(line_no)) +
+                   ": " + why;
+      }
+      ++r.num_bad_lines;
+      if (r.errors.size() < kYoloMaxListedErrors) r.errors.push_back(YoloParseError{line_no, std::move(why)});
     }
     if (end == text.size()) break;
   }
-  if (!r.errors.empty()) {
+  if (r.num_bad_lines > 0) {
     r.status = Status::ParseError;
-    r.reason = "line " + std::to_string(r.errors.front().line) + ": " + r.errors.front().message + " (" +
-               std::to_string(r.errors.size()) + " bad line(s))";
+    r.reason += " (" + std::to_string(r.num_bad_lines) + (r.num_bad_lines == 1 ? " bad line)" : " bad lines)");
   }
   return r;
 }
