@@ -921,7 +921,8 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
       ++r.num_dynamic;
       continue;
     }
-    const long lu = std::lround(static_cast<double>(px)), lv = std::lround(static_cast<double>(py));
+    int lu = -1, lv = -1;  // outside every rect when the point is outside the image
+    pixel_of(static_cast<double>(px), static_cast<double>(py), depth.width, depth.height, &lu, &lv);
     bool inside_any = false;
     for (std::size_t b = 0; b < r.boxes.size(); ++b) {
       const DepthMaskBoxInfo& info = r.boxes[b];
@@ -933,7 +934,7 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
           r.reasons[i] = CullReason::DepthMask;
           r.box_index[i] = static_cast<std::int32_t>(b);
         }
-      } else if (detail::band_contains(depth, range, bands[b], info.rect, static_cast<int>(lu), static_cast<int>(lv))) {
+      } else if (detail::band_contains(depth, range, bands[b], info.rect, lu, lv)) {
         if (r.labels[i] != FeatureLabel::Dynamic) {
           r.labels[i] = FeatureLabel::Dynamic;
           r.reasons[i] = CullReason::DepthMask;

@@ -200,8 +200,10 @@ void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>
       ++r.num_large_parallax;
       continue;
     }
-    const int pu = static_cast<int>(std::lround(x.x())), pv = static_cast<int>(std::lround(x.y()));
-    const T measured = detail::closest_depth_in_window<Raw, T>(depth, pu, pv, options.search_radius_px, X_cur.z());
+    int pu = 0, pv = 0;
+    const T measured = pixel_of(x.x(), x.y(), depth.width, depth.height, &pu, &pv)
+                           ? detail::closest_depth_in_window<Raw, T>(depth, pu, pv, options.search_radius_px, X_cur.z())
+                           : T(0);
     r.measured_depth_m[i] = measured;
     if (!(measured > T(0))) {
       r.outcome[i] = MultiViewOutcome::NoMeasuredDepth;
@@ -255,8 +257,8 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
   const double units = static_cast<double>(depth.units_per_metre);
   for (std::size_t i = 0; i < result.labels.size(); ++i) {
     if (result.labels[i] != FeatureLabel::Dynamic) continue;
-    const int su = static_cast<int>(std::lround(result.projected[i].x()));
-    const int sv = static_cast<int>(std::lround(result.projected[i].y()));
+    int su = 0, sv = 0;
+    if (!pixel_of(result.projected[i].x(), result.projected[i].y(), w, h, &su, &sv)) continue;
     if (su < rc0 || sv < rr0 || su >= rc1 || sv >= rr1) continue;
     const std::size_t seed_idx = static_cast<std::size_t>(sv) * static_cast<std::size_t>(w) + static_cast<std::size_t>(su);
     if (m[seed_idx]) continue;  // already inside a grown region

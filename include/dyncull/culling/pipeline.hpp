@@ -283,11 +283,7 @@ inline bool is_regional_cull(CullReason r) {
 
 template <class T, class Keypoints>
 bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u, int* v) {
-  const T x = point_x<T>(kp[i]), y = point_y<T>(kp[i]);
-  if (!std::isfinite(x) || !std::isfinite(y)) return false;
-  *u = static_cast<int>(std::lround(x));
-  *v = static_cast<int>(std::lround(y));
-  return *u >= 0 && *v >= 0 && *u < w && *v < h;
+  return pixel_of(point_x<T>(kp[i]), point_y<T>(kp[i]), w, h, u, v);
 }
 
 /// PipelineOptions::low_override_by_depth: features the box rule sheltered (LowLevelOverride) that a

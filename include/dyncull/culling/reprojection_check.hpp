@@ -8,6 +8,7 @@
 
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -255,7 +256,8 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
     r.residual_px[i] = res;
     bool dyn = !(res <= limit);
     if (use_depth && pc.z() > T(0)) {
-      const float measured = depth.depth_m(static_cast<int>(std::lround(u)), static_cast<int>(std::lround(v)));
+      int pu = 0, pv = 0;
+      const float measured = pixel_of(u, v, depth.width, depth.height, &pu, &pv) ? depth.depth_m(pu, pv) : 0.f;
       if (measured > 0.f) {
         const T dz = static_cast<T>(measured) - pc.z();
         r.depth_residual_m[i] = dz;
