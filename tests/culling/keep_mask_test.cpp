@@ -79,6 +79,43 @@ TEST(KeepMask, MismatchedSizesTouchNothing) {
   EXPECT_TRUE(c.empty());
 }
 
+TEST(KeepMask, BadDescriptorViewsAreRefusedAndTouchNothing) {
+  const std::vector<std::uint8_t> keep = make_keep_mask(kLabels);
+  std::vector<int> ids = {0, 1, 2, 3, 4};
+  // Null data with rows: nothing to move rows through.
+  CompactResult r = compact_parallel(keep, ids, RowsView{nullptr, 32, 32, 5});
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("null"), std::string::npos) << r.reason;
+  EXPECT_EQ(ids.size(), 5u);
+  EXPECT_EQ(r.count, 5u);
+  EXPECT_EQ(r.removed, 0u);
+  // Rows longer than the stride overlap each other.
+  std::vector<std::uint8_t> desc(5 * 8, 7);
+  r = compact_parallel(keep, ids, RowsView{desc.data(), 16, 8, 5});
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("row_bytes"), std::string::npos) << r.reason;
+  EXPECT_EQ(ids.size(), 5u);
+  // Rows that would reach past the address space.
+  r = compact_parallel(keep, RowsView{desc.data(), 8, std::numeric_limits<std::size_t>::max() / 2, 5});
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  // Two views of the same rows, and the same vector twice: the second pass would read freed slots.
+  r = compact_parallel(keep, RowsView{desc.data(), 8, 8, 5}, RowsView{desc.data() + 4, 4, 8, 5});
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("overlap"), std::string::npos) << r.reason;
+  r = compact_parallel(keep, ids, ids);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_EQ(ids, (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(desc, std::vector<std::uint8_t>(5 * 8, 7));
+  // Null data is fine with no rows, and an empty frame compacts nothing.
+  EXPECT_TRUE(compact_parallel(std::vector<std::uint8_t>{}, RowsView{nullptr, 32, 32, 0}).ok());
+  // Ordinary views side by side in one buffer do not overlap.
+  std::vector<std::uint8_t> two(5 * 16, 1);
+  r = compact_parallel(keep, RowsView{two.data(), 8, 16, 5}, RowsView{two.data() + 8, 8, 16, 5});
+  EXPECT_FALSE(r.ok());  // interleaved rows share the same span of memory
+  std::vector<std::uint8_t> a(5 * 8, 1), b(5 * 8, 2);
+  EXPECT_TRUE(compact_parallel(keep, RowsView{a.data(), 8, 8, 5}, RowsView{b.data(), 8, 8, 5}, ids).ok());
+}
+
 template <class T>
 class RegionPredicate : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
@@ -115,6 +152,37 @@ TYPED_TEST(RegionPredicate, ObjectMaskAloneOrRefiningBoxes) {
   const DynamicRegionPredicate<T> refined(boxes, m.view(), T(1), 1, true);
   EXPECT_TRUE(refined(T(15), T(15)));
   EXPECT_FALSE(refined(T(25), T(25)));  // in the box, off the object's mask
+}
+
+// A mask lookup at x = 2^32 + 10 must not wrap to column 10 (or 0 in float): every pixel is set,
+// so any wrapped read would report the point inside.
+TYPED_TEST(RegionPredicate, MaskLookupBeyondTheIntRangeIsOutside) {
+  using T = TypeParam;
+  Mask m(64, 48, 255);
+  const DynamicRegionPredicate<T> inside(std::vector<Box<T>>{}, m.view());
+  const T beyond = T(4294967306.0);
+  EXPECT_TRUE(inside(T(10), T(10)));
+  EXPECT_FALSE(inside(beyond, T(10)));
+  EXPECT_FALSE(inside(T(10), beyond));
+  EXPECT_FALSE(inside(-beyond, T(10)));
+  EXPECT_FALSE(inside(T(1e30), T(10)));
+  EXPECT_FALSE(inside(T(63.6), T(10)));  // rounds to column 64, past the mask
+  EXPECT_TRUE(inside(T(63.4), T(47.4)));
+}
+
+TYPED_TEST(RegionPredicate, AbsurdPyramidsAreBounded) {
+  using T = TypeParam;
+  const std::vector<Box<T>> boxes = {{T(100), T(100), T(200), T(300)}};
+  // A huge level count must not allocate a table per level; levels past the table use pow().
+  const DynamicRegionPredicate<T> many(boxes, ConstMaskView{}, T(1.2), std::numeric_limits<int>::max());
+  const T s20 = std::pow(T(1.2), T(20));
+  EXPECT_TRUE(many(T(150) / s20, T(200) / s20, 20));
+  // Non-finite or non-positive scale factors fall back to 1.
+  for (const T f : {std::numeric_limits<T>::quiet_NaN(), std::numeric_limits<T>::infinity(), T(0), T(-2)}) {
+    const DynamicRegionPredicate<T> p(boxes, ConstMaskView{}, f, 8);
+    EXPECT_TRUE(p(T(150), T(200), 3)) << f;
+    EXPECT_FALSE(p(T(50), T(200), 3)) << f;
+  }
 }
 
 TEST(Rasterise, ConventionsAndObjectMasks) {

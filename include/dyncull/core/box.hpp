@@ -3,6 +3,7 @@
 /// coordinates, [x0, x1] x [y0, y1] inclusive; pixel (u, v) has its centre at (u, v).
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/types.hpp"
 
 #include <algorithm>

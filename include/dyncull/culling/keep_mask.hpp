@@ -13,6 +13,7 @@
 
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/mask.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/culling/labels.hpp"
 
@@ -66,6 +67,44 @@ namespace detail {
 inline std::size_t array_size(const RowsView& r) { return r.rows; }
 template <class V> std::size_t array_size(const std::vector<V>& v) { return v.size(); }
 
+/// Memory an argument of compact_parallel writes, as addresses [begin, end): a vector by its own
+/// object (two vector objects never share elements), a RowsView by the bytes its rows span.
+struct ByteSpan {
+  std::uintptr_t begin = 0, end = 0;
+};
+template <class V> ByteSpan byte_span(const std::vector<V>& v) {
+  const auto p = reinterpret_cast<std::uintptr_t>(&v);
+  return ByteSpan{p, p + sizeof(v)};
+}
+inline ByteSpan byte_span(const RowsView& r) {
+  if (r.data == nullptr || r.rows == 0 || r.row_bytes == 0) return ByteSpan{};
+  const auto p = reinterpret_cast<std::uintptr_t>(r.data);
+  return ByteSpan{p, p + (r.rows - 1) * r.stride() + r.row_bytes};  // bounded by rows_view_ok
+}
+
+/// A RowsView compaction can trust: rows reachable (non-null data), not overlapping each other, and
+/// the whole span addressable. Vectors always are.
+template <class V> bool rows_view_ok(const std::vector<V>&, std::size_t, std::string*) { return true; }
+inline bool rows_view_ok(const RowsView& r, std::size_t arg, std::string* reason) {
+  const std::string which = "argument " + std::to_string(arg + 1) + " (RowsView): ";
+  if (r.rows == 0 || r.row_bytes == 0) return true;  // nothing is moved
+  if (r.data == nullptr) {
+    *reason = which + "data is null but rows = " + std::to_string(r.rows);
+    return false;
+  }
+  if (r.row_bytes > r.stride()) {
+    *reason = which + "row_bytes " + std::to_string(r.row_bytes) + " exceeds stride_bytes " +
+              std::to_string(r.stride()) + ": rows would overlap";
+    return false;
+  }
+  const std::uintptr_t room = UINTPTR_MAX - reinterpret_cast<std::uintptr_t>(r.data);
+  if (r.row_bytes > room || (r.rows - 1) > (room - r.row_bytes) / r.stride()) {
+    *reason = which + "rows * stride_bytes reaches past the address space";
+    return false;
+  }
+  return true;
+}
+
 inline void compact_one(const std::vector<std::uint8_t>& keep, RowsView& r, std::size_t count) {
   const std::size_t stride = r.stride();
   std::size_t j = 0;
@@ -89,18 +128,41 @@ void compact_one(const std::vector<std::uint8_t>& keep, std::vector<V>& v, std::
 }  // namespace detail
 
 /// Compacts every array (std::vector of anything, or RowsView) in place, stably, keeping element i
-/// where keep[i] != 0. All arrays must have keep.size() elements; otherwise nothing is touched and
-/// status is InvalidInput. RowsView arguments may be temporaries: their rows field is not needed back.
+/// where keep[i] != 0. All arrays must have keep.size() elements, a RowsView with rows must have
+/// non-null data, row_bytes <= stride and a span inside the address space, and no two arguments may
+/// share memory (the same vector twice, or overlapping views); otherwise nothing is touched, status is
+/// InvalidInput, count = keep.size() and removed = 0. RowsView arguments may be temporaries: their
+/// rows field is not needed back.
 template <class... Arrays>
 CompactResult compact_parallel(const std::vector<std::uint8_t>& keep, Arrays&&... arrays) {
   CompactResult r;
   const std::size_t n = keep.size();
+  r.count = n;
   const bool sizes_ok = ((detail::array_size(arrays) == n) && ... && true);
   if (!sizes_ok) {
     r.status = Status::InvalidInput;
     r.reason = "every parallel array must have keep.size() = " + std::to_string(n) + " elements";
-    r.count = n;
     return r;
+  }
+  constexpr std::size_t kArrays = sizeof...(Arrays);
+  if constexpr (kArrays > 0) {
+    std::size_t arg = 0;
+    const bool views_ok = (detail::rows_view_ok(arrays, arg++, &r.reason) && ...);
+    if (!views_ok) {
+      r.status = Status::InvalidInput;
+      return r;
+    }
+    const detail::ByteSpan spans[kArrays] = {detail::byte_span(arrays)...};
+    for (std::size_t a = 0; a < kArrays; ++a) {
+      for (std::size_t b = a + 1; b < kArrays; ++b) {
+        if (spans[a].begin < spans[b].end && spans[b].begin < spans[a].end) {
+          r.status = Status::InvalidInput;
+          r.reason = "arguments " + std::to_string(a + 1) + " and " + std::to_string(b + 1) +
+                     " share memory (the same array twice, or overlapping RowsViews)";
+          return r;
+        }
+      }
+    }
   }
   std::size_t count = 0;
   for (std::uint8_t k : keep) count += k != 0;
@@ -119,6 +181,8 @@ CompactResult compact_parallel(const std::vector<std::uint8_t>& keep, Arrays&&..
 template <class T>
 class DynamicRegionPredicate {
  public:
+  static constexpr int kMaxTabulatedLevels = 64;
+
   DynamicRegionPredicate() = default;
   DynamicRegionPredicate(const std::vector<Box<T>>& boxes, ConstMaskView mask = {}, T scale_factor = T(1),
                          int num_levels = 1, bool mask_refines_boxes = false)
@@ -133,9 +197,12 @@ class DynamicRegionPredicate {
     set_pyramid(scale_factor, num_levels);
   }
 
+  /// A non-finite or non-positive scale factor counts as 1. At most kMaxTabulatedLevels scales are
+  /// tabulated (ORB-SLAM uses 8); deeper levels are computed with pow().
   void set_pyramid(T scale_factor, int num_levels) {
-    factor_ = scale_factor > T(0) ? scale_factor : T(1);
-    scales_.assign(static_cast<std::size_t>(num_levels > 0 ? num_levels : 1), T(1));
+    factor_ = scale_factor > T(0) && std::isfinite(scale_factor) ? scale_factor : T(1);
+    const int levels = num_levels < 1 ? 1 : (num_levels > kMaxTabulatedLevels ? kMaxTabulatedLevels : num_levels);
+    scales_.assign(static_cast<std::size_t>(levels), T(1));
     for (std::size_t l = 1; l < scales_.size(); ++l) scales_[l] = scales_[l - 1] * factor_;
   }
 
@@ -160,8 +227,8 @@ class DynamicRegionPredicate {
     return in != 0;
   }
   bool on_mask(T x, T y) const {
-    if (mask_.empty() || !std::isfinite(x) || !std::isfinite(y)) return false;
-    return mask_.test(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)));
+    int u = 0, v = 0;
+    return !mask_.empty() && pixel_of(x, y, mask_.width, mask_.height, &u, &v) && mask_.test(u, v);
   }
   bool inside_level0(T x, T y) const {
     if (!std::isfinite(x) || !std::isfinite(y)) return true;  // never trust a NaN position as static
