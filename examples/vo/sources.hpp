@@ -19,9 +19,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <locale>
 #include <map>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace dyncull {
@@ -110,6 +112,7 @@ inline bool read_tum_list(const std::string& file, std::vector<StampedFile>* out
     ++line_no;
     if (line.empty() || line[0] == '#') continue;
     std::istringstream ss(line);
+    ss.imbue(std::locale::classic());  // '.' decimals whatever the global locale
     StampedFile f;
     if (!(ss >> f.timestamp >> f.path)) {
       *error = file + ":" + std::to_string(line_no) + ": expected 'timestamp filename'";
@@ -128,14 +131,56 @@ inline std::string stem(const std::string& path) {
   return dot == std::string::npos ? name : name.substr(0, dot);
 }
 
-/// YOLO text ("class cx cy w h [conf]" normalised per line) -> pixel detections through
-/// dyncull's conversion (001 eq. 1-2) and filter. Returns the number of unparseable lines.
-inline std::size_t yolo_text_to_detections(const std::string& text, int width, int height,
-                                           std::vector<Detection<float>>* out) {
-  const YoloParseResult<float> parsed = parse_yolo_lines<float>(text);
+/// Reads a whole text file; false with "path: why" for a directory or an unreadable path.
+inline bool read_text_file(const std::string& path, std::string* text, std::string* error) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    *error = path + ": is a directory, not a detections file";
+    return false;
+  }
+  std::ifstream in(path, std::ios::in | std::ios::binary);
+  if (!in) {
+    *error = path + ": cannot open for reading";
+    return false;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) {
+    *error = path + ": read error";
+    return false;
+  }
+  *text = ss.str();
+  return true;
+}
+
+/// Malformed detection lines: the count and the first few as "file:line: reason".
+struct DetectionLineErrors {
+  static constexpr std::size_t kListed = 5;
+  std::size_t count = 0;
+  std::vector<std::string> first;
+  void add(const std::string& file, int line, const std::string& why) {
+    ++count;
+    if (first.size() < kListed) first.push_back(file + ":" + std::to_string(line) + ": " + why);
+  }
+  std::string format() const {
+    std::string out = std::to_string(count) + (count == 1 ? " malformed detection line" : " malformed detection lines");
+    for (const std::string& e : first) out += "\n  " + e;
+    if (count > first.size()) out += "\n  ...";
+    return out;
+  }
+};
+
+/// YOLO text ("class cx cy w h [conf]" normalised per line) -> pixel detections through dyncull's
+/// conversion (001 eq. 1-2) and filter; malformed lines go to `errors` as `file`:line (line numbers
+/// counted from `first_line`).
+inline void yolo_text_to_detections(std::string_view text, int width, int height, const std::string& file,
+                                    int first_line, std::vector<Detection<float>>* out, DetectionLineErrors* errors) {
+  const YoloParseResult<float> parsed = parse_yolo_lines<float>(text, file);
+  for (const YoloParseError& e : parsed.errors) errors->add(file, first_line - 1 + e.line, e.message);
+  // Bad lines beyond the listed ones are counted only.
+  errors->count += parsed.num_bad_lines - parsed.errors.size();
   const DetectionsResult<float> boxes = convert_yolo_detections<float>(parsed.boxes, width, height);
   out->insert(out->end(), boxes.detections.begin(), boxes.detections.end());
-  return parsed.errors.size();
 }
 
 }  // namespace detail
@@ -145,12 +190,17 @@ inline std::size_t yolo_text_to_detections(const std::string& text, int width, i
 class TumSource {
  public:
   /// `detections` is empty (none), a directory of YOLO label files named after the RGB image
-  /// (<stem>.txt, "class cx cy w h [conf]" normalised per line), or one text file whose lines are
-  /// "<rgb timestamp or stem> class cx cy w h [conf]".
+  /// (<stem>.txt, "class cx cy w h [conf]" normalised per line; no file: no detections), or one text
+  /// file whose lines are "<rgb timestamp or stem> class cx cy w h [conf]". Every file is read here:
+  /// a malformed line fails the open, the error giving the count and the first few as
+  /// "file:line: reason" (culling with part of a detector's boxes would measure the wrong thing).
   bool open(const std::string& dir, const std::string& detections, const PinholeCamera<double>& camera,
             std::string* error) {
     dir_ = dir;
     camera_ = camera;
+    frames_.clear();
+    detections_.clear();
+    bad_detection_lines_ = 0;
     std::vector<detail::StampedFile> rgb, depth;
     if (!detail::read_tum_list(dir + "/rgb.txt", &rgb, error)) return false;
     if (!detail::read_tum_list(dir + "/depth.txt", &depth, error)) return false;
@@ -190,7 +240,7 @@ class TumSource {
   PinholeCamera<double> camera() const { return camera_; }
   bool has_detections() const { return has_detections_; }
   bool has_truth_labels() const { return false; }
-  /// Detection lines skipped as unparseable so far (reported by the demo).
+  /// Malformed detection lines found by the last open() (which then failed).
   std::size_t bad_detection_lines() const { return bad_detection_lines_; }
 
   bool load(int index, SequenceFrame* out, std::string* error) {
@@ -213,8 +263,6 @@ class TumSource {
     if (has_detections_) {
       auto it = detections_.find(detail::stem(p.rgb.path));
       if (it != detections_.end()) out->detections = it->second;
-      if (!detection_dir_.empty()) load_detection_file(detection_dir_ + "/" + detail::stem(p.rgb.path) + ".txt",
-                                                       &out->detections);
     }
     out->has_truth_pose = false;
     out->bgr.release();
@@ -228,41 +276,56 @@ class TumSource {
   };
 
   bool load_detections(const std::string& path, std::string* error) {
+    detail::DetectionLineErrors bad;
     std::error_code ec;
+    std::string text;
     if (std::filesystem::is_directory(path, ec)) {
-      detection_dir_ = path;
-      return true;
+      // One label file per RGB image; YOLO writes none for an image without detections.
+      for (const Pair& p : frames_) {
+        const std::string key = detail::stem(p.rgb.path);
+        const std::string file = path + "/" + key + ".txt";
+        if (!std::filesystem::exists(file, ec)) continue;
+        if (!detail::read_text_file(file, &text, error)) return false;
+        detail::yolo_text_to_detections(text, camera_.width, camera_.height, file, 1, &detections_[key], &bad);
+      }
+    } else {
+      if (!detail::read_text_file(path, &text, error)) return false;
+      // One file for the sequence: the first field keys the RGB image, the rest is a YOLO line.
+      const std::string_view all(text);
+      int line_no = 0;
+      for (std::size_t pos = 0; pos < all.size();) {
+        std::size_t end = all.find('\n', pos);
+        if (end == std::string_view::npos) end = all.size();
+        const std::string_view line = all.substr(pos, end - pos);
+        pos = end + 1;
+        ++line_no;
+        const std::size_t first = line.find_first_not_of(" \t\r");
+        if (first == std::string_view::npos || line[first] == '#') continue;
+        if (line.size() > text::kMaxLineChars) {
+          bad.add(path, line_no, "line is " + std::to_string(line.size()) + " bytes long (limit " +
+                                     std::to_string(text::kMaxLineChars) + ")");
+          continue;
+        }
+        const std::size_t split = line.find_first_of(" \t", first);
+        const std::size_t rest = split == std::string_view::npos ? line.size() : line.find_first_not_of(" \t\r", split);
+        if (rest == std::string_view::npos || rest >= line.size()) {
+          bad.add(path, line_no, "expected '<rgb timestamp or stem> class cx cy w h [conf]'");
+          continue;
+        }
+        const std::string key(line.substr(first, std::min<std::size_t>(split, line.size()) - first));
+        detail::yolo_text_to_detections(line.substr(split), camera_.width, camera_.height, path, line_no,
+                                        &detections_[key], &bad);
+      }
     }
-    std::ifstream in(path);
-    if (!in) {
-      *error = "cannot open detections " + path;
+    bad_detection_lines_ = bad.count;
+    if (bad.count > 0) {
+      *error = "detections " + path + ": " + bad.format();
       return false;
-    }
-    // One file for the sequence: the first field keys the RGB image, the rest is a YOLO line.
-    std::map<std::string, std::string> text;
-    std::string line;
-    while (std::getline(in, line)) {
-      const std::size_t first = line.find_first_not_of(" \t");
-      if (first == std::string::npos || line[first] == '#') continue;
-      const std::size_t split = line.find_first_of(" \t", first);
-      if (split == std::string::npos) continue;
-      text[line.substr(first, split - first)] += line.substr(split) + "\n";
-    }
-    for (const auto& [key, lines] : text) {
-      bad_detection_lines_ += detail::yolo_text_to_detections(lines, camera_.width, camera_.height, &detections_[key]);
     }
     return true;
   }
 
-  void load_detection_file(const std::string& file, std::vector<Detection<float>>* out) {
-    std::ifstream in(file);
-    if (!in) return;  // YOLO writes no file for an image without detections
-    std::stringstream ss;
-    ss << in.rdbuf();
-    bad_detection_lines_ += detail::yolo_text_to_detections(ss.str(), camera_.width, camera_.height, out);
-  }
-
-  std::string dir_, detection_dir_;
+  std::string dir_;
   PinholeCamera<double> camera_;
   std::vector<Pair> frames_;
   std::map<std::string, std::vector<Detection<float>>> detections_;
