@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
+#include <vector>
 
 namespace {
 using namespace dyncull;
@@ -131,6 +133,90 @@ TYPED_TEST(Detections, PixelBoxesAreFilteredTheSameWay) {
   EXPECT_EQ(r.detections[0].box.y1, T(479));
   EXPECT_EQ(r.rejections[1], BoxRejection::OutsideImage);
   EXPECT_EQ(r.rejections[2], BoxRejection::NonPositiveSize);
+}
+
+// Negative padding shrinks boxes (for detectors that draw them loose); a box it empties is dropped
+// as NonPositiveSize, one it moves off the image as OutsideImage, and neither is counted as kept.
+TYPED_TEST(Detections, NegativePaddingThatInvertsABoxDropsIt) {
+  using T = TypeParam;
+  DetectionOptions<T> o;
+  o.box_padding_px = T(-100);
+  const std::vector<Detection<T>> in = {{Box<T>{T(10), T(10), T(30), T(30)}, 0, T(0.9)},      // inverted
+                                        {Box<T>{T(100), T(100), T(400), T(400)}, 0, T(0.9)},  // shrunk
+                                        {Box<T>{T(50), T(50), T(250), T(250)}, 0, T(0.9)},    // a point
+                                        {Box<T>{T(-400), T(10), T(50), T(300)}, 0, T(0.9)}};  // off the left edge
+  const DetectionsResult<T> r = filter_detections(in, 640, 480, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.rejections[0], BoxRejection::NonPositiveSize);
+  EXPECT_EQ(r.rejections[1], BoxRejection::None);
+  EXPECT_EQ(r.rejections[2], BoxRejection::NonPositiveSize);
+  EXPECT_EQ(r.rejections[3], BoxRejection::OutsideImage);
+  ASSERT_EQ(r.num_kept, 1u);
+  ASSERT_EQ(r.detections.size(), 1u);
+  EXPECT_EQ(r.source_index[0], 1);
+  EXPECT_EQ(r.detections[0].box.x0, T(200));
+  EXPECT_EQ(r.detections[0].box.x1, T(300));
+  for (const Detection<T>& d : r.detections) EXPECT_TRUE(d.box.valid());
+  // The same through the YOLO path.
+  const std::vector<YoloBox<T>> yolo = {{0, T(0.5), T(0.5), T(0.05), T(0.05), T(0.9)}};
+  const DetectionsResult<T> y = convert_yolo_detections(yolo, 640, 480, o);
+  EXPECT_EQ(y.rejections[0], BoxRejection::NonPositiveSize);
+  EXPECT_TRUE(y.detections.empty());
+}
+
+TYPED_TEST(Detections, OptionsAreValidatedWithTheFieldNamed) {
+  using T = TypeParam;
+  std::string why = "unchanged";
+  EXPECT_EQ(DetectionOptions<T>{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  struct Case {
+    const char* field;
+    void (*spoil)(DetectionOptions<T>*);
+  };
+  const Case cases[] = {
+      {"box_padding_px", [](DetectionOptions<T>* o) { o->box_padding_px = std::numeric_limits<T>::quiet_NaN(); }},
+      {"box_padding_px", [](DetectionOptions<T>* o) { o->box_padding_px = -std::numeric_limits<T>::infinity(); }},
+      {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = std::numeric_limits<T>::quiet_NaN(); }},
+      {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = T(1.5); }},
+      {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = T(-0.1); }},
+      {"min_confidence_person", [](DetectionOptions<T>* o) { o->min_confidence_person = std::numeric_limits<T>::quiet_NaN(); }},
+      {"class_min_confidence[3]", [](DetectionOptions<T>* o) { o->class_min_confidence.assign(5, T(-1)); o->class_min_confidence[3] = std::numeric_limits<T>::quiet_NaN(); }},
+      {"class_min_confidence[1]", [](DetectionOptions<T>* o) { o->class_min_confidence = {T(0.5), T(2)}; }},
+      {"letterbox.scale", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.scale = T(0); }},
+      {"letterbox.scale", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.scale = std::numeric_limits<T>::quiet_NaN(); }},
+      {"letterbox.pad_x", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.pad_x = std::numeric_limits<T>::infinity(); }},
+      {"letterbox.input_height", [](DetectionOptions<T>* o) { o->letterbox.input_width = 640; o->letterbox.input_height = 0; }},
+  };
+  const std::vector<YoloBox<T>> yolo = {{0, T(0.5), T(0.5), T(0.2), T(0.2), T(0.9)}};
+  const std::vector<Detection<T>> px = {{Box<T>{T(10), T(10), T(100), T(100)}, 0, T(0.9)}};
+  for (const Case& c : cases) {
+    DetectionOptions<T> o;
+    c.spoil(&o);
+    EXPECT_EQ(o.validate(&why), Status::InvalidInput) << c.field;
+    EXPECT_NE(why.find(c.field), std::string::npos) << why;
+    const DetectionsResult<T> a = convert_yolo_detections(yolo, 640, 480, o);
+    EXPECT_EQ(a.status, Status::InvalidInput) << c.field;
+    EXPECT_NE(a.reason.find(c.field), std::string::npos) << a.reason;
+    EXPECT_TRUE(a.detections.empty());
+    const DetectionsResult<T> b = filter_detections(px, 640, 480, o);
+    EXPECT_EQ(b.status, Status::InvalidInput) << c.field;
+    EXPECT_NE(b.reason.find(c.field), std::string::npos) << b.reason;
+    EXPECT_TRUE(b.detections.empty());
+  }
+  // Thresholds of 0 and 1, negative per-class entries (use the default) and huge finite padding are fine.
+  DetectionOptions<T> edge;
+  edge.min_confidence = T(0);
+  edge.min_confidence_person = T(1);
+  edge.class_min_confidence = {T(-1), T(0.3)};
+  edge.box_padding_px = T(1e30);
+  EXPECT_EQ(edge.validate(), Status::Ok);
+  const DetectionsResult<T> all = filter_detections(px, 640, 480, edge);
+  ASSERT_EQ(all.detections.size(), 0u);  // person threshold 1 > 0.9
+  edge.min_confidence_person = T(0);
+  const DetectionsResult<T> whole = filter_detections(px, 640, 480, edge);
+  ASSERT_EQ(whole.detections.size(), 1u);
+  EXPECT_EQ(whole.detections[0].box.x0, T(0));
+  EXPECT_EQ(whole.detections[0].box.x1, T(639));
 }
 
 TEST(YoloParser, ParsesLinesAndReportsLineNumbers) {

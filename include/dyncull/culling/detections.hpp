@@ -75,7 +75,8 @@ constexpr const char* to_string(BoxRejection r) noexcept {
 template <class T>
 struct DetectionOptions {
   /// Grow every kept box by this many pixels on each side before clipping (Crowd-SLAM / CDS-SLAM
-  /// use 5 px: detector boxes are tight and limbs stick out).
+  /// use 5 px: detector boxes are tight and limbs stick out). Negative shrinks; a box the shrinking
+  /// empties is dropped (NonPositiveSize), one it moves off the image too (OutsideImage).
   T box_padding_px = T(5);
   /// Minimum confidence for classes without their own entry.
   T min_confidence = T(0.4);
@@ -92,6 +93,36 @@ struct DetectionOptions {
         class_min_confidence[static_cast<std::size_t>(class_id)] >= T(0))
       return class_min_confidence[static_cast<std::size_t>(class_id)];
     return class_id == person_class_id ? min_confidence_person : min_confidence;
+  }
+
+  /// Ok, or InvalidInput naming the first bad field: box_padding_px finite; min_confidence and
+  /// min_confidence_person in [0, 1]; class_min_confidence entries in [0, 1] or negative (= use the
+  /// default), never NaN; a letterbox in use (input_width or input_height set) needs both sizes
+  /// positive, a finite scale > 0 and finite pads.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const std::string& why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    auto unit = [](T v) { return v >= T(0) && v <= T(1); };  // false for NaN
+    if (!std::isfinite(box_padding_px)) return bad("box_padding_px must be finite");
+    if (!unit(min_confidence)) return bad("min_confidence must be in [0, 1]");
+    if (!unit(min_confidence_person)) return bad("min_confidence_person must be in [0, 1]");
+    for (std::size_t c = 0; c < class_min_confidence.size(); ++c) {
+      const T v = class_min_confidence[c];
+      if (!(v < T(0)) && !unit(v))
+        return bad("class_min_confidence[" + std::to_string(c) + "] must be in [0, 1] (or negative for the default)");
+    }
+    if (letterbox.input_width != 0 || letterbox.input_height != 0) {
+      if (letterbox.input_width <= 0) return bad("letterbox.input_width must be positive when a letterbox is set");
+      if (letterbox.input_height <= 0) return bad("letterbox.input_height must be positive when a letterbox is set");
+      if (!(letterbox.scale > T(0)) || !std::isfinite(letterbox.scale))
+        return bad("letterbox.scale must be positive and finite");
+      if (!std::isfinite(letterbox.pad_x)) return bad("letterbox.pad_x must be finite");
+      if (!std::isfinite(letterbox.pad_y)) return bad("letterbox.pad_y must be finite");
+    }
+    if (reason) reason->clear();
+    return Status::Ok;
   }
 };
 
@@ -130,8 +161,12 @@ BoxRejection check_and_finish_box(Box<T>* box, T confidence, int class_id, int w
   if (box->x1 < T(0) || box->y1 < T(0) || box->x0 > T(width - 1) || box->y0 > T(height - 1))
     return BoxRejection::OutsideImage;
   if (confidence < o.threshold_for(class_id)) return BoxRejection::LowConfidence;
-  const T pad = std::isfinite(o.box_padding_px) ? o.box_padding_px : T(0);
-  *box = box->padded(pad).clipped(width, height);
+  // Negative padding shrinks: a box it empties, or moves off the image, is not a box any more.
+  const Box<T> padded = box->padded(o.box_padding_px);
+  if (!(padded.x1 > padded.x0) || !(padded.y1 > padded.y0)) return BoxRejection::NonPositiveSize;
+  const Box<T> clipped = padded.clipped(width, height);
+  if (!clipped.valid()) return BoxRejection::OutsideImage;
+  *box = clipped;
   return BoxRejection::None;
 }
 
@@ -160,7 +195,8 @@ void finish(DetectionsResult<T>* r, int width, int height) {
 }  // namespace detail
 
 /// Converts, filters, pads and clips YOLO boxes. Rejected boxes do not make the call fail: status
-/// stays Ok and `reason` / `rejections` say what was dropped. InvalidInput only for a bad image size.
+/// stays Ok and `reason` / `rejections` say what was dropped. InvalidInput (no boxes kept, no
+/// rejections listed) for a bad image size or options that fail DetectionOptions::validate.
 template <class T>
 DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>& boxes, int width, int height,
                                             const DetectionOptions<T>& options = {}) {
@@ -168,6 +204,10 @@ DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>& boxes
   r.num_input = boxes.size();
   if (width <= 0 || height <= 0) {
     detail::finish(&r, width, height);
+    return r;
+  }
+  if (options.validate(&r.reason) != Status::Ok) {
+    r.status = Status::InvalidInput;
     return r;
   }
   r.rejections.reserve(boxes.size());
@@ -190,7 +230,7 @@ DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>& boxes
 }
 
 /// Same checks, padding and clipping for boxes already in pixels (e.g. after the detector's own
-/// post-processing).
+/// post-processing), and the same InvalidInput cases.
 template <class T>
 DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, int width, int height,
                                       const DetectionOptions<T>& options = {}) {
@@ -198,6 +238,10 @@ DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, in
   r.num_input = boxes.size();
   if (width <= 0 || height <= 0) {
     detail::finish(&r, width, height);
+    return r;
+  }
+  if (options.validate(&r.reason) != Status::Ok) {
+    r.status = Status::InvalidInput;
     return r;
   }
   r.rejections.reserve(boxes.size());
