@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace {
@@ -98,5 +100,75 @@ TYPED_TEST(BoxTrackerT, ClassesBoundsAndBadInput) {
   t2.update({person_at(T(1))}, 640, 480);
   t2.reset();
   EXPECT_TRUE(t2.tracks().empty());
+}
+
+TYPED_TEST(BoxTrackerT, OptionsAreValidatedWithTheFieldNamed) {
+  using T = TypeParam;
+  std::string why = "unchanged";
+  EXPECT_EQ(BoxTrackerOptions<T>{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+  struct Case {
+    const char* field;
+    BoxTrackerOptions<T> o;
+  };
+  std::vector<Case> cases;
+  auto add = [&](const char* field, auto spoil) {
+    BoxTrackerOptions<T> o;
+    spoil(o);
+    cases.push_back({field, o});
+  };
+  add("min_iou", [&](BoxTrackerOptions<T>& o) { o.min_iou = nan; });
+  add("min_iou", [&](BoxTrackerOptions<T>& o) { o.min_iou = T(-0.1); });
+  add("min_iou", [&](BoxTrackerOptions<T>& o) { o.min_iou = T(1.5); });
+  add("grow_px_per_frame", [&](BoxTrackerOptions<T>& o) { o.grow_px_per_frame = nan; });
+  add("grow_px_per_frame", [&](BoxTrackerOptions<T>& o) { o.grow_px_per_frame = inf; });
+  add("grow_px_per_frame", [&](BoxTrackerOptions<T>& o) { o.grow_px_per_frame = T(-1); });
+  add("max_missed_frames", [&](BoxTrackerOptions<T>& o) { o.max_missed_frames = -1; });
+  add("max_missed_frames", [&](BoxTrackerOptions<T>& o) { o.max_missed_frames = 1 << 30; });
+  add("velocity_smoothing", [&](BoxTrackerOptions<T>& o) { o.velocity_smoothing = nan; });
+  add("velocity_smoothing", [&](BoxTrackerOptions<T>& o) { o.velocity_smoothing = T(2); });
+  for (const Case& c : cases) {
+    EXPECT_EQ(c.o.validate(&why), Status::InvalidInput) << c.field;
+    EXPECT_NE(why.find(c.field), std::string::npos) << why;
+    BoxTracker<T> tracker(c.o);
+    const BoxTrackerResult<T> r = tracker.update({person_at(T(100))}, 640, 480);
+    EXPECT_EQ(r.status, Status::InvalidInput) << c.field;
+    EXPECT_NE(r.reason.find(c.field), std::string::npos) << r.reason;
+    EXPECT_TRUE(r.boxes.empty());
+    EXPECT_TRUE(tracker.tracks().empty());  // state untouched
+  }
+}
+
+// Whatever the detections (NaN, inverted, huge finite, off the image), every box the tracker
+// carries is valid and inside the image, and the tracks stay bounded.
+TYPED_TEST(BoxTrackerT, CarriedBoxesStayValidOnAwkwardDetections) {
+  using T = TypeParam;
+  const T big = std::numeric_limits<T>::max(), nan = std::numeric_limits<T>::quiet_NaN();
+  const T values[] = {T(0), T(100), T(639), T(-50), T(700), T(5e9), -T(5e9), big, -big, nan};
+  std::uint64_t state = 1;
+  auto pick = [&]() {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return values[(state >> 33) % (sizeof(values) / sizeof(values[0]))];
+  };
+  BoxTracker<T> tracker;
+  for (int frame = 0; frame < 200; ++frame) {
+    std::vector<Detection<T>> dets;
+    for (int d = 0; d < 4; ++d) dets.push_back(Detection<T>{Box<T>{pick(), pick(), pick(), pick()}, d % 2, T(1)});
+    if (frame % 3 == 0) dets.push_back(person_at(T(frame % 500)));
+    const BoxTrackerResult<T> r = tracker.update(dets, 640, 480);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    ASSERT_EQ(r.boxes.size(), r.carried.size());
+    for (std::size_t b = 0; b < r.boxes.size(); ++b) {
+      if (!r.carried[b]) continue;
+      const Box<T>& box = r.boxes[b].box;
+      EXPECT_TRUE(box.valid()) << "frame " << frame;
+      EXPECT_GE(box.x0, T(0));
+      EXPECT_GE(box.y0, T(0));
+      EXPECT_LE(box.x1, T(639));
+      EXPECT_LE(box.y1, T(479));
+    }
+    EXPECT_LE(tracker.tracks().size(), 5u * 3u);  // at most max_missed_frames + 1 generations of 5
+  }
 }
 }  // namespace

@@ -43,6 +43,19 @@ struct BoxRuleOptions {
   bool high_as_candidate = false;
   /// Whether a low-level box also shelters medium-level features (consistent with 002 Table 2).
   bool low_overrides_medium = true;
+
+  /// Ok, or InvalidInput naming the first bad field: both paddings finite. Negative values are
+  /// allowed (a negative high padding shrinks; a box it empties is skipped like an invalid box).
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!std::isfinite(high_padding_px)) return bad("high_padding_px must be finite");
+    if (!std::isfinite(low_shrink_px)) return bad("low_shrink_px must be finite");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 template <class T>
@@ -114,7 +127,9 @@ void mark_points(const T* xs, const T* ys, std::size_t n, const std::vector<Box<
 }  // namespace detail
 
 /// Applies the box rule to every point. Boxes of Ignore-level classes take no part; invalid
-/// (non-finite or inverted) boxes are skipped and counted in `reason`.
+/// (non-finite or inverted) boxes, and high-level boxes a negative high_padding_px empties, are
+/// skipped and counted in `reason`. Options failing BoxRuleOptions::validate give InvalidInput with
+/// every point Static (None): nothing is decided.
 template <class Points, class Dets, class T = detail::detection_scalar_t<Dets>>
 BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, const MotionLevelTable& levels,
                                 const BoxRuleOptions<T>& options = {}) {
@@ -124,6 +139,11 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
   r.box_index.assign(n, -1);
+  if (options.validate(&r.reason) != Status::Ok) {
+    r.status = Status::InvalidInput;
+    r.num_static = n;
+    return r;
+  }
 
   // Effective boxes (padded / shrunk) with their level bit; detection index kept for box_index.
   std::vector<Box<T>> boxes;
@@ -144,6 +164,10 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
     if (level == MotionLevel::High) {
       e = d.box.padded(options.high_padding_px);
       bit = detail::kInHigh;
+      if (!e.valid()) {  // shrunk to nothing by a negative padding
+        ++skipped;
+        continue;
+      }
       ++r.num_high_boxes;
     } else if (level == MotionLevel::Low) {
       e = d.box.padded(-options.low_shrink_px);

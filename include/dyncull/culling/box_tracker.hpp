@@ -14,6 +14,7 @@
 #include "dyncull/core/types.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -33,6 +34,22 @@ struct BoxTrackerOptions {
   T velocity_smoothing = T(0.5);
   /// Only detections of the track's class continue it.
   bool same_class_only = true;
+
+  /// Ok, or InvalidInput naming the first bad field: min_iou and velocity_smoothing in [0, 1],
+  /// grow_px_per_frame finite and >= 0, max_missed_frames in [0, 1000].
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(min_iou >= T(0) && min_iou <= T(1))) return bad("min_iou must be in [0, 1]");
+    if (!(grow_px_per_frame >= T(0)) || !std::isfinite(grow_px_per_frame))
+      return bad("grow_px_per_frame must be finite and >= 0");
+    if (max_missed_frames < 0 || max_missed_frames > 1000) return bad("max_missed_frames must be in [0, 1000]");
+    if (!(velocity_smoothing >= T(0) && velocity_smoothing <= T(1))) return bad("velocity_smoothing must be in [0, 1]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 template <class T>
@@ -62,12 +79,17 @@ class BoxTracker {
   explicit BoxTracker(const BoxTrackerOptions<T>& options = {}) : options_(options) {}
 
   /// Feeds one frame's detections (already filtered, pixel boxes). Invalid boxes are ignored
-  /// (counted in `reason`); a bad image size fails with InvalidInput and leaves the state as is.
+  /// (counted in `reason`); a bad image size or options failing BoxTrackerOptions::validate fail
+  /// with InvalidInput and leave the state as is.
   BoxTrackerResult<T> update(const std::vector<Detection<T>>& detections, int width, int height) {
     BoxTrackerResult<T> r;
     if (width <= 0 || height <= 0) {
       r.status = Status::InvalidInput;
       r.reason = "image size must be positive";
+      return r;
+    }
+    if (options_.validate(&r.reason) != Status::Ok) {
+      r.status = Status::InvalidInput;
       return r;
     }
     // Predicted boxes of the existing tracks.
