@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace {
 
 template <class T>
@@ -88,6 +90,26 @@ TYPED_TEST(CameraTest, IntrinsicMatrixValidityAndCast) {
   EXPECT_NEAR(d.fx, 535.4, 1e-4);
   EXPECT_EQ(d.width, 640);
   EXPECT_EQ(d.height, 480);
+}
+
+// Infinite focal lengths and image sizes at the ends of the int range: no overflow, no
+// camera that claims validity while projecting everything to Inf.
+TYPED_TEST(CameraTest, NonFiniteFocalLengthsAndExtremeSizes) {
+  using T = TypeParam;
+  dyncull::PinholeCamera<T> cam;
+  cam.fx = std::numeric_limits<T>::infinity();
+  EXPECT_FALSE(cam.valid());
+  cam = dyncull::PinholeCamera<T>{};
+  cam.fy = std::numeric_limits<T>::quiet_NaN();
+  EXPECT_FALSE(cam.valid());
+  cam = dyncull::PinholeCamera<T>{};
+  cam.width = std::numeric_limits<int>::min();
+  cam.height = std::numeric_limits<int>::min();
+  EXPECT_FALSE(cam.valid());
+  EXPECT_FALSE(cam.in_image(T(0), T(0)));  // no int overflow computing the far edge
+  cam.width = std::numeric_limits<int>::max();
+  cam.height = 10;
+  EXPECT_TRUE(cam.in_image(T(1e9), T(5)));
 }
 
 TEST(Camera, DefaultsAreTumDefaults) {

@@ -30,14 +30,18 @@ struct PinholeCamera {
   Vec3<T> ray(const Vec2<T>& uv) const { return Vec3<T>((uv.x() - cx) / fx, (uv.y() - cy) / fy, T(1)); }
   /// True when (u, v) lies inside the image, at least `border` pixels from every edge.
   bool in_image(T u, T v, T border = T(0)) const {
-    return u >= border && v >= border && u <= T(width - 1) - border && v <= T(height - 1) - border;
+    // T(width) - 1, not T(width - 1): no int overflow for a bogus width of INT_MIN.
+    return u >= border && v >= border && u <= T(width) - T(1) - border && v <= T(height) - T(1) - border;
   }
   Mat3<T> K() const {
     Mat3<T> k;
     k << fx, T(0), cx, T(0), fy, cy, T(0), T(0), T(1);
     return k;
   }
-  bool valid() const { return fx > T(0) && fy > T(0) && width > 0 && height > 0 && std::isfinite(cx) && std::isfinite(cy); }
+  bool valid() const {
+    return fx > T(0) && fy > T(0) && std::isfinite(fx) && std::isfinite(fy) && width > 0 && height > 0 &&
+           std::isfinite(cx) && std::isfinite(cy);
+  }
   template <class U> PinholeCamera<U> cast() const {
     return PinholeCamera<U>{U(fx), U(fy), U(cx), U(cy), width, height};
   }
