@@ -135,6 +135,23 @@ TYPED_TEST(AteTest, FailuresAreStatusesWithReasons) {
   EXPECT_EQ(evaluate_ate(gt, broken).status, Status::InvalidInput);
 }
 
+TYPED_TEST(AteTest, LargeFiniteCoordinatesGiveAFiniteError) {
+  using T = TypeParam;
+  // Trajectories far beyond a lab (double 1e160, float 1e25): squares overflow, the ATE does not.
+  const double big = std::is_same<T, double>::value ? 1e160 : 1e25;
+  const Trajectory<T> gt = synthetic::make_loop<T>(50);
+  Eigen::Matrix<T, 3, Eigen::Dynamic> g(3, 50), e(3, 50);
+  for (int i = 0; i < 50; ++i) {
+    g.col(i) = gt.poses[static_cast<std::size_t>(i)].t * T(big);
+    e.col(i) = g.col(i) + Vec3<T>(T(big), T(-2 * big), T(0.5 * big));  // a pure offset: zero error
+    e(0, i) += T(i % 2 ? 0.01 : -0.01) * T(big);
+  }
+  const AteResult<T> ate = ate_from_positions(e, g);
+  ASSERT_TRUE(ate.ok()) << ate.reason;
+  EXPECT_TRUE(std::isfinite(ate.error_m.rmse));
+  EXPECT_NEAR(ate.error_m.rmse / T(big), T(0.01), T(1e-3));
+}
+
 TEST(AteFromPositions, MatchesTrajectoryVersion) {
   const Trajectory<double> gt = synthetic::make_loop<double>(40);
   Eigen::Matrix<double, 3, Eigen::Dynamic> g(3, 40), e(3, 40);

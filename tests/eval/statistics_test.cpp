@@ -80,6 +80,27 @@ TYPED_TEST(StatisticsTest, EmptyAndNonFiniteAreReportedNotSummarised) {
   EXPECT_NE(s1.reason.find("value 1"), std::string::npos) << s1.reason;
 }
 
+TYPED_TEST(StatisticsTest, HugeFiniteValuesGiveFiniteStatistics) {
+  using T = TypeParam;
+  // Squares (and, for double, sums) overflow; the statistics themselves are representable.
+  const T big = std::numeric_limits<T>::max() / T(2);
+  const std::vector<T> v{big, big, T(0), big};
+  const ErrorStatistics<T> s = compute_statistics(v);
+  ASSERT_TRUE(s.ok()) << s.reason;
+  for (T x : {s.rmse, s.mean, s.median, s.std, s.min, s.max}) EXPECT_TRUE(std::isfinite(x)) << x;
+  EXPECT_EQ(s.max, big);
+  EXPECT_EQ(s.median, big);
+  EXPECT_NEAR(double(s.mean) / double(big), 0.75, 1e-6);
+  EXPECT_NEAR(double(s.rmse) / double(big), std::sqrt(0.75), 1e-6);
+  EXPECT_NEAR(double(s.std) / double(big), std::sqrt(0.75 * 0.25), 1e-6);
+  // Values of both signs near the limit: the median of the two middle values does not overflow either.
+  const std::vector<T> w{-big, big};
+  const ErrorStatistics<T> t = compute_statistics(w);
+  ASSERT_TRUE(t.ok()) << t.reason;
+  EXPECT_EQ(t.median, T(0));
+  EXPECT_TRUE(std::isfinite(t.std));
+}
+
 TEST(ImprovementRate, ReproducesPaperTable) {
   // 002 Table 4, walking_xyz ATE RMSE: ORB-SLAM3 0.6459 m, theirs 0.1290 m -> "80.02 %". The paper
   // truncates to two decimals (the exact rate is 80.0279 %), so compare the truncated percentage.

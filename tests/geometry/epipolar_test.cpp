@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <vector>
 
@@ -219,6 +220,127 @@ TYPED_TEST(EpipolarTyped, SizeMismatchIsInvalidInput) {
   EXPECT_EQ(epipolar_distances(Mat3<T>(Mat3<T>::Identity()), a, b, &out), Status::InvalidInput);
   std::uint8_t labels[3];
   EXPECT_EQ(label_epipolar(Mat3<T>(Mat3<T>::Identity()), a, b, T(1), labels), Status::InvalidInput);
+}
+
+TYPED_TEST(EpipolarTyped, UndeterminedMatrixIsReportedNotNaN) {
+  using T = TypeParam;
+  const std::vector<Vec2<T>> a = {Vec2<T>(10, 20), Vec2<T>(30, 40)}, b = {Vec2<T>(11, 19), Vec2<T>(29, 41)};
+  std::vector<T> out;
+  std::vector<std::uint8_t> labels(2);
+  for (auto kind : {dyncull::EpipolarDistance::PointToLine, dyncull::EpipolarDistance::SampsonSq}) {
+    EXPECT_EQ(epipolar_distances(Mat3<T>(Mat3<T>::Zero()), a, b, &out, kind), Status::Degenerate);
+    Mat3<T> F = Mat3<T>::Identity();
+    F(1, 2) = std::numeric_limits<T>::quiet_NaN();
+    EXPECT_EQ(epipolar_distances(F, a, b, &out, kind), Status::NonFinite);
+  }
+  EXPECT_EQ(label_epipolar(Mat3<T>(Mat3<T>::Zero()), a, b, T(1), labels.data()), Status::Degenerate);
+  // A valid F with entries so large that X^2 + Y^2 overflows: the distance is scale-free in F.
+  Mat3<T> F;
+  F << 0, 0, 0, 0, 0, -1, 0, 1, 0;  // pure horizontal translation: lines are rows, distance = |y2 - y1|
+  ASSERT_EQ(epipolar_distances(F, a, b, &out), Status::Ok);
+  EXPECT_NEAR(out[0], T(1), T(1e-5));
+  const Mat3<T> huge = F * (std::numeric_limits<T>::max() / T(4));
+  for (auto kind : {dyncull::EpipolarDistance::PointToLine, dyncull::EpipolarDistance::PointToLineSq,
+                    dyncull::EpipolarDistance::SymmetricSq, dyncull::EpipolarDistance::SampsonSq}) {
+    ASSERT_EQ(epipolar_distances(huge, a, b, &out, kind), Status::Ok);
+    EXPECT_TRUE(std::isfinite(out[0])) << static_cast<int>(kind);
+    EXPECT_TRUE(std::isfinite(out[1])) << static_cast<int>(kind);
+  }
+  std::size_t count = 9;
+  ASSERT_EQ(label_epipolar(huge, a, b, T(0.5), labels.data(), &count), Status::Ok);
+  EXPECT_EQ(count, 2u);  // both distances are 1 px > 0.5
+}
+
+template <class T>
+T wild_coordinate(Random& rng) {
+  const double u = rng.uniform();
+  if (u < 0.03) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.05) return std::numeric_limits<T>::infinity();
+  if (u < 0.07) return -std::numeric_limits<T>::infinity();
+  if (u < 0.09) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.11) return std::numeric_limits<T>::denorm_min();
+  return T(rng.uniform(-50, 700));
+}
+
+// The SSE2 packed path, the SoA block path (a container without data()) and the scalar one-point
+// function agree on NaN, Inf and huge inputs at sizes around the vector widths and the 256-point block.
+// Property: Ok means every distance is finite unless its own line is undefined.
+TYPED_TEST(EpipolarTyped, PropertyPackedSoaAndScalarAgreeOnWildInput) {
+  using T = TypeParam;
+  Random rng(99);
+  const std::vector<std::size_t> sizes = {0, 1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 255, 256, 257, 263, 513};
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::size_t n = sizes[rng.index(static_cast<std::uint32_t>(sizes.size()))];
+    Mat3<T> F;
+    const double kind_of_f = rng.uniform();
+    for (int k = 0; k < 9; ++k) F(k / 3, k % 3) = T(rng.normal());
+    if (kind_of_f < 0.1) F(rng.index(3), rng.index(3)) = wild_coordinate<T>(rng);
+    if (kind_of_f > 0.9) F *= std::numeric_limits<T>::max() / T(64);
+    if (kind_of_f > 0.85 && kind_of_f <= 0.9) F *= T(1e-30);
+    const bool clean = rng.uniform() < 0.3;
+    std::vector<Vec2<T>> a(n), b(n);
+    std::deque<Vec2<T>> da, db;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (Vec2<T>* p : {&a[i], &b[i]}) {
+        *p = clean ? Vec2<T>(T(rng.uniform(0, 640)), T(rng.uniform(0, 480)))
+                   : Vec2<T>(wild_coordinate<T>(rng), wild_coordinate<T>(rng));
+      }
+      da.push_back(a[i]);
+      db.push_back(b[i]);
+    }
+    std::vector<T> packed, blocked;
+    const Status s = epipolar_distances(F, a, b, &packed);
+    ASSERT_EQ(epipolar_distances(F, da, db, &blocked), s);
+    if (s != Status::Ok) {
+      EXPECT_TRUE(s == Status::NonFinite || s == Status::Degenerate) << static_cast<int>(s);
+      EXPECT_FALSE(F.allFinite() && F.cwiseAbs().maxCoeff() > T(0));
+      continue;
+    }
+    ASSERT_EQ(packed.size(), n);
+    const T m = F.cwiseAbs().maxCoeff();
+    const Mat3<T> Fn = F / m;  // the one-point function is not normalised: give it a tame F
+    for (std::size_t i = 0; i < n; ++i) {
+      const T one = dyncull::epipolar_distance(Fn, a[i], b[i]);
+      // Finite coordinates beyond 1e15 px are not pixels: X^2 may overflow and each path may give NaN,
+      // +inf or 0 there (documented); everything else must agree.
+      const bool huge = (a[i].allFinite() && a[i].cwiseAbs().maxCoeff() > T(1e15)) ||
+                        (b[i].allFinite() && b[i].cwiseAbs().maxCoeff() > T(1e15));
+      if (huge) continue;
+      if (std::isfinite(packed[i])) {
+        const T tol = T(64) * std::numeric_limits<T>::epsilon() * (T(1) + std::abs(packed[i]));
+        EXPECT_NEAR(blocked[i], packed[i], tol) << "trial " << trial << " i " << i;
+        if (std::isfinite(one)) {
+          EXPECT_NEAR(one, packed[i], T(1e3) * tol) << "trial " << trial << " i " << i;
+        }
+      } else {
+        EXPECT_FALSE(std::isfinite(blocked[i])) << "trial " << trial << " i " << i;
+        // Not finite only where the line is undefined: a non-finite coordinate or the epipole.
+        const bool wild = !a[i].allFinite() || !b[i].allFinite();
+        const Vec3<T> l = Fn * Vec3<T>(a[i].x(), a[i].y(), T(1));
+        const bool at_epipole = !(l.x() * l.x() + l.y() * l.y() > T(0));
+        EXPECT_TRUE(wild || at_epipole) << "trial " << trial << " i " << i << ": " << packed[i];
+      }
+    }
+    // Labels agree with the thresholded distances wherever the distance is finite.
+    std::vector<std::uint8_t> labels(n, 7);
+    std::size_t count = 0;
+    const T thr = T(rng.uniform(0, 5));
+    ASSERT_EQ(label_epipolar(F, a, b, thr, labels.data(), &count), Status::Ok);
+    std::size_t ones = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_LE(labels[i], 1);
+      ones += labels[i];
+      if (std::isfinite(packed[i]) && std::abs(packed[i] - thr) > T(1e-3) * (T(1) + thr)) {
+        EXPECT_EQ(labels[i], packed[i] > thr ? 1 : 0) << "trial " << trial << " i " << i;
+      }
+    }
+    EXPECT_EQ(ones, count);
+  }
+  std::vector<std::uint8_t> one_label(1);
+  const std::vector<Vec2<T>> p = {Vec2<T>(1, 2)};
+  EXPECT_EQ(label_epipolar(Mat3<T>(Mat3<T>::Identity()), p, p, std::numeric_limits<T>::quiet_NaN(), one_label.data()),
+            Status::InvalidInput);
+  EXPECT_EQ(label_epipolar(Mat3<T>(Mat3<T>::Identity()), p, p, T(-1), one_label.data()), Status::InvalidInput);
 }
 
 TEST(EpipolarPointTypes, StructAndKeypointContainers) {

@@ -145,6 +145,37 @@ TYPED_TEST(UmeyamaTest, FailsOnBadInput) {
   EXPECT_EQ(dyncull::umeyama(p, p, {}, w0.data()).status, Status::TooFewPoints);
 }
 
+TYPED_TEST(UmeyamaTest, LargeFiniteCoordinatesAreAlignedNotCalledNonFinite) {
+  using T = TypeParam;
+  // Coordinates whose squares overflow T (double: 1e160^2 = 1e320; float: 1e25^2 = 1e50): the data
+  // are finite and well spread, so the fit exists and must be found.
+  Random rng(21);
+  const dyncull::Rigid3<T> g = dyncull::test::random_rigid<T>(rng, 1.0, 0.0);
+  for (const double big : {std::is_same<T, double>::value ? 1e160 : 1e25,
+                           std::is_same<T, double>::value ? 1e300 : 1e36}) {
+    for (const bool scale : {false, true}) {
+      const Points<T> src = dyncull::test::random_points<T>(rng, 40) * T(big);
+      Points<T> dst = g.R * src;
+      dst.colwise() += Vec3<T>(T(0.5 * big), T(-0.25 * big), T(0.1 * big));
+      AlignmentOptions o;
+      o.estimate_scale = scale;
+      const auto r = dyncull::umeyama(src, dst, o);
+      ASSERT_TRUE(r.ok()) << big << ": " << r.reason;
+      EXPECT_LT((r.rigid().R - g.R).norm(), T(1e3) * this->tol()) << big;
+      EXPECT_NEAR(r.dst_from_src.scale, T(1), T(1e3) * this->tol());
+      EXPECT_TRUE(r.dst_from_src.t.allFinite());
+      EXPECT_NEAR(r.dst_from_src.t.x() / T(big), T(0.5), T(1e3) * this->tol());
+    }
+  }
+  // Weighted, with weights that overflow their products with the coordinates.
+  const Points<T> src = dyncull::test::random_points<T>(rng, 12) * T(1e3);
+  const Points<T> dst = g.R * src;
+  const std::vector<T> w(12, std::numeric_limits<T>::max() / T(8));
+  const auto rw = dyncull::umeyama(src, dst, {}, w.data());
+  ASSERT_TRUE(rw.ok()) << rw.reason;
+  EXPECT_LT((rw.rigid().R - g.R).norm(), T(1e3) * this->tol());
+}
+
 // Cross-check against Eigen's own implementation on noisy data (not just exact data).
 TEST(UmeyamaVsEigen, MatchesEigenUmeyamaTo1e12) {
   Random rng(13);

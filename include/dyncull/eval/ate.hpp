@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <type_traits>
@@ -66,7 +67,17 @@ AteResult<typename DE::Scalar> ate_from_positions(const Eigen::MatrixBase<DE>& e
   for (Eigen::Index i = 0; i < n; ++i) {
     const Vec3<T> e = estimate_xyz.col(i);
     const Vec3<T> g = groundtruth_xyz.col(i);
-    result.errors_m[static_cast<std::size_t>(i)] = (s.apply(e) - g).norm();
+    const Vec3<T> d = s.apply(e) - g;
+    T err = d.norm();
+    if (!std::isfinite(err) && d.allFinite()) err = d.stableNorm();  // squares overflowed, the norm did not
+    if (!std::isfinite(err)) {
+      result.status = Status::InvalidInput;
+      result.reason = "ate: the error of pair " + std::to_string(i) +
+                      " is beyond the largest finite value (coordinates near the floating-point limit)";
+      result.errors_m.clear();
+      return result;
+    }
+    result.errors_m[static_cast<std::size_t>(i)] = err;
   }
   result.error_m = compute_statistics(result.errors_m.data(), result.errors_m.size());
   if (!result.error_m.ok()) {

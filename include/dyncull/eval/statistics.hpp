@@ -36,7 +36,9 @@ struct ErrorStatistics {
 /// Statistics of values[0..n). `scratch` (optional) is reused for the median's partial sort so a
 /// caller evaluating many sequences allocates once. Empty input -> TooFewPoints; any NaN/Inf ->
 /// NonFinite (TUM would print nan; we refuse instead of hiding it in a mean).
-/// Sums run in double whatever T is, so float errors are summarised without float round-off.
+/// Sums run in double whatever T is, so float errors are summarised without float round-off. Finite
+/// values near the double limit, whose squares or sums overflow, are summed scaled by the largest
+/// magnitude: every statistic of finite values is finite.
 template <class T>
 ErrorStatistics<T> compute_statistics(const T* values, std::size_t n, std::vector<T>* scratch = nullptr) {
   static_assert(std::is_floating_point<T>::value, "compute_statistics: T must be float or double");
@@ -64,12 +66,27 @@ ErrorStatistics<T> compute_statistics(const T* values, std::size_t n, std::vecto
     hi = v > hi ? v : hi;
   }
   const double dn = static_cast<double>(n);
-  const double mean = sum / dn;
+  // Only when a square or a sum overflowed (values near 1e154 and beyond): rerun the sums on values
+  // divided by the largest magnitude, a power of two so the scaling itself is exact.
+  double scale = 1.0;
+  if (!std::isfinite(sum_sq) || !std::isfinite(sum)) {
+    int exponent = 0;
+    std::frexp(std::max(std::abs(lo), std::abs(hi)), &exponent);
+    scale = std::ldexp(1.0, exponent);
+    sum = 0.0;
+    sum_sq = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double v = static_cast<double>(values[i]) / scale;
+      sum += v;
+      sum_sq += v * v;
+    }
+  }
+  const double mean = sum / dn;  // in units of scale
   // Two-pass variance (numpy: mean(|x - mean|^2)) rather than E[x^2] - mean^2, which cancels badly
   // when the spread is small against the mean.
   double sum_dev = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double d = static_cast<double>(values[i]) - mean;
+    const double d = static_cast<double>(values[i]) / scale - mean;
     sum_dev += d * d;
   }
 
@@ -83,13 +100,13 @@ ErrorStatistics<T> compute_statistics(const T* values, std::size_t n, std::vecto
     // The lower middle is the largest element of the left part after nth_element.
     const double lower = static_cast<double>(
         *std::max_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(half)));
-    median = 0.5 * (lower + median);
+    median = 0.5 * lower + 0.5 * median;  // not (lower + median) / 2: that sum can overflow
   }
 
-  out.rmse = static_cast<T>(std::sqrt(sum_sq / dn));
-  out.mean = static_cast<T>(mean);
+  out.rmse = static_cast<T>(std::sqrt(sum_sq / dn) * scale);
+  out.mean = static_cast<T>(mean * scale);
   out.median = static_cast<T>(median);
-  out.std = static_cast<T>(std::sqrt(sum_dev / dn));
+  out.std = static_cast<T>(std::sqrt(sum_dev / dn) * scale);
   out.min = static_cast<T>(lo);
   out.max = static_cast<T>(hi);
   return out;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -304,16 +305,41 @@ Status for_each_soa_block(const C1& points1, const C2& points2, Fn&& fn) {
   }
   return Status::Ok;
 }
+
+/// F divided by a power of two near its largest magnitude (exact: every distance is invariant to the
+/// scale of F, and power-of-two scaling rounds nothing), so that X^2 + Y^2 neither overflows for a
+/// huge F nor underflows for a tiny one. NonFinite for NaN / Inf entries, Degenerate for F = 0 (no
+/// epipolar geometry: every line is undefined).
+template <class T>
+Status normalised_fundamental(const Mat3<T>& F, Mat3<T>* out) {
+  if (!F.allFinite()) return Status::NonFinite;
+  const T m = F.cwiseAbs().maxCoeff();
+  if (!(m > T(0))) return Status::Degenerate;
+  int exponent = 0;
+  std::frexp(m, &exponent);
+  *out = F * std::ldexp(T(1), -exponent);
+  return Status::Ok;
+}
 }  // namespace detail
 
 /// Batch distances of `kind` for corresponding containers; `out` must hold points1.size() values.
-/// Returns InvalidInput (writing nothing) when the sizes differ.
+/// Returns InvalidInput (writing nothing) when the sizes differ, NonFinite when F has a NaN / Inf
+/// entry and Degenerate when F = 0 (every value NaN then: no line is defined). The distances do not depend on the scale
+/// of F, which is normalised first. A value is NaN (or +inf) only where its line is undefined: a
+/// non-finite point or p1 at the epipole. Finite coordinates so large that X^2 + Y^2 overflows (beyond
+/// ~1e19 px in float, ~1e154 in double; no image has them) give an unspecified NaN, +inf or 0.
 template <class T, class C1, class C2>
-Status epipolar_distances(const Mat3<T>& F, const C1& points1, const C2& points2, T* out,
+Status epipolar_distances(const Mat3<T>& F_in, const C1& points1, const C2& points2, T* out,
                           EpipolarDistance kind = EpipolarDistance::PointToLine) {
+  if (points1.size() != points2.size()) return Status::InvalidInput;
+  Mat3<T> F;
+  const Status fs = detail::normalised_fundamental(F_in, &F);
+  if (fs != Status::Ok) {
+    std::fill(out, out + points1.size(), Constants<T>::nan());
+    return fs;
+  }
   if constexpr (detail::is_packed_xy<T, C1>() && detail::is_packed_xy<T, C2>()) {
     if (kind == EpipolarDistance::PointToLine) {
-      if (points1.size() != points2.size()) return Status::InvalidInput;
       if (points1.size() == 0) return Status::Ok;
       detail::point_to_line_packed(F, reinterpret_cast<const T*>(points1.data()),
                                    reinterpret_cast<const T*>(points2.data()), points1.size(), out);
@@ -351,9 +377,20 @@ Status symmetric_epipolar_distances_sq(const Mat3<T>& F, const C1& points1, cons
 
 /// Thresholded labels (1 = seed 003 eq. 3 distance above `threshold_px`) for corresponding containers,
 /// without sqrt or division. `labels` holds points1.size() bytes; `count` (optional) receives the number of 1s.
+/// Statuses as epipolar_distances (F normalised first), and InvalidInput for a threshold that is negative
+/// or not finite (labels all 0 on any failure but a size mismatch). Non-finite points get 0.
 template <class T, class C1, class C2>
-Status label_epipolar(const Mat3<T>& F, const C1& points1, const C2& points2, T threshold_px, std::uint8_t* labels,
-                      std::size_t* count = nullptr) {
+Status label_epipolar(const Mat3<T>& F_in, const C1& points1, const C2& points2, T threshold_px,
+                      std::uint8_t* labels, std::size_t* count = nullptr) {
+  if (count) *count = 0;
+  if (points1.size() != points2.size()) return Status::InvalidInput;
+  Mat3<T> F;
+  Status fs = detail::normalised_fundamental(F_in, &F);
+  if (!(threshold_px >= T(0)) || !std::isfinite(threshold_px)) fs = Status::InvalidInput;
+  if (fs != Status::Ok) {
+    std::fill(labels, labels + points1.size(), std::uint8_t{0});
+    return fs;
+  }
   std::size_t total = 0;
   const Status s = detail::for_each_soa_block<T>(
       points1, points2,

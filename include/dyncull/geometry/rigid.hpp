@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -19,6 +20,12 @@ namespace dyncull {
 struct AlignmentOptions {
   /// Estimate a similarity (monocular trajectories); when false the scale is exactly 1.
   bool estimate_scale = false;
+
+  /// Always Ok: the only field is a flag. Present so every options struct has the same shape.
+  Status validate(std::string* reason = nullptr) const {
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 template <class T>
@@ -85,10 +92,13 @@ struct AlignmentAccumulator {
 /// src and dst are 3xN (any Eigen expression, column i corresponds); weights (optional) points to N
 /// non-negative finite weights. Fails with TooFewPoints below 3 points, Degenerate when the
 /// cross-covariance has rank < 2 (collinear or coincident points), NonFinite on NaN/Inf input.
+/// Finite coordinates near the floating-point limits (squares that overflow or underflow) are aligned
+/// after scaling by the largest magnitude; InvalidInput when the fitted translation itself is not
+/// representable. Every output of an Ok result is finite.
 /// Call it qualified, `dyncull::umeyama(src, dst)`: with two Eigen arguments an unqualified call also
 /// finds Eigen::umeyama by argument-dependent lookup and is ambiguous.
 /// Cost: one pass over the data (3x3 cross-covariance, centred on the first point so far-from-origin
-/// trajectories do not cancel) plus one 3x3 SVD.
+/// trajectories do not cancel) plus one 3x3 SVD; a second, scaled pass only when the first fails.
 template <class DA, class DB>
 AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, const Eigen::MatrixBase<DB>& dst,
                                              const AlignmentOptions& options = {},
@@ -154,7 +164,56 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
       acc.add(src.col(i), dst.col(i), w);
     }
   }
-  return acc.solve(options);
+  result = acc.solve(options);
+  if (result.ok() && result.dst_from_src.R.allFinite() && result.dst_from_src.t.allFinite() &&
+      std::isfinite(result.dst_from_src.scale)) {
+    return result;
+  }
+  if (!result.ok() && result.status != Status::NonFinite && result.status != Status::Degenerate) return result;
+  // Overflowing (or underflowing) moments of finite data: align src / c and dst / c with c the largest
+  // magnitude (a power of two, so the scaling is exact). R and the scale are unchanged by a common
+  // factor; the translation scales by c. Weights are normalised the same way.
+  T c = T(0), wmax = T(0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    c = std::max(c, std::max(src.col(i).cwiseAbs().maxCoeff(), dst.col(i).cwiseAbs().maxCoeff()));
+    if (weights != nullptr) wmax = std::max(wmax, weights[i]);
+  }
+  if (!std::isfinite(c)) {  // NaN fails max, so test the data itself
+    result.status = Status::NonFinite;
+    result.reason = "umeyama: non-finite coordinates in src or dst";
+    return result;
+  }
+  if (!(c > T(0))) return result;  // all points at the origin: the first status (Degenerate) stands
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!src.col(i).allFinite() || !dst.col(i).allFinite()) {
+      result.status = Status::NonFinite;
+      result.reason = "umeyama: non-finite coordinates in src or dst";
+      return result;
+    }
+  }
+  int exponent = 0;
+  std::frexp(c, &exponent);
+  const T inv_c = std::ldexp(T(1), -exponent);
+  T inv_w = T(1);
+  if (weights != nullptr && wmax > T(0)) {
+    std::frexp(wmax, &exponent);
+    inv_w = std::ldexp(T(1), -exponent);
+  }
+  AlignmentAccumulator<T> scaled(src.col(0) * inv_c, dst.col(0) * inv_c);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const T w = weights != nullptr ? weights[i] * inv_w : T(1);
+    scaled.add(src.col(i) * inv_c, dst.col(i) * inv_c, w);
+  }
+  AlignmentResult<T> second = scaled.solve(options);
+  if (!second.ok()) return second;
+  second.dst_from_src.t /= inv_c;
+  if (!second.dst_from_src.t.allFinite() || !second.dst_from_src.R.allFinite() ||
+      !std::isfinite(second.dst_from_src.scale)) {
+    second.status = Status::InvalidInput;
+    second.reason = "umeyama: the aligning translation is beyond the largest finite value (coordinates near the "
+                    "floating-point limit)";
+  }
+  return second;
 }
 
 template <class T>
