@@ -2,13 +2,19 @@
 /// dynamic_vo: RGB-D visual odometry (ORB + LK, PnP-RANSAC against the keyframe's depth) run with
 /// every dyncull culling preset and with no culling, on the synthetic walking sequences or a TUM
 /// directory; prints ATE (000 eq. 6-7), the improvement (m - n) / m (002 eq. 7) and label quality.
+/// --family / --scene pick the scene (sim/families.hpp, sim/scene_keys.hpp); --suite runs every family.
 
+#include "dyncull/sim/families.hpp"
+#include "dyncull/sim/scene_keys.hpp"
+
+#include "vo/ablation.hpp"
 #include "vo/culling.hpp"
 #include "vo/frontend.hpp"
 #include "vo/report.hpp"
 #include "vo/runner.hpp"
 #include "vo/sources.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -17,6 +23,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -34,8 +41,17 @@ struct Args {
   std::vector<std::string> strategies;  // empty: no culling + every preset
   bool list = false;
   bool diagnose = false;
+  bool sequences_set = false, seeds_set = false;
   int depth_edge_radius_px = vo::FrontEndOptions{}.depth_edge_radius_px;
+  std::vector<std::string> families = {"walking"};  // scene families (sim/families.hpp)
+  bool families_set = false;
+  std::string scene;  // key=value,... applied on top of each family
+  int jobs = 1;       // sequences run in parallel
+  bool suite = false;
 };
+
+/// The suite's sequence length: 7 families x 4 motions x 3 seeds stay within about 10 minutes on 2 cores.
+constexpr int kSuiteFrames = 150;
 
 void usage(const char* argv0) {
   std::printf(
@@ -64,8 +80,18 @@ void usage(const char* argv0) {
       "  --depth-edge-radius N  front end: no new corner within N px of a depth step above 5 %% (default 1;\n"
       "                      larger N drops corners whose LK window straddles an occlusion edge)\n"
       "  --diagnose          also print, per strategy, where its labels come from (sim instance, truth,\n"
-      "                      decision, deciding stage)\n",
-      argv0);
+      "                      decision, deciding stage)\n"
+      "  --family LIST       scene families, comma separated (default walking; see below). Each runs with\n"
+      "                      every sequence and seed; with several, a per-family summary table is printed\n"
+      "                      and written (family_summary.md, family_summary.csv)\n"
+      "  --scene K=V[,K=V]   scene keys set on top of each family (keys below), e.g.\n"
+      "                      --scene actors.walking_speed_mps=0.9,miss_rate=0.2,trajectory.xyz_amplitude_m=0.2:0.1:0.2\n"
+      "  --suite             every family x static,xyz,rpy,halfsphere x seeds 1,2,3 at %d frames (unless\n"
+      "                      --family / --sequences / --seeds / --frames say otherwise); prints the summary only\n"
+      "  --jobs N            sequences run in parallel on N threads (default 1)\n"
+      "\nscene families (--family):\n%s"
+      "\nscene keys (--scene; vectors as x:y or x:y:z):\n%s",
+      argv0, kSuiteFrames, sim::format_scene_families().c_str(), sim::format_scene_keys().c_str());
 }
 
 std::vector<std::string> split(const std::string& s) {
@@ -110,8 +136,10 @@ bool parse_args(int argc, char** argv, Args* a) {
     } else if (arg == "--sequences") {
       if (!value(&v)) return false;
       a->sequences = split(v);
+      a->sequences_set = true;
     } else if (arg == "--seeds") {
       if (!value(&v)) return false;
+      a->seeds_set = true;
       a->seeds.clear();
       for (const std::string& item : split(v)) {
         char* end = nullptr;
@@ -137,6 +165,28 @@ bool parse_args(int argc, char** argv, Args* a) {
       if (!value(&a->tum)) return false;
     } else if (arg == "--detections") {
       if (!value(&a->detections)) return false;
+    } else if (arg == "--family") {
+      if (!value(&v)) return false;
+      a->families = split(v);
+      a->families_set = true;
+      for (const std::string& name : a->families) {
+        std::string reason;
+        if (!sim::find_scene_family(name, nullptr, &reason)) {
+          std::fprintf(stderr, "dynamic_vo: --family: %s\n", reason.c_str());
+          return false;
+        }
+      }
+      if (a->families.empty()) {
+        std::fprintf(stderr, "dynamic_vo: --family needs at least one family\n");
+        return false;
+      }
+    } else if (arg == "--scene") {
+      if (!value(&v)) return false;
+      a->scene += (a->scene.empty() ? "" : ",") + v;
+    } else if (arg == "--jobs") {
+      if (!value(&v) || !parse_int(arg, v, 1, 64, &a->jobs)) return false;
+    } else if (arg == "--suite") {
+      a->suite = true;
     } else if (arg == "--quick") {
       a->quick = true;
     } else if (arg == "--diagnose") {
@@ -148,18 +198,38 @@ bool parse_args(int argc, char** argv, Args* a) {
       return false;
     }
   }
+  if (a->suite) {
+    if (!a->families_set) {
+      a->families.clear();
+      for (const sim::SceneFamily& f : sim::scene_families()) a->families.push_back(f.name);
+      a->families_set = true;
+    }
+    if (!a->frames_set && !a->quick) a->frames = kSuiteFrames;
+  }
   if (a->quick && !a->frames_set) a->frames = 60;
+  // A bad key or value stops here, before any run: the message names the key and what it expects.
+  for (const std::string& name : a->families) {
+    sim::SceneFamily f;
+    sim::find_scene_family(name, &f);
+    std::string reason;
+    if (sim::apply_scene_assignments(&f.options, a->scene, &reason) != Status::Ok) {
+      std::fprintf(stderr, "dynamic_vo: --scene (family %s): %s\n", name.c_str(), reason.c_str());
+      return false;
+    }
+  }
   return true;
 }
 
 bool motion_from_name(const std::string& name, sim::CameraMotion* m) {
-  if (name == "static") *m = sim::CameraMotion::Static;
-  else if (name == "xyz") *m = sim::CameraMotion::Xyz;
-  else if (name == "rpy") *m = sim::CameraMotion::Rpy;
-  else if (name == "halfsphere") *m = sim::CameraMotion::Halfsphere;
-  else return false;
-  return true;
+  return sim::camera_motion_from_string(name, m);
 }
+
+/// One synthetic sequence of the run: a family's scene with one motion and seed.
+struct SimJob {
+  std::string family, sequence, name;
+  std::uint64_t seed = 0;
+  sim::SceneOptions options;
+};
 
 }  // namespace
 
@@ -168,6 +238,7 @@ int main(int argc, char** argv) {
   if (!parse_args(argc, argv, &args)) return 2;
 
   std::vector<vo::StrategySpec> all = vo::all_strategies();
+  for (const vo::StrategySpec& s : vo::ablation_strategies()) all.push_back(s);
   if (args.list) {
     for (const auto& s : all)
       std::printf("%-26s %s%s%s\n", s.name.c_str(), s.description.c_str(),
@@ -237,31 +308,66 @@ int main(int argc, char** argv) {
     reports.push_back(std::move(rep));
   } else {
     for (const std::string& seq : args.sequences) {
-      sim::SceneOptions so;
-      if (!motion_from_name(seq, &so.motion)) {
+      sim::CameraMotion m{};
+      if (!motion_from_name(seq, &m)) {
         std::fprintf(stderr, "dynamic_vo: unknown sequence '%s' (static, xyz, rpy, halfsphere)\n", seq.c_str());
         return 2;
       }
     }
-    for (const std::string& seq : args.sequences) {
-      for (const std::uint64_t seed : args.seeds) {
-        sim::SceneOptions so;
-        motion_from_name(seq, &so.motion);
-        so.num_frames = args.frames;
-        so.seed = seed;
-        vo::SimSource source(so);
-        vo::SequenceReport rep;
-        rep.sequence = seq;
-        rep.seed = seed;
-        std::string error;
-        const std::string name = args.seeds.size() > 1 ? seq + "-s" + std::to_string(seed) : seq;
-        if (!vo::run_sequence(name, source, chosen, ro, &rep, &error)) {
-          std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
-          return 1;
+    std::vector<SimJob> jobs;
+    for (const std::string& family : args.families) {
+      sim::SceneFamily f;
+      sim::find_scene_family(family, &f);
+      sim::apply_scene_assignments(&f.options, args.scene);  // checked in parse_args
+      for (const std::string& seq : args.sequences) {
+        for (const std::uint64_t seed : args.seeds) {
+          SimJob job;
+          job.family = family;
+          job.sequence = seq;
+          job.seed = seed;
+          job.options = f.options;
+          motion_from_name(seq, &job.options.motion);
+          job.options.num_frames = args.frames;
+          job.options.seed = seed;
+          job.name = (args.families_set ? family + "-" : std::string()) + seq +
+                     (args.seeds.size() > 1 ? "-s" + std::to_string(seed) : std::string());
+          jobs.push_back(std::move(job));
         }
-        vo::evaluate_against_recorded_truth(&rep, ro);
-        reports.push_back(std::move(rep));
       }
+    }
+    // Several families: one line per finished sequence instead of the per-frame progress.
+    const bool quiet = args.families.size() > 1;
+    if (quiet) ro.print_progress = false;
+    std::vector<vo::SequenceReport> done(jobs.size());
+    std::vector<std::string> errors(jobs.size());
+    std::atomic<std::size_t> next{0}, finished{0};
+    auto worker = [&]() {
+      for (std::size_t k = next++; k < jobs.size(); k = next++) {
+        const auto started = std::chrono::steady_clock::now();
+        vo::SimSource source(jobs[k].options);
+        vo::SequenceReport& rep = done[k];
+        rep.family = jobs[k].family;
+        rep.sequence = jobs[k].sequence;
+        rep.seed = jobs[k].seed;
+        if (!vo::run_sequence(jobs[k].name, source, chosen, ro, &rep, &errors[k])) continue;
+        vo::evaluate_against_recorded_truth(&rep, ro);
+        if (quiet)
+          std::printf("[%zu/%zu] %s: %.0f s\n", ++finished, jobs.size(), jobs[k].name.c_str(),
+                      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+        std::fflush(stdout);
+      }
+    };
+    std::vector<std::thread> threads;
+    const int n_threads = std::min<int>(args.jobs, static_cast<int>(jobs.size()));
+    for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker);
+    worker();
+    for (std::thread& t : threads) t.join();
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+      if (!errors[k].empty()) {
+        std::fprintf(stderr, "dynamic_vo: %s\n", errors[k].c_str());
+        return 1;
+      }
+      reports.push_back(std::move(done[k]));
     }
   }
 
@@ -269,8 +375,20 @@ int main(int argc, char** argv) {
   std::ostringstream cmd;
   for (int i = 0; i < argc; ++i) cmd << (i ? " " : "") << argv[i];
   std::string table = vo::format_table(reports, cmd.str(), seconds);
-  if (args.tum.empty() && args.seeds.size() > 1) table += "\n" + vo::format_seed_summary(reports);
-  std::printf("\n%s", table.c_str());
+  const bool several_families = args.tum.empty() && args.families.size() > 1;
+  if (args.tum.empty() && args.seeds.size() > 1 && !several_families) table += "\n" + vo::format_seed_summary(reports);
+  std::string summary;
+  if (args.tum.empty() && args.families_set) {
+    const std::vector<vo::FamilyStrategySummary> rows = vo::summarise_families(reports);
+    summary = vo::format_family_summary(rows);
+    summary += "\nCommand: `" + cmd.str() + "` (" + vo::fmt(seconds, "%.0f") + " s, " + std::to_string(args.frames) +
+               " frames a sequence)\n";
+    std::ofstream(args.out + "/family_summary.md") << summary;
+    std::ofstream(args.out + "/family_summary.csv") << vo::family_summary_csv(rows);
+    table = summary + "\n" + table;
+  }
+  // Several families: the summary alone on screen (the per-sequence table is in results.md).
+  std::printf("\n%s", several_families ? summary.c_str() : table.c_str());
   if (args.diagnose) {
     for (const auto& r : reports)
       for (const auto& run : r.runs)
@@ -281,7 +399,15 @@ int main(int argc, char** argv) {
   const std::string md = args.out + "/results.md";
   std::ofstream(md) << table;
   std::printf("\nwrote %s\n", md.c_str());
-  for (const auto& r : reports)
-    for (const auto& f : r.files) std::printf("wrote %s\n", f.c_str());
+  if (!summary.empty())
+    std::printf("wrote %s/family_summary.md\nwrote %s/family_summary.csv\n", args.out.c_str(), args.out.c_str());
+  std::size_t files = 0;
+  for (const auto& r : reports) {
+    for (const auto& f : r.files) {
+      if (!several_families) std::printf("wrote %s\n", f.c_str());
+      ++files;
+    }
+  }
+  if (several_families) std::printf("wrote %zu trajectory files and images under %s\n", files, args.out.c_str());
   return 0;
 }

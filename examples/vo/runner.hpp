@@ -59,6 +59,7 @@ struct StrategyRun {
 
 struct SequenceReport {
   std::string name;
+  std::string family;      ///< sim: the scene family (sim/families.hpp)
   std::string sequence;    ///< sim: the camera motion (name adds the seed when several run)
   std::uint64_t seed = 0;  ///< sim: SceneOptions::seed
   bool has_label_truth = false;
@@ -339,6 +340,174 @@ inline std::string format_seed_summary(const std::vector<SequenceReport>& report
   }
   o << "\nMedian over the seeds of each sequence; improvement = median of the per-seed (m-n)/m; labels pooled over"
        " the seeds' frames.\n";
+  return o.str();
+}
+
+namespace detail {
+/// Median of the finite values, NaN when there are none.
+inline double median_of(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t h = v.size() / 2;
+  return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+}  // namespace detail
+
+/// One strategy over a family's runs (all motions, or one motion): median ATE over its sequences
+/// (motions x seeds), labels and times pooled.
+struct FamilyStrategySummary {
+  std::string family;
+  std::string motion;  ///< "all", or the camera motion
+  std::string strategy;
+  bool culls = false, recommended = false, oracle = false;  ///< as the strategy's StrategySpec
+  std::size_t runs = 0;
+  double median_ate_m = std::numeric_limits<double>::quiet_NaN();
+  double median_improvement = std::numeric_limits<double>::quiet_NaN();  ///< of the per-run (m - n) / m
+  LabelCounts labels;
+  double cull_ms = 0, front_end_ms = 0;
+  std::size_t frames = 0;
+  double cull_over_front_end() const { return front_end_ms > 0 ? cull_ms / front_end_ms : std::numeric_limits<double>::quiet_NaN(); }
+};
+
+/// Per family (in order of appearance), per motion ("all" first) and per strategy (in run order).
+inline std::vector<FamilyStrategySummary> summarise_families(const std::vector<SequenceReport>& reports) {
+  std::vector<std::string> families, motions;
+  auto add_unique = [](std::vector<std::string>& v, const std::string& x) {
+    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+  };
+  std::vector<const StrategySpec*> specs;
+  for (const SequenceReport& r : reports) {
+    add_unique(families, r.family);
+    add_unique(motions, r.sequence);
+    for (const StrategyRun& run : r.runs)
+      if (std::none_of(specs.begin(), specs.end(), [&](const StrategySpec* s) { return s->name == run.spec.name; }))
+        specs.push_back(&run.spec);
+  }
+  motions.insert(motions.begin(), "all");
+  std::vector<FamilyStrategySummary> out;
+  for (const std::string& family : families) {
+    for (const std::string& motion : motions) {
+      for (const StrategySpec* spec_ptr : specs) {
+        const StrategySpec& spec = *spec_ptr;
+        FamilyStrategySummary s;
+        s.family = family;
+        s.motion = motion;
+        s.strategy = spec.name;
+        s.culls = spec.culls;
+        s.recommended = spec.recommended;
+        s.oracle = spec.oracle;
+        std::vector<double> ate, improvement;
+        for (const SequenceReport& r : reports) {
+          if (r.family != family || (motion != "all" && r.sequence != motion)) continue;
+          double reference = std::numeric_limits<double>::quiet_NaN();
+          for (const StrategyRun& x : r.runs)
+            if (!x.spec.culls && x.has_ate) reference = x.ate_rmse_m;
+          for (const StrategyRun& run : r.runs) {
+            if (run.spec.name != spec.name) continue;
+            ++s.runs;
+            const double a = run.has_ate ? run.ate_rmse_m : std::numeric_limits<double>::quiet_NaN();
+            ate.push_back(a);
+            if (run.spec.culls && reference > 0) improvement.push_back((reference - a) / reference);
+            if (r.has_label_truth) s.labels += run.labels;
+            s.cull_ms += run.cull_ms;
+            s.front_end_ms += run.front_end_ms;
+            s.frames += run.frames;
+          }
+        }
+        if (s.runs == 0) continue;
+        s.median_ate_m = detail::median_of(ate);
+        s.median_improvement = detail::median_of(improvement);
+        out.push_back(s);
+      }
+    }
+  }
+  return out;
+}
+
+/// Per family: the median ATE (cm, over motions x seeds) of every strategy that ran, the recommended
+/// preset's ATE over the oracle's and over no culling's (ratios of the medians; "worst motion": the
+/// largest recommended / oracle ratio of one motion's medians over its seeds), its label precision and
+/// recall (pooled over the family's runs) and its culling time over the front end's.
+inline std::string format_family_summary(const std::vector<FamilyStrategySummary>& rows) {
+  std::vector<std::string> families, strategies;
+  for (const FamilyStrategySummary& r : rows) {
+    if (r.motion != "all") continue;
+    if (std::find(families.begin(), families.end(), r.family) == families.end()) families.push_back(r.family);
+    if (std::find(strategies.begin(), strategies.end(), r.strategy) == strategies.end())
+      strategies.push_back(r.strategy);
+  }
+  auto find = [&](const std::string& family, const std::string& motion, auto pred) -> const FamilyStrategySummary* {
+    for (const FamilyStrategySummary& r : rows)
+      if (r.family == family && r.motion == motion && pred(r)) return &r;
+    return nullptr;
+  };
+  auto is_rec = [](const FamilyStrategySummary& s) { return s.recommended; };
+  auto is_oracle = [](const FamilyStrategySummary& s) { return s.oracle; };
+  auto is_none = [](const FamilyStrategySummary& s) { return !s.culls; };
+  auto ratio = [](const FamilyStrategySummary* a, const FamilyStrategySummary* b) {
+    return a && b && b->median_ate_m > 0 ? a->median_ate_m / b->median_ate_m : std::numeric_limits<double>::quiet_NaN();
+  };
+  std::ostringstream o;
+  o << "| family | runs |";
+  for (const std::string& name : strategies) o << " " << name << " |";
+  o << " rec / oracle | worst motion | rec / none | dyn. precision | dyn. recall | cull / front end |\n|---|---|";
+  for (std::size_t k = 0; k < strategies.size(); ++k) o << "---|";
+  o << "---|---|---|---|---|---|\n";
+  for (const std::string& family : families) {
+    const FamilyStrategySummary* rec = find(family, "all", is_rec);
+    const FamilyStrategySummary* oracle = find(family, "all", is_oracle);
+    const FamilyStrategySummary* none = find(family, "all", is_none);
+    std::size_t runs = 0;
+    for (const FamilyStrategySummary& r : rows)
+      if (r.family == family && r.motion == "all") runs = std::max(runs, r.runs);
+    o << "| " << family << " | " << runs << " |";
+    for (const std::string& name : strategies) {
+      const FamilyStrategySummary* r = find(family, "all", [&](const FamilyStrategySummary& x) { return x.strategy == name; });
+      o << " " << (r ? fmt(r->median_ate_m * 100.0, "%.2f") : "-") << " |";
+    }
+    double worst = std::numeric_limits<double>::quiet_NaN();
+    std::string worst_motion;
+    for (const FamilyStrategySummary& r : rows) {
+      if (r.family != family || r.motion == "all" || !r.recommended) continue;
+      const double q = ratio(&r, find(family, r.motion, is_oracle));
+      if (std::isfinite(q) && !(q <= worst)) {
+        worst = q;
+        worst_motion = r.motion;
+      }
+    }
+    o << " " << fmt(ratio(rec, oracle), "%.2f") << " | "
+      << (worst_motion.empty() ? "-" : fmt(worst, "%.2f") + " (" + worst_motion + ")") << " | "
+      << fmt(ratio(rec, none), "%.2f") << " | " << (rec ? fmt(rec->labels.precision()) : "-") << " | "
+      << (rec ? fmt(rec->labels.recall()) : "-") << " | " << (rec ? fmt(rec->cull_over_front_end()) : "-") << " |\n";
+  }
+  o << "\nATE columns: median ATE RMSE in cm over the family's runs (motions x seeds). rec / oracle and rec / none:"
+       " the recommended preset's median over the oracle's and no culling's; worst motion: the largest recommended /"
+       " oracle ratio of one motion's medians over its seeds. Precision / recall: the recommended preset's dynamic"
+       " labels pooled over the family's runs. cull / front end: its culling time over the front end's.\n";
+  return o.str();
+}
+
+/// The summary, long format, one row per family x motion ("all" = every motion) x strategy, for tools.
+inline std::string family_summary_csv(const std::vector<FamilyStrategySummary>& rows) {
+  std::ostringstream o;
+  o << "family,motion,strategy,recommended,oracle,runs,median_ate_m,median_improvement,precision,recall,"
+       "static_in_boxes_kept,true_positive,false_positive,false_negative,true_negative,cull_ms_per_frame,"
+       "front_end_ms_per_frame,cull_over_front_end\n";
+  auto num = [](double v, const char* f) { return std::isfinite(v) ? fmt(v, f) : std::string(); };
+  for (const FamilyStrategySummary& r : rows) {
+    const bool labels = r.culls && r.labels.true_positive + r.labels.false_positive + r.labels.false_negative +
+                                            r.labels.true_negative > 0;
+    const double frames = r.frames ? static_cast<double>(r.frames) : std::numeric_limits<double>::quiet_NaN();
+    o << r.family << "," << r.motion << "," << r.strategy << "," << (r.recommended ? 1 : 0) << ","
+      << (r.oracle ? 1 : 0) << "," << r.runs << "," << num(r.median_ate_m, "%.6f") << ","
+      << num(r.median_improvement, "%.4f") << "," << (labels ? num(r.labels.precision(), "%.4f") : "") << ","
+      << (labels ? num(r.labels.recall(), "%.4f") : "") << ","
+      << (labels ? num(r.labels.static_in_box_kept_ratio(), "%.4f") : "") << "," << r.labels.true_positive << ","
+      << r.labels.false_positive << "," << r.labels.false_negative << "," << r.labels.true_negative << ","
+      << num(r.cull_ms / frames, "%.4f") << "," << num(r.front_end_ms / frames, "%.3f") << ","
+      << (r.culls ? num(r.cull_over_front_end(), "%.4f") : "") << "\n";
+  }
   return o.str();
 }
 

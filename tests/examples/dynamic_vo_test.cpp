@@ -4,7 +4,9 @@
 
 #ifdef DYNCULL_HAS_OPENCV
 
+#include "../../examples/vo/ablation.hpp"
 #include "../../examples/vo/runner.hpp"
+#include "dyncull/sim/families.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -16,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -413,6 +416,141 @@ TEST(DynamicVo, TumSourceReadsDirectory) {
   EXPECT_FALSE(missing.open((dir / "nope").string(), "", cam, &error));
   EXPECT_NE(error.find("rgb.txt"), std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+
+// Per family: median ATE over its motions x seeds for each strategy, the recommended / oracle and
+// recommended / none ratios of those medians, the worst motion's ratio, and labels pooled over the runs.
+TEST(DynamicVo, FamilySummaryGivesMediansRatiosAndPooledLabels) {
+  const auto all = vo::all_strategies();
+  const vo::StrategySpec* none = find_spec(all, false);
+  const vo::StrategySpec* preset = find_spec(all, true);
+  const auto oracle = std::find_if(all.begin(), all.end(), [](const vo::StrategySpec& s) { return s.oracle; });
+  ASSERT_NE(none, nullptr);
+  ASSERT_NE(preset, nullptr);
+  ASSERT_NE(oracle, all.end());
+  struct Run {
+    const char* family;
+    const char* motion;
+    double none_m, rec_m, oracle_m;
+    std::size_t tp, fp, fn;
+  };
+  const Run runs[] = {
+      {"walking", "xyz", 0.10, 0.020, 0.010, 9, 1, 0},  {"walking", "xyz", 0.20, 0.030, 0.030, 1, 1, 0},
+      {"walking", "rpy", 0.30, 0.040, 0.020, 0, 0, 9},  {"walking", "rpy", 0.05, 0.060, 0.040, 0, 0, 0},
+      {"sitting", "xyz", 0.01, 0.012, 0.010, 5, 5, 0},
+  };
+  std::vector<vo::SequenceReport> reports;
+  for (const Run& r : runs) {
+    vo::SequenceReport rep;
+    rep.family = r.family;
+    rep.sequence = r.motion;
+    rep.has_label_truth = true;
+    rep.runs.resize(3);
+    rep.runs[0].spec = *none;
+    rep.runs[1].spec = *preset;
+    rep.runs[2].spec = *oracle;
+    const double ate[3] = {r.none_m, r.rec_m, r.oracle_m};
+    for (int k = 0; k < 3; ++k) {
+      rep.runs[static_cast<std::size_t>(k)].has_ate = true;
+      rep.runs[static_cast<std::size_t>(k)].ate_rmse_m = ate[k];
+      rep.runs[static_cast<std::size_t>(k)].frames = 10;
+      rep.runs[static_cast<std::size_t>(k)].front_end_ms = 100;
+    }
+    rep.runs[1].labels.true_positive = r.tp;
+    rep.runs[1].labels.false_positive = r.fp;
+    rep.runs[1].labels.false_negative = r.fn;
+    rep.runs[1].cull_ms = 5;
+    reports.push_back(rep);
+  }
+  const std::vector<vo::FamilyStrategySummary> rows = vo::summarise_families(reports);
+  // walking: all + xyz + rpy, sitting: all + xyz; three strategies each.
+  ASSERT_EQ(rows.size(), (3u + 2u) * 3u);
+  const std::string table = vo::format_family_summary(rows);
+  // walking medians: none 0.075 / 0.20 / 0.30 / 0.05 -> 0.15 m; recommended 0.035 m; oracle 0.025 m.
+  // Ratios 1.40 and 0.23; worst motion rpy: median 0.05 over 0.03 = 1.67 (xyz: 0.025 / 0.02 = 1.25).
+  // Pooled labels: precision 10 / 12, recall 10 / 19.
+  EXPECT_NE(table.find("| walking | 4 | 15.00 | 3.50 | 2.50 | 1.40 | 1.67 (rpy) | 0.23 | 0.833 | 0.526 | 0.050 |"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("| sitting | 1 | 1.00 | 1.20 | 1.00 | 1.20 | 1.20 (xyz) | 1.20 | 0.500 | 1.000 |"), std::string::npos)
+      << table;
+  const std::string csv = vo::family_summary_csv(rows);
+  EXPECT_EQ(csv.rfind("family,motion,strategy,", 0), 0u) << csv;
+  EXPECT_NE(csv.find("\nwalking,all,recommended,1,0,4,0.035000,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nwalking,rpy,oracle,0,1,2,0.030000,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nsitting,all,none,0,0,1,0.010000,,"), std::string::npos) << csv;
+  std::size_t lines = 0;
+  for (char c : csv) lines += c == '\n' ? 1 : 0;
+  EXPECT_EQ(lines, rows.size() + 1);
+}
+
+// The fields the ablation switches touch, as text: each switch must change it (a switch that changes
+// nothing, because the preset came to use the library default, is dead and should go).
+std::string ablated_fields(const vo::StrategySpec& s) {
+  const PipelineOptions<float>& o = s.pipeline;
+  std::ostringstream t;
+  t << o.use_detection_filter << o.use_box_tracker << o.use_box_rule << o.use_depth_mask << o.use_moving_consistency
+    << o.use_reprojection << o.use_subbox << o.use_coherent_motion << o.static_history.min_frames << o.survivor_guard
+    << s.tracks_from_keyframe << static_cast<int>(o.depth_mask.missing_depth) << " " << o.depth_mask.eps_m << " "
+    << o.moving.max_epipolar_distance_in_boxes_px << " " << o.reprojection.max_depth_residual_sigmas << " "
+    << o.assign_overlaps_by_depth << " " << o.overlap_high_level_margin_m << " " << o.low_override_by_depth << " "
+    << o.edge_evidence_radius_px << " " << o.subbox.object_mask_votes_only << o.subbox.static_needs_evidence
+    << o.subbox_verifies_candidates << " " << o.min_evidence_frames << o.short_baseline_keeps_last_vote
+    << o.cull_geometric_outside_boxes;
+  return t.str();
+}
+
+TEST(DynamicVo, AblationStrategiesEachUndoOneThingOfTheRecommendedPreset) {
+  const auto all = vo::all_strategies();
+  const vo::StrategySpec* preset = find_spec(all, true);
+  ASSERT_NE(preset, nullptr);
+  const std::vector<vo::StrategySpec> ablations = vo::ablation_strategies();
+  ASSERT_EQ(ablations.size(), vo::ablation_switches().size());
+  std::set<std::string> names;
+  for (const vo::StrategySpec& s : all) names.insert(s.name);
+  std::set<std::string> changed;
+  for (const vo::StrategySpec& s : ablations) {
+    EXPECT_EQ(s.name.rfind("recommended-no_", 0), 0u) << s.name;
+    EXPECT_TRUE(names.insert(s.name).second) << "duplicate strategy " << s.name;
+    EXPECT_FALSE(s.in_default) << s.name;
+    EXPECT_FALSE(s.recommended) << s.name;
+    EXPECT_TRUE(s.culls) << s.name;
+    EXPECT_FALSE(s.needs_truth()) << s.name;
+    const std::string fields = ablated_fields(s);
+    EXPECT_NE(fields, ablated_fields(*preset)) << s.name << " changes nothing";
+    EXPECT_TRUE(changed.insert(fields).second) << s.name << " repeats another switch";
+  }
+  for (const char* stage : {"recommended-no_depth_mask", "recommended-no_subbox", "recommended-no_static_history",
+                            "recommended-no_reprojection", "recommended-no_keyframe_tracks"})
+    EXPECT_TRUE(names.count(stage)) << stage;
+}
+
+// A family's scene runs through the demo unchanged: the sitting family, 12 frames, no culling and the preset.
+TEST(DynamicVo, FamilySceneRunsThroughTheFrontEnd) {
+  sim::SceneFamily family;
+  ASSERT_TRUE(sim::find_scene_family("sitting", &family));
+  sim::SceneOptions so = family.options;
+  ASSERT_EQ(sim::apply_scene_assignments(&so, "motion=rpy,num_frames=12,seed=4"), Status::Ok);
+  const auto all = vo::all_strategies();
+  vo::SimSource source(so);
+  vo::RunnerOptions ro;
+  ro.max_frames = 12;
+  ro.write_outputs = false;
+  ro.print_progress = false;
+  vo::SequenceReport report;
+  report.family = family.name;
+  std::string error;
+  ASSERT_TRUE(vo::run_sequence("sitting-rpy", source, {*find_spec(all, false), *find_spec(all, true)}, ro, &report,
+                               &error))
+      << error;
+  vo::evaluate_against_recorded_truth(&report, ro);
+  ASSERT_EQ(report.runs.size(), 2u);
+  for (const vo::StrategyRun& run : report.runs) {
+    EXPECT_TRUE(run.has_ate) << run.spec.name << ": " << run.ate_note;
+    EXPECT_LT(run.ate_rmse_m, 0.05) << run.spec.name;
+  }
+  EXPECT_GT(report.runs[1].labels.true_positive, 0u) << "the seated person's moving parts are culled";
 }
 
 }  // namespace
