@@ -135,6 +135,27 @@ TYPED_TEST(AteTest, FailuresAreStatusesWithReasons) {
   EXPECT_EQ(evaluate_ate(gt, broken).status, Status::InvalidInput);
 }
 
+TEST(Ate, OptionsValidateNamesTheField) {
+  std::string why;
+  AteOptions o;
+  EXPECT_EQ(o.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  const Trajectory<double> gt = synthetic::make_loop<double>(50);
+  for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
+    AteOptions b;
+    b.association.max_difference_s = bad;
+    EXPECT_EQ(b.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find("association.max_difference_s"), std::string::npos) << why;
+    const AteResult<double> r = evaluate_ate(gt, gt, b);
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_NE(r.reason.find("max_difference_s"), std::string::npos) << r.reason;
+  }
+  AteOptions b;
+  b.association.offset_s = -HUGE_VAL;
+  EXPECT_EQ(b.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("association.offset_s"), std::string::npos) << why;
+}
+
 TYPED_TEST(AteTest, LargeFiniteCoordinatesGiveAFiniteError) {
   using T = TypeParam;
   // Trajectories far beyond a lab (double 1e160, float 1e25): squares overflow, the ATE does not.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <string>
 #include <cstdint>
 #include <vector>
 
@@ -62,6 +63,15 @@ TEST(ScoreLabels, EmptyAndAllStaticAreDefinedSizeMismatchIsAnError) {
   const LabelScores bad = score_labels(zeros, none);
   EXPECT_EQ(bad.status, Status::InvalidInput);
   EXPECT_NE(bad.reason.find("10 predicted"), std::string::npos) << bad.reason;
+}
+
+TEST(ScoreLabels, OptionsAlwaysValidate) {
+  std::string why = "stale";
+  EXPECT_EQ(LabelScoreOptions{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  LabelScoreOptions o;
+  o.candidate_is_dynamic = true;
+  EXPECT_EQ(o.validate(), Status::Ok);
 }
 
 TEST(ScoreMasks, StridedViewsAndValidMask) {

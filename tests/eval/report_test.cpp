@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <clocale>
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -50,6 +51,20 @@ TEST(EvalArgs, BadArgumentsAreReported) {
   EXPECT_EQ(parse({"a", "b", "--delta-unit", "furlongs"}).status, Status::InvalidInput);
   EXPECT_EQ(parse({"a", "b", "--max-difference", "0"}).status, Status::InvalidInput);
   EXPECT_NE(eval_usage().find("FIXED factor"), std::string::npos);  // --scale differs from TUM's
+}
+
+TEST(EvalArgs, NumbersAreReadTheSameInACommaDecimalLocale) {
+  const std::string previous = std::setlocale(LC_NUMERIC, nullptr);
+  bool switched = false;
+  for (const char* l : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8"}) switched = switched || std::setlocale(LC_NUMERIC, l);
+  if (!switched) GTEST_SKIP() << "no comma-decimal locale installed";
+  const auto ok = parse({"a", "b", "--delta", "0.5", "--offset", "-1.25"});
+  const auto comma = parse({"a", "b", "--delta", "0,5"});
+  std::setlocale(LC_NUMERIC, previous.c_str());
+  ASSERT_TRUE(ok.ok()) << ok.reason;
+  EXPECT_EQ(ok.args.delta, 0.5);
+  EXPECT_EQ(ok.args.offset_s, -1.25);
+  EXPECT_EQ(comma.status, Status::InvalidInput);
 }
 
 TEST(EvalRun, MalformedFileGivesFileAndLine) {

@@ -141,6 +141,49 @@ TYPED_TEST(RpeTest, FloatAgreesWithDouble) {
   EXPECT_GT(ref.rotation_deg.rmse, 0.05);
 }
 
+TYPED_TEST(RpeTest, MotionBeyondTheScalarRangeIsReportedNotOkWithInfiniteStatistics) {
+  using T = TypeParam;
+  // Estimate positions alternating between +-0.9 * max: each relative motion is 1.8 * max, beyond T.
+  const Trajectory<T> gt = synthetic::make_loop<T>(40);
+  Trajectory<T> est = gt;
+  for (std::size_t i = 0; i < est.size(); ++i) {
+    est.poses[i].t = Vec3<T>(std::numeric_limits<T>::max() * T(i % 2 ? 0.9 : -0.9), T(0), T(0));
+  }
+  RpeOptions o;
+  o.delta = 1;
+  o.delta_unit = DeltaUnit::Frames;
+  const RpeResult<T> r = evaluate_rpe(gt, est, o);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("translation"), std::string::npos) << r.reason;
+}
+
+TEST(Rpe, OptionsValidateNamesTheField) {
+  std::string why;
+  RpeOptions o;
+  EXPECT_EQ(o.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  const Trajectory<double> gt = synthetic::make_loop<double>(50);
+  auto expect_field = [&](const RpeOptions& bad, const char* field) {
+    EXPECT_EQ(bad.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+    const RpeResult<double> r = evaluate_rpe(gt, gt, bad);
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+  };
+  RpeOptions bad = o;
+  bad.delta = -1;
+  expect_field(bad, "delta");
+  bad = o;
+  bad.scale = std::numeric_limits<double>::infinity();
+  expect_field(bad, "scale");
+  bad = o;
+  bad.offset_s = std::nan("");
+  expect_field(bad, "offset_s");
+  bad = o;
+  bad.delta_unit = static_cast<DeltaUnit>(42);
+  expect_field(bad, "delta_unit");
+}
+
 TEST(Rpe, FixedScaleMultipliesEstimateMotions) {
   Trajectory<double> gt, est;
   make_drifting_pair<double>(50, 30.0, Vec3<double>(0.01, 0, 0), Vec3<double>::Zero(), 0.0, &gt, &est);

@@ -25,6 +25,19 @@ struct AteOptions {
   /// Fit a similarity (scale too): for monocular estimates. evaluate_ate.py's --scale is instead a
   /// fixed factor given by the user; a fitted scale gives the lower bound of the error over scales.
   bool estimate_scale = false;
+
+  /// Ok, or InvalidInput with a reason naming the field (the association window's own checks).
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(association.max_difference_s > 0.0) || !std::isfinite(association.max_difference_s))
+      return bad("AteOptions: association.max_difference_s must be positive and finite");
+    if (!std::isfinite(association.offset_s)) return bad("AteOptions: association.offset_s must be finite");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 template <class T>
@@ -94,6 +107,14 @@ template <class T>
 AteResult<T> evaluate_ate(const Trajectory<T>& groundtruth, const Trajectory<T>& estimate,
                           const AteOptions& options = {}) {
   AteResult<T> result;
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) {
+      result.status = Status::InvalidInput;
+      result.reason = "ate: " + why;
+      return result;
+    }
+  }
   if (groundtruth.stamps.size() != groundtruth.poses.size() || estimate.stamps.size() != estimate.poses.size()) {
     result.status = Status::InvalidInput;
     result.reason = "ate: a trajectory has different numbers of stamps and poses";

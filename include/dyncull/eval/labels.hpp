@@ -58,6 +58,12 @@ struct LabelScoreOptions {
   /// How a FeatureLabel::Candidate counts: false = static (only Dynamic features are culled), true =
   /// dynamic (a pipeline that culls candidates too).
   bool candidate_is_dynamic = false;
+
+  /// Always Ok: the only field is a flag. Present so every options struct has the same shape.
+  Status validate(std::string* reason = nullptr) const {
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 namespace detail {
@@ -74,7 +80,8 @@ bool label_is_dynamic(const V& value, const LabelScoreOptions&) {
 
 /// Scores per-feature labels. predicted and truth: containers with size() and operator[] of bool,
 /// uint8 / int (non-zero = dynamic) or FeatureLabel, e.g. std::vector<std::uint8_t> and the labels of a
-/// culling result. InvalidInput when the sizes differ (counts then stay zero).
+/// culling result. InvalidInput when the sizes differ (counts then stay zero). The options are not
+/// validated: a flag cannot be out of range (LabelScoreOptions::validate is always Ok).
 template <class Predicted, class Truth>
 LabelScores score_labels(const Predicted& predicted, const Truth& truth, const LabelScoreOptions& options = {}) {
   LabelScores scores;

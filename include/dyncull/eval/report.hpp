@@ -4,6 +4,7 @@
 #pragma once
 
 #include "dyncull/core/status.hpp"
+#include "dyncull/core/text.hpp"
 #include "dyncull/eval/ate.hpp"
 #include "dyncull/eval/rpe.hpp"
 #include "dyncull/eval/statistics.hpp"
@@ -79,11 +80,13 @@ inline std::string eval_usage(const std::string& program = "dyncull_eval") {
 }
 
 namespace detail {
-inline bool parse_number_arg(const std::string& text, double* out) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  *out = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && std::isfinite(*out);
+/// A finite number in Python's float() grammar, whatever the C locale (strtod would read "0,5" under a
+/// comma-decimal locale and reject "0.5").
+inline bool parse_number_arg(const std::string& arg, double* out) {
+  double v = 0.0;
+  if (dyncull::text::parse_python_float(arg, &v) != text::NumberStatus::Ok || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
 }
 
 inline bool parse_delta_unit(const std::string& text, DeltaUnit* out) {

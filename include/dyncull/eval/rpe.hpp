@@ -43,6 +43,29 @@ struct RpeOptions {
   /// Fixed factor on the estimate's relative translations (evaluate_rpe.py --scale); set it to the
   /// ATE Sim(3) scale to evaluate a monocular estimate.
   double scale = 1.0;
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(delta > 0.0) || !std::isfinite(delta)) return bad("RpeOptions: delta must be positive and finite");
+    switch (delta_unit) {
+      case DeltaUnit::Frames:
+      case DeltaUnit::Seconds:
+      case DeltaUnit::Metres:
+      case DeltaUnit::Radians:
+      case DeltaUnit::Degrees:
+        break;
+      default:
+        return bad("RpeOptions: delta_unit is not one of the DeltaUnit values");
+    }
+    if (!std::isfinite(offset_s)) return bad("RpeOptions: offset_s must be finite");
+    if (!std::isfinite(scale)) return bad("RpeOptions: scale must be finite");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// One compared pair. Indices point into the caller's trajectories (not the sorted order).
@@ -131,9 +154,9 @@ RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>&
   if (groundtruth.stamps.size() != groundtruth.poses.size() || estimate.stamps.size() != estimate.poses.size()) {
     return fail(Status::InvalidInput, "a trajectory has different numbers of stamps and poses");
   }
-  if (!(options.delta > 0.0) || !std::isfinite(options.delta) || !std::isfinite(options.offset_s) ||
-      !std::isfinite(options.scale)) {
-    return fail(Status::InvalidInput, "delta must be positive and finite, offset_s and scale finite");
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, why);
   }
   std::vector<std::uint32_t> gt_order;
   std::vector<std::uint32_t> est_order;
@@ -234,6 +257,12 @@ RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>&
     pair.groundtruth_j = gt_order[gj];
     pair.translation_m = static_cast<T>(error.t.norm());
     pair.rotation_deg = static_cast<T>(detail::relative_rotation_angle_rad<T>(error.R) * Constants<double>::rad_to_deg());
+    if (!std::isfinite(pair.translation_m) || !std::isfinite(pair.rotation_deg)) {
+      // Finite poses whose relative motion leaves the range of T (or of double): no error to report.
+      return fail(Status::InvalidInput, "the translation error of the pair from estimate pose " +
+                                            std::to_string(est_order[i]) + " is beyond the range of the scalar type "
+                                            "(positions near the floating-point limit)");
+    }
     trans.push_back(pair.translation_m);
     rot.push_back(pair.rotation_deg);
     result.pairs.push_back(pair);
@@ -247,6 +276,9 @@ RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>&
   }
   result.translation_m = compute_statistics(trans.data(), trans.size());
   result.rotation_deg = compute_statistics(rot.data(), rot.size());
+  for (const ErrorStatistics<T>* s : {&result.translation_m, &result.rotation_deg}) {
+    if (!s->ok()) return fail(s->status, s->reason);
+  }
   return result;
 }
 
