@@ -4,9 +4,22 @@
 set -euo pipefail
 
 packages=(g++ clang cmake make pkg-config libeigen3-dev libopencv-dev libceres-dev
-          libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev)
+          libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev locales)
 # Open3D is an optional benchmark peer (ICP); set DYNCULL_WITH_OPEN3D=1 to install it.
 if [[ "${DYNCULL_WITH_OPEN3D:-0}" == 1 ]]; then packages+=(libopen3d-dev); fi
+
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+
+# The parser tests and fuzz targets run under a comma-decimal locale (de_DE.UTF-8) to show that the
+# number parsing ignores the locale; they skip loudly without it.
+ensure_comma_locale() {
+  if locale -a 2>/dev/null | grep -qiE '^de_DE\.utf-?8$'; then return 0; fi
+  [[ -f /etc/locale.gen ]] && command -v locale-gen >/dev/null || return 0
+  echo "install-deps: generating the de_DE.UTF-8 locale"
+  grep -q '^de_DE.UTF-8 UTF-8' /etc/locale.gen || echo 'de_DE.UTF-8 UTF-8' | "${sudo_cmd[@]}" tee -a /etc/locale.gen >/dev/null
+  "${sudo_cmd[@]}" locale-gen >/dev/null
+}
 
 missing=()
 for p in "${packages[@]}"; do
@@ -14,10 +27,10 @@ for p in "${packages[@]}"; do
 done
 if ((${#missing[@]} == 0)); then
   echo "install-deps: all ${#packages[@]} packages present"
+  ensure_comma_locale
   exit 0
 fi
-sudo_cmd=()
-if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
 echo "install-deps: installing ${missing[*]}"
 "${sudo_cmd[@]}" apt-get update -qq
 DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+ensure_comma_locale

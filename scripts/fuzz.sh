@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz/*_fuzz.cpp, clang++ with ASan + UBSan) in build/fuzz and
+# runs each for a bounded time from its checked-in seed corpus tests/fuzz/corpus/<name>/, printing the
+# number of executions per target. Exit status 1 when a target found a crash, a leak, a timeout or a
+# broken invariant; the input is saved as build/fuzz/crashes/<name>-crash-<sha1> (add it to the seed
+# corpus or turn it into a regression test once fixed).
+#   scripts/fuzz.sh [seconds per target]     (default 60; also DYNCULL_FUZZ_SECONDS)
+#   DYNCULL_FUZZ_TARGETS="tum yolo"          run only these targets
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+seconds=${1:-${DYNCULL_FUZZ_SECONDS:-60}}
+jobs=${DYNCULL_JOBS:-$(nproc)}
+build="$root/build/fuzz"
+cxx=$(command -v clang++ || true)
+if [[ -z "$cxx" ]]; then
+  echo "fuzz.sh: clang++ not found (libFuzzer needs clang)" >&2
+  exit 2
+fi
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="" -DCMAKE_CXX_COMPILER="$cxx" \
+  -DDYNCULL_WERROR=ON -DDYNCULL_BUILD_FUZZERS=ON -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_BENCHMARKS=OFF \
+  -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=OFF -DDYNCULL_WITH_CERES=OFF >/dev/null
+
+targets=${DYNCULL_FUZZ_TARGETS:-$(cd "$root/tests/fuzz" && ls *_fuzz.cpp | sed 's/_fuzz\.cpp$//')}
+cmake --build "$build" -j "$jobs" --target $(for t in $targets; do printf '%s_fuzz ' "$t"; done)
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+mkdir -p "$build/crashes"
+failed=()
+summary=()
+for t in $targets; do
+  work="$build/corpus/$t"  # new inputs go here; the checked-in seeds are only read
+  mkdir -p "$work"
+  log="$build/$t.log"
+  status=0
+  "$build/tests/fuzz/${t}_fuzz" "$work" "$root/tests/fuzz/corpus/$t" -max_total_time="$seconds" -timeout=10 \
+    -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/crashes/$t-" >"$log" 2>&1 || status=$?
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  line="fuzz: $t: ${execs:-?} executions in ${seconds} s"
+  if ((status != 0)); then
+    line+=" FAILED (exit $status; log $log)"
+    failed+=("$t")
+    grep -E "ERROR|runtime error|fuzz invariant|SUMMARY|Test unit written" "$log" | head -20 >&2 || true
+  fi
+  echo "$line"
+  summary+=("$line")
+done
+printf '%s\n' "${summary[@]}" >"$build/summary.txt"
+if ((${#failed[@]})); then
+  echo "fuzz.sh: failures in: ${failed[*]} (inputs in $build/crashes)" >&2
+  exit 1
+fi
