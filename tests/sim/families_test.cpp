@@ -23,12 +23,18 @@ SceneFamily family(const std::string& name) {
   return f;
 }
 
+bool is_walker(std::uint16_t id) {
+  for (int w = 0; w < 4; ++w)
+    if (id == SceneInstance::walker(w)) return true;
+  return false;
+}
+
 /// Visible pixels of walkers (the instances of walking people) in one frame.
 std::size_t walker_pixels(const FrameData& f, std::vector<float>* depths = nullptr) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < f.instance.size(); ++i) {
     const std::uint16_t id = f.instance[i];
-    if (id != SceneInstance::kWalkerA && id != SceneInstance::kWalkerB) continue;
+    if (!is_walker(id)) continue;
     ++n;
     if (depths && f.depth_m[i] > 0) depths->push_back(f.depth_m[i]);
   }
@@ -46,7 +52,7 @@ TEST(SceneFamilies, TheSuiteNamesItsFamiliesOnce) {
     EXPECT_FALSE(f.description.empty()) << f.name;
     EXPECT_EQ(f.name.find_first_of(", ="), std::string::npos) << f.name << ": must fit in a comma-separated list";
   }
-  for (const char* name : {"walking", "sitting", "far_walker", "brisk", "low_texture", "noisy_detector"})
+  for (const char* name : {"walking", "sitting", "crowd", "far_walker", "brisk", "low_texture", "noisy_detector"})
     EXPECT_TRUE(names.count(name)) << name;
 }
 
@@ -55,7 +61,7 @@ TEST(SceneFamilies, UnknownFamilyIsNamedWithTheKnownOnes) {
   std::string reason;
   EXPECT_FALSE(find_scene_family("Walking", &f, &reason));
   EXPECT_NE(reason.find("'Walking'"), std::string::npos) << reason;
-  EXPECT_NE(reason.find("walking, sitting"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("walking, sitting, crowd"), std::string::npos) << reason;
   EXPECT_TRUE(find_scene_family("brisk", nullptr));
 }
 
@@ -100,26 +106,53 @@ TEST(SceneFamilies, EveryFamilyRendersWithEveryMotion) {
   }
 }
 
-// sitting: nobody walks, the seated person moves and is detected.
-TEST(SceneFamilies, SittingHasASeatedPersonAndNoWalkers) {
+// sitting: nobody walks; two desk people move, are detected, and their boxes cover a large part of the
+// image (fr3/sitting_static: a mean person-box area of 0.55 of the image).
+TEST(SceneFamilies, SittingHasTwoDeskPeopleAndNoWalkers) {
   SceneOptions o = family("sitting").options;
   o.motion = CameraMotion::Static;
   o.num_frames = 30;
-  o.miss_rate = 0;
   const Scene scene(o);
   FrameData frame;
   for (int i : {0, 15, 29}) {
     scene.render(i, &frame);
     ASSERT_TRUE(frame.ok()) << frame.reason;
     EXPECT_EQ(walker_pixels(frame), 0u) << "frame " << i;
-    std::size_t seated_moving = 0;
+    std::size_t moving[2] = {0, 0};
     for (std::size_t p = 0; p < frame.instance.size(); ++p)
-      seated_moving += frame.instance[p] == SceneInstance::kSittingPerson && frame.moving[p] ? 1 : 0;
-    EXPECT_GT(seated_moving, 500u) << "frame " << i;
-    EXPECT_TRUE(std::any_of(frame.detections.begin(), frame.detections.end(),
-                            [](const auto& d) { return d.class_id == CocoClass::kPerson; }))
-        << "frame " << i;
+      for (int k = 0; k < 2; ++k)
+        moving[k] += frame.instance[p] == SceneInstance::kDeskPersonA + k && frame.moving[p] ? 1 : 0;
+    EXPECT_GT(moving[0], 500u) << "frame " << i;
+    EXPECT_GT(moving[1], 500u) << "frame " << i;
+    double person_box_area = 0;
+    for (const auto& d : frame.detections)
+      if (d.class_id == CocoClass::kPerson)
+        person_box_area += (d.box.x1 - d.box.x0) * (d.box.y1 - d.box.y0) / (frame.width * frame.height);
+    EXPECT_GT(person_box_area, 0.3) << "frame " << i;
   }
+  EXPECT_EQ(o.detector.model, DetectorModel::Calibrated);
+}
+
+// crowd: four walkers, at least three of them in view at some frame.
+TEST(SceneFamilies, CrowdHasFourWalkersSeveralInView) {
+  SceneOptions o = family("crowd").options;
+  o.motion = CameraMotion::Static;
+  o.num_frames = 300;
+  const Scene scene(o);
+  FrameData frame;
+  std::set<std::uint16_t> seen;
+  std::size_t most_in_view = 0;
+  for (int i = 0; i < 300; i += 20) {
+    scene.render(i, &frame);
+    ASSERT_TRUE(frame.ok()) << frame.reason;
+    std::set<std::uint16_t> now;
+    for (std::uint16_t id : frame.instance)
+      if (is_walker(id)) now.insert(id);
+    most_in_view = std::max(most_in_view, now.size());
+    seen.insert(now.begin(), now.end());
+  }
+  EXPECT_EQ(seen.size(), 4u);
+  EXPECT_GE(most_in_view, 3u);
 }
 
 // far_walker: one walker, and wherever it is seen it is more than 2 m away (walking: within 2 m).
@@ -138,7 +171,7 @@ TEST(SceneFamilies, FarWalkerIsOneWalkerBeyondTwoMetres) {
       ASSERT_TRUE(frame.ok()) << frame.reason;
       walker_pixels(frame, &depths);
       for (std::uint16_t id : frame.instance)
-        if (id == SceneInstance::kWalkerA || id == SceneInstance::kWalkerB) walkers.insert(id);
+        if (is_walker(id)) walkers.insert(id);
     }
     ASSERT_GT(depths.size(), 1000u) << name << ": the walker is never seen";
     std::sort(depths.begin(), depths.end());
@@ -166,8 +199,7 @@ TEST(SceneFamilies, BriskWalkersMoveFasterThanWalking) {
     for (int i = 10; i < 60; i += 10) {
       scene.render(i, &frame);
       for (std::size_t p = 0; p < frame.instance.size(); ++p)
-        if ((frame.instance[p] == SceneInstance::kWalkerA || frame.instance[p] == SceneInstance::kWalkerB) &&
-            frame.moving[p])
+        if (is_walker(frame.instance[p]) && frame.moving[p])
           mm.push_back(1000.f * frame.motion_m[p]);
     }
     if (mm.empty()) return 0.f;

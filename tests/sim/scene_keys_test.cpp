@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <set>
@@ -40,7 +41,10 @@ std::string other_value(const SceneKey& k, const std::string& current) {
       for (int i = 0; i < n; ++i) s += (i ? ":" : "") + detail::format_number(number(c[i]) + 0.01 * i);
       return s;
     }
-    case SceneKeyType::Motion: return current == "rpy" ? "halfsphere" : "rpy";
+    case SceneKeyType::Enum: {
+      EXPECT_GE(k.choices.size(), 2u) << k.name;
+      return k.choices.front() == current ? k.choices.back() : k.choices.front();
+    }
   }
   return current;
 }
@@ -60,9 +64,10 @@ TEST(SceneKeys, NamesAreUniqueAndDocumented) {
     EXPECT_NE(find_scene_key(name), nullptr) << name;
 }
 
-// SceneOptions has 13 fields of its own, 8 in DepthNoiseOptions, 11 in TrajectoryOptions and 12 in
-// ActorOptions: a field added without a key fails here, so the table cannot silently fall behind.
-TEST(SceneKeys, TableCoversEveryField) { EXPECT_EQ(scene_keys().size(), 13u + 8u + 11u + 12u); }
+// SceneOptions has 13 fields of its own, 8 in DepthNoiseOptions, 12 in TrajectoryOptions (besides the
+// recorded samples, which are data), 15 in ActorOptions and 7 in DetectorModelOptions: a field added
+// without a key fails here, so the table cannot silently fall behind.
+TEST(SceneKeys, TableCoversEveryField) { EXPECT_EQ(scene_keys().size(), 13u + 8u + 12u + 15u + 7u); }
 
 TEST(SceneKeys, EveryKeyRoundTripsItsDefaultAndAnotherValue) {
   for (const SceneKey& k : scene_keys()) {
@@ -154,13 +159,15 @@ TEST(SceneKeys, BadKeysAndValuesAreRejectedWithTheExpectedTypeAndRange) {
       {"seed", "-1", "non-negative integer"},
       {"seed", "18446744073709551616", "non-negative integer"},
       {"actors.sitting_person", "maybe", "true or false"},
-      {"actors.walking_people", "3", "integer [0, 2]"},
+      {"actors.walking_people", "5", "integer [0, 4]"},
+      {"actors.desk_people", "3", "integer [0, 2]"},
+      {"detector.model", "yolo", "one of gaussian|calibrated"},
       {"trajectory.eye_m", "1:2", "x:y:z, each [-100, 100]"},
       {"trajectory.eye_m", "1:2:3:4", "x:y:z, each [-100, 100]"},
       {"trajectory.eye_m", "1:2:300", "x:y:z, each [-100, 100]"},
       {"actors.loop_semi_axes_m", "0.5", "x:y, each [0, 10]"},
       {"actors.texture_scale", "0", "number (0, 100]"},
-      {"motion", "spiral", "one of static|xyz|rpy|halfsphere"},
+      {"motion", "spiral", "one of static|xyz|rpy|halfsphere|recorded"},
   };
   for (const Case& c : cases) {
     SceneOptions o;
@@ -190,6 +197,9 @@ TEST(SceneKeys, AssignmentsEndWithTheSceneValidation) {
   EXPECT_EQ(apply_scene_assignments(&o, "seed=3", &reason), Status::InvalidInput);
   EXPECT_NE(reason.find("fps"), std::string::npos) << reason;
   EXPECT_EQ(apply_scene_assignments(&o, "fps=15", &reason), Status::Ok) << reason;
+  // A recorded motion without a recording: the key is fine, the scene is not.
+  EXPECT_EQ(apply_scene_assignments(&o, "motion=recorded", &reason), Status::InvalidInput);
+  EXPECT_NE(reason.find("recorded"), std::string::npos) << reason;
 }
 
 TEST(SceneKeys, HelpListsEveryKeyWithItsDefault) {
@@ -206,6 +216,12 @@ TEST(SceneKeys, MotionsByName) {
     EXPECT_EQ(back, m);
   }
   CameraMotion m = CameraMotion::Xyz;
+  EXPECT_TRUE(camera_motion_from_string("recorded", &m));
+  EXPECT_EQ(m, CameraMotion::Recorded);
+  const std::vector<CameraMotion> motions = camera_motions();
+  EXPECT_EQ(std::count(motions.begin(), motions.end(), CameraMotion::Recorded), 0)
+      << "camera_motions() lists the motions that need no data";
+  m = CameraMotion::Xyz;
   EXPECT_FALSE(camera_motion_from_string("XYZ", &m));
   EXPECT_EQ(m, CameraMotion::Xyz);
 }

@@ -21,8 +21,8 @@
 namespace dyncull::sim {
 
 /// Value type of a scene key. Vectors are written with colons between components ("0:2.6" or
-/// "0.3:0.15:0.25") so that a comma can separate assignments.
-enum class SceneKeyType { Int, UInt64, Double, Bool, Vec2, Vec3, Motion };
+/// "0.3:0.15:0.25") so that a comma can separate assignments; enums by their to_string() names.
+enum class SceneKeyType { Int, UInt64, Double, Bool, Vec2, Vec3, Enum };
 
 constexpr const char* to_string(SceneKeyType type) noexcept {
   switch (type) {
@@ -32,7 +32,7 @@ constexpr const char* to_string(SceneKeyType type) noexcept {
     case SceneKeyType::Bool: return "true/false";
     case SceneKeyType::Vec2: return "x:y";
     case SceneKeyType::Vec3: return "x:y:z";
-    case SceneKeyType::Motion: return "motion";
+    case SceneKeyType::Enum: return "name";
   }
   return "unknown";
 }
@@ -47,17 +47,20 @@ struct SceneKey {
   double hi = std::numeric_limits<double>::infinity();
   bool lo_open = false;
   std::string help;
+  std::vector<std::string> choices;  ///< Enum: the accepted names
   /// Parses `value` into the field; false (with `reason` naming the key, the expected type and range)
   /// leaves the options unchanged.
   std::function<bool(SceneOptions&, const std::string&, std::string*)> set;
   /// The field's value as text that `set` reads back to the same value.
   std::function<std::string(const SceneOptions&)> get;
 
-  /// "number in (0, 1000]", "integer in [0, 2]", "x:y:z, each in [-100, 100]", "static|xyz|...".
+  /// "number (0, 1000]", "integer [0, 2]", "x:y:z, each [-100, 100]", "one of static|xyz|...".
   inline std::string expected() const;
 };
 
-/// The table, in SceneOptions declaration order (nested structs after the top-level fields).
+/// The table, in SceneOptions declaration order (nested structs after the top-level fields). The recorded
+/// trajectory's samples (trajectory.recorded_stamps_s, recorded_poses) are data, not keys: a caller loads
+/// them from a file (dynamic_vo: a TUM sequence name as the motion).
 inline const std::vector<SceneKey>& scene_keys();
 /// The key named `name`, or nullptr.
 inline const SceneKey* find_scene_key(const std::string& name);
@@ -76,9 +79,9 @@ inline std::string scene_difference(const SceneOptions& options, const SceneOpti
 /// One line per key: "  name  type/range (default value)  help", for --help.
 inline std::string format_scene_keys();
 
-/// The synthetic camera motions by name, in enum order.
+/// The camera motions that need no data (every one but Recorded), in enum order.
 inline std::vector<CameraMotion> camera_motions();
-/// Motion from its to_string() name; false for an unknown name.
+/// Motion from its to_string() name (Recorded included); false for an unknown name.
 inline bool camera_motion_from_string(const std::string& name, CameraMotion* motion);
 
 // ---------------------------------------------------------------------------------------------
@@ -156,12 +159,6 @@ inline bool in_range(double v, const SceneKey& k) {
   return std::isfinite(v) && (k.lo_open ? v > k.lo : v >= k.lo) && v <= k.hi;
 }
 
-inline std::string motion_names() {
-  std::string names;
-  for (const CameraMotion m : camera_motions()) names += (names.empty() ? "" : "|") + std::string(to_string(m));
-  return names;
-}
-
 /// Field accessor: a captureless lambda returning a reference into the options.
 template <class F>
 using FieldRef = F& (*)(SceneOptions&);
@@ -179,7 +176,7 @@ inline bool fail(const SceneKey& k, const std::string& value, std::string* reaso
 
 inline SceneKey number_key(const char* name, FieldRef<double> ref, double lo, double hi, bool lo_open,
                            const char* help) {
-  SceneKey k{name, SceneKeyType::Double, lo, hi, lo_open, help, {}, {}};
+  SceneKey k{name, SceneKeyType::Double, lo, hi, lo_open, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     double v = 0;
     if (!parse_double(text, &v) || !in_range(v, k)) return fail(k, text, reason);
@@ -191,7 +188,7 @@ inline SceneKey number_key(const char* name, FieldRef<double> ref, double lo, do
 }
 
 inline SceneKey int_key(const char* name, FieldRef<int> ref, int lo, int hi, const char* help) {
-  SceneKey k{name, SceneKeyType::Int, static_cast<double>(lo), static_cast<double>(hi), false, help, {}, {}};
+  SceneKey k{name, SceneKeyType::Int, static_cast<double>(lo), static_cast<double>(hi), false, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     long long v = 0;
     if (!parse_whole(text, &v) || !in_range(static_cast<double>(v), k)) return fail(k, text, reason);
@@ -203,7 +200,7 @@ inline SceneKey int_key(const char* name, FieldRef<int> ref, int lo, int hi, con
 }
 
 inline SceneKey uint64_key(const char* name, FieldRef<std::uint64_t> ref, const char* help) {
-  SceneKey k{name, SceneKeyType::UInt64, 0, 18446744073709551615.0, false, help, {}, {}};
+  SceneKey k{name, SceneKeyType::UInt64, 0, 18446744073709551615.0, false, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     unsigned long long v = 0;
     // The stream would read "-1" as 2^64 - 1.
@@ -217,7 +214,7 @@ inline SceneKey uint64_key(const char* name, FieldRef<std::uint64_t> ref, const 
 }
 
 inline SceneKey bool_key(const char* name, FieldRef<bool> ref, const char* help) {
-  SceneKey k{name, SceneKeyType::Bool, 0, 1, false, help, {}, {}};
+  SceneKey k{name, SceneKeyType::Bool, 0, 1, false, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     bool v = false;
     if (!parse_bool(text, &v)) return fail(k, text, reason);
@@ -231,7 +228,7 @@ inline SceneKey bool_key(const char* name, FieldRef<bool> ref, const char* help)
 template <int N>
 SceneKey vector_key(const char* name, FieldRef<Eigen::Matrix<double, N, 1>> ref, double lo, double hi,
                     const char* help) {
-  SceneKey k{name, N == 2 ? SceneKeyType::Vec2 : SceneKeyType::Vec3, lo, hi, false, help, {}, {}};
+  SceneKey k{name, N == 2 ? SceneKeyType::Vec2 : SceneKeyType::Vec3, lo, hi, false, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     double c[N] = {};
     if (!parse_components(text, N, c)) return fail(k, text, reason);
@@ -248,13 +245,18 @@ SceneKey vector_key(const char* name, FieldRef<Eigen::Matrix<double, N, 1>> ref,
   return k;
 }
 
-inline SceneKey motion_key(const char* name, FieldRef<CameraMotion> ref, const char* help) {
-  SceneKey k{name, SceneKeyType::Motion, 0, 0, false, help, {}, {}};
-  k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
-    CameraMotion m{};
-    if (!camera_motion_from_string(text, &m)) return fail(k, text, reason);
-    ref(o) = m;
-    return true;
+template <class E>
+SceneKey enum_key(const char* name, FieldRef<E> ref, const std::vector<E>& values, const char* help) {
+  SceneKey k{name, SceneKeyType::Enum, 0, 0, false, help, {}, {}, {}};
+  for (const E v : values) k.choices.push_back(to_string(v));
+  k.set = [k, ref, values](SceneOptions& o, const std::string& text, std::string* reason) {
+    for (const E v : values) {
+      if (text == to_string(v)) {
+        ref(o) = v;
+        return true;
+      }
+    }
+    return fail(k, text, reason);
   };
   k.get = [ref](const SceneOptions& o) { return std::string(to_string(read_field(ref, o))); };
   return k;
@@ -269,7 +271,10 @@ inline std::vector<SceneKey> make_scene_keys() {
   k.push_back(int_key("height", [](O& o) -> int& { return o.height; }, 1, 8192, "image height, px"));
   k.push_back(number_key("fps", [](O& o) -> double& { return o.fps; }, 0, 1000, true, "frame rate, Hz"));
   k.push_back(int_key("num_frames", [](O& o) -> int& { return o.num_frames; }, 0, 1000000, "frames in the sequence"));
-  k.push_back(motion_key("motion", [](O& o) -> CameraMotion& { return o.motion; }, "camera motion"));
+  k.push_back(enum_key<CameraMotion>("motion", [](O& o) -> CameraMotion& { return o.motion; },
+                                     {CameraMotion::Static, CameraMotion::Xyz, CameraMotion::Rpy,
+                                      CameraMotion::Halfsphere, CameraMotion::Recorded},
+                                     "camera motion (recorded: needs a recorded trajectory)"));
   k.push_back(uint64_key("seed", [](O& o) -> std::uint64_t& { return o.seed; }, "textures, phases, noise, detections"));
   k.push_back(bool_key("depth_noise", [](O& o) -> bool& { return o.depth_noise; }, "Kinect-like depth noise and holes"));
   k.push_back(number_key("box_jitter_px", [](O& o) -> double& { return o.box_jitter_px; }, 0, 1000, false,
@@ -331,8 +336,10 @@ inline std::vector<SceneKey> make_scene_keys() {
   k.push_back(number_key("trajectory.halfsphere_elevation_deg",
                          [](O& o) -> double& { return o.trajectory.halfsphere_elevation_deg; }, 0, 89, false,
                          "halfsphere: elevation swing, deg"));
+  k.push_back(number_key("trajectory.recorded_start_s", [](O& o) -> double& { return o.trajectory.recorded_start_s; },
+                         0, 1e6, false, "recorded: seconds into the recording where frame 0 starts"));
   // Actors.
-  k.push_back(int_key("actors.walking_people", [](O& o) -> int& { return o.actors.walking_people; }, 0, 2,
+  k.push_back(int_key("actors.walking_people", [](O& o) -> int& { return o.actors.walking_people; }, 0, 4,
                       "people walking the elliptic loop"));
   k.push_back(bool_key("actors.sitting_person", [](O& o) -> bool& { return o.actors.sitting_person; },
                        "a person on a chair moving head, torso and arms"));
@@ -357,6 +364,29 @@ inline std::vector<SceneKey> make_scene_keys() {
                          "texture contrast of walls, floor and ceiling"));
   k.push_back(number_key("actors.texture_scale", [](O& o) -> double& { return o.actors.texture_scale; }, 0, 100, true,
                          "multiplies every texture cell size (larger = fewer corners)"));
+  k.push_back(int_key("actors.desk_people", [](O& o) -> int& { return o.actors.desk_people; }, 0, 2,
+                      "people seated at the desk in front of the camera (as in fr3/sitting_*)"));
+  k.push_back(number_key("actors.desk_motion_scale", [](O& o) -> double& { return o.actors.desk_motion_scale; }, 0, 10,
+                         false, "scales the desk people's sway, head turns, gestures and swivels"));
+  k.push_back(bool_key("actors.desk_clutter", [](O& o) -> bool& { return o.actors.desk_clutter; },
+                       "monitors, keyboards, mice, bottle, cup, book and laptop on the desk"));
+  // Detector model.
+  k.push_back(enum_key<DetectorModel>("detector.model", [](O& o) -> DetectorModel& { return o.detector.model; },
+                                      {DetectorModel::Gaussian, DetectorModel::Calibrated},
+                                      "detector noise model (calibrated: as YOLOv8n on TUM fr3)"));
+  k.push_back(number_key("detector.tail_probability", [](O& o) -> double& { return o.detector.tail_probability; }, 0,
+                         1, false, "calibrated: probability of a heavy-tailed box edge jump"));
+  k.push_back(number_key("detector.tail_scale", [](O& o) -> double& { return o.detector.tail_scale; }, 0, 1000, false,
+                         "calibrated: scale of the jumps, in box_jitter_px"));
+  k.push_back(number_key("detector.object_miss_rate", [](O& o) -> double& { return o.detector.object_miss_rate; }, 0,
+                         1, false, "calibrated: extra miss probability of objects other than people and monitors"));
+  k.push_back(number_key("detector.confidence_sd", [](O& o) -> double& { return o.detector.confidence_sd; }, 0, 1,
+                         false, "calibrated: spread of a detection's confidence"));
+  k.push_back(number_key("detector.border_confidence_drop",
+                         [](O& o) -> double& { return o.detector.border_confidence_drop; }, 0, 1, false,
+                         "calibrated: confidence lost by a box cut by the image border"));
+  k.push_back(number_key("detector.min_confidence", [](O& o) -> double& { return o.detector.min_confidence; }, 0, 1,
+                         false, "calibrated: detections below it are dropped"));
   return k;
 }
 
@@ -371,7 +401,11 @@ inline std::string SceneKey::expected() const {
     case SceneKeyType::Vec2:
     case SceneKeyType::Vec3:
       return std::string(to_string(type)) + ", each " + detail::format_range(lo, hi, lo_open);
-    case SceneKeyType::Motion: return "one of " + detail::motion_names();
+    case SceneKeyType::Enum: {
+      std::string names;
+      for (const std::string& c : choices) names += (names.empty() ? "" : "|") + c;
+      return "one of " + names;
+    }
   }
   return "?";
 }
@@ -458,7 +492,9 @@ inline std::vector<CameraMotion> camera_motions() {
 }
 
 inline bool camera_motion_from_string(const std::string& name, CameraMotion* motion) {
-  for (const CameraMotion m : camera_motions()) {
+  std::vector<CameraMotion> all = camera_motions();
+  all.push_back(CameraMotion::Recorded);
+  for (const CameraMotion m : all) {
     if (name == to_string(m)) {
       if (motion) *motion = m;
       return true;
