@@ -1,11 +1,15 @@
 // Tests of core/depth.hpp: uint16 with a scale (TUM 5000 / m), float metres, every "no measurement"
 // case (raw 0, NaN, Inf, negative, outside [min_m, max_m], outside the image) and row strides.
 #include "dyncull/core/depth.hpp"
+#include "dyncull/core/random.hpp"
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <climits>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace {
@@ -80,6 +84,75 @@ TEST(AxialDepthSigma, KinectModelAndItsParameters) {
   EXPECT_NEAR(dyncull::axial_depth_sigma_m(2.4), 0.0012 + 0.0019 * 4.0, 1e-15);
   EXPECT_NEAR(dyncull::axial_depth_sigma_m(3.0f), 0.0012f + 0.0019f * 6.76f, 1e-7f);
   EXPECT_DOUBLE_EQ(dyncull::axial_depth_sigma_m(1.0, 0.001, 0.01, 0.5), 0.001 + 0.01 * 0.25);
+}
+
+TEST(DepthView, ValidateNamesTheBadField) {
+  const std::vector<std::uint16_t> raw(4, 5000);
+  auto view = dyncull::tum_depth_view(raw.data(), 2, 2);
+  std::string why;
+  EXPECT_EQ(view.validate(&why), dyncull::Status::Ok) << why;
+  EXPECT_EQ(dyncull::DepthView<float>{}.validate(), dyncull::Status::Ok);  // no depth image is valid
+  view.units_per_metre = -5000.f;
+  EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  EXPECT_NE(why.find("units_per_metre"), std::string::npos) << why;
+  view.units_per_metre = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  view = dyncull::tum_depth_view(raw.data(), 2, 2);
+  view.stride = 1;
+  EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  EXPECT_NE(why.find("stride"), std::string::npos) << why;
+  view = dyncull::tum_depth_view(raw.data(), 2, 2, 1.f, 0.5f);
+  EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  EXPECT_NE(why.find("max_m"), std::string::npos) << why;
+  view = dyncull::tum_depth_view(raw.data(), 2, 2, -1.f);
+  EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  EXPECT_NE(why.find("min_m"), std::string::npos) << why;
+}
+
+// A depth step 30 px away in a 64 x 48 image (columns 40 on are farther): every radius that reaches it
+// finds it, however large, and a radius far beyond the image costs one pass over the image at most.
+TEST(DepthStepNear, HugeRadiusIsClampedToTheImage) {
+  const int w = 64, h = 48;
+  std::vector<float> d(static_cast<std::size_t>(w * h), 2.f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 40; x < w; ++x) d[static_cast<std::size_t>(y * w + x)] = 3.f;
+  const dyncull::DepthView<float> view{d.data(), w, h};
+  EXPECT_FALSE(dyncull::depth_step_near(view, 10, 10, 4, 0.05));
+  EXPECT_TRUE(dyncull::depth_step_near(view, 10, 10, 30, 0.05));
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(dyncull::depth_step_near(view, 10, 10, 100000000, 0.05));
+  EXPECT_TRUE(dyncull::depth_step_near(view, 10, 10, INT_MAX, 0.05));
+  EXPECT_TRUE(dyncull::depth_step_near(view, 10, 10, INT_MAX - 1, 0.05));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 1.0);
+}
+
+TEST(DepthStepNear, PropertyMatchesTheUnclampedLoopOnSmallRadii) {
+  // Reference: the plain loop over every sampled offset (radius small enough not to overflow).
+  auto reference = [](const dyncull::DepthView<float>& v, int u, int y, int radius, double ratio) {
+    const float z = v.depth_m(u, y);
+    if (!(z > 0.f)) return false;
+    const int step = radius > 2 ? 2 : 1;
+    for (int dy = -radius; dy <= radius; dy += step)
+      for (int dx = -radius; dx <= radius; dx += step) {
+        if (!v.in_bounds(u + dx, y + dy)) continue;
+        const float zz = v.depth_m(u + dx, y + dy);
+        if (!(zz > 0.f) || std::abs(zz - z) > static_cast<float>(ratio) * z) return true;
+      }
+    return false;
+  };
+  dyncull::Random rng(5);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int w = 1 + static_cast<int>(rng.index(30)), h = 1 + static_cast<int>(rng.index(30));
+    std::vector<float> d(static_cast<std::size_t>(w * h));
+    for (float& x : d) x = rng.index(10) == 0 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(1.0 + 0.1 * rng.index(3));
+    const dyncull::DepthView<float> view{d.data(), w, h};
+    const int u = static_cast<int>(rng.index(40)) - 5, y = static_cast<int>(rng.index(40)) - 5;
+    const int radius = static_cast<int>(rng.index(40)) - 2;
+    const double ratio = rng.uniform(0, 0.2);
+    EXPECT_EQ(dyncull::depth_step_near(view, u, y, radius, ratio), reference(view, u, y, radius, ratio))
+        << trial << " " << u << "," << y << " r=" << radius;
+  }
 }
 
 }  // namespace

@@ -4,9 +4,13 @@
 /// depth_m() returns 0 for all of them, so callers test one thing.
 #pragma once
 
+#include "dyncull/core/status.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <type_traits>
 
 namespace dyncull {
@@ -25,6 +29,23 @@ struct DepthView {
   float max_m = 1e30f;
 
   bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
+  /// InvalidInput with the field in `reason` when the view cannot be read as documented: negative size,
+  /// a stride shorter than a row, units_per_metre not in (0, 1e9], min_m not finite and >= 0, max_m NaN or
+  /// below min_m. An empty view (no data) is valid: it means "no depth image".
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (width < 0 || height < 0) return bad("depth width and height must be >= 0");
+    if (stride < 0 || (stride > 0 && stride < width)) return bad("depth stride must be 0 or at least the width");
+    if (!(units_per_metre > 0.f) || !(units_per_metre <= 1e9f))
+      return bad("depth units_per_metre must be positive and at most 1e9");
+    if (!(min_m >= 0.f) || !std::isfinite(min_m)) return bad("depth min_m must be >= 0 and finite");
+    if (!(max_m >= min_m)) return bad("depth max_m must be >= min_m (not NaN)");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
   std::ptrdiff_t row_stride() const { return stride > 0 ? stride : width; }
   const Raw* row(int v) const { return data + static_cast<std::ptrdiff_t>(v) * row_stride(); }
   Raw raw(int u, int v) const { return row(v)[u]; }
@@ -60,16 +81,20 @@ T axial_depth_sigma_m(T z, T base = T(0.0012), T quadratic = T(0.0019), T refere
 template <class Raw>
 bool depth_step_near(const DepthView<Raw>& depth, int u, int v, int radius, double ratio) {
   const float z = depth.depth_m(u, v);
-  if (!(z > 0.f)) return false;
-  const int step = radius > 2 ? 2 : 1;
+  if (!(z > 0.f) || radius <= 0) return false;
+  const long long step = radius > 2 ? 2 : 1;
   const float tol = static_cast<float>(ratio) * z;
-  for (int dy = -radius; dy <= radius; dy += step) {
-    const int y = v + dy;
-    if (y < 0 || y >= depth.height) continue;
-    for (int dx = -radius; dx <= radius; dx += step) {
-      const int x = u + dx;
-      if (x < 0 || x >= depth.width) continue;
-      const float zz = depth.depth_m(x, y);
+  // The sampled offsets are -radius, -radius + step, ... ; only those inside the image are visited, in
+  // 64 bits, so a radius far beyond the image costs one pass over the image at most.
+  auto first_inside = [&](long long centre) {
+    const long long lo = centre - radius;
+    return lo >= 0 ? lo : lo + ((-lo + step - 1) / step) * step;
+  };
+  const long long y_end = std::min<long long>(static_cast<long long>(v) + radius, depth.height - 1);
+  const long long x_end = std::min<long long>(static_cast<long long>(u) + radius, depth.width - 1);
+  for (long long y = first_inside(v); y <= y_end; y += step) {
+    for (long long x = first_inside(u); x <= x_end; x += step) {
+      const float zz = depth.depth_m(static_cast<int>(x), static_cast<int>(y));
       if (!(zz > 0.f) || std::abs(zz - z) > tol) return true;
     }
   }

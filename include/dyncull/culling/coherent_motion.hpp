@@ -11,6 +11,7 @@
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,6 +34,21 @@ struct CoherentMotionOptions {
   T sigmas = T(10);
   T min_noise_px = T(0.2);      ///< floor of the noise: LK and map points rarely do better at 640x480
   T min_median_px = T(0.5);     ///< a shared offset below this is never motion
+
+  /// InvalidInput naming the first field out of its range: grid in [1, 8], min_points >= 1, sigmas and
+  /// min_noise_px positive and finite, min_median_px finite and >= 0.
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    if (grid < 1 || grid > 8) return invalid_option(reason, "grid", "must be in [1, 8]");
+    if (min_points < 1) return invalid_option(reason, "min_points", "must be >= 1");
+    if (!(sigmas > T(0)) || !std::isfinite(sigmas)) return invalid_option(reason, "sigmas", "must be positive and finite");
+    if (!(min_noise_px > T(0)) || !std::isfinite(min_noise_px))
+      return invalid_option(reason, "min_noise_px", "must be positive and finite");
+    if (!finite_in(min_median_px, 0, 1e30)) return invalid_option(reason, "min_median_px", "must be finite and >= 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Outcome: which cells were flagged and how many features turned Dynamic.
@@ -58,7 +74,8 @@ struct CoherentMotionResult {
 /// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
 /// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: min_noise_px).
 /// in_object_mask / object_box_bits as in refine_subboxes: a box's cells hold only its object's features.
-/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged).
+/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged). residuals, labels and
+/// the optional per-feature arrays are raw pointers that must hold points.size() entries.
 template <class T, class Points, class Boxes>
 void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const Boxes& boxes, T noise_px,
                          const CoherentMotionOptions<T>& options, FeatureLabel* labels, CoherentMotionResult<T>* out,
@@ -73,10 +90,10 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
   r.reason.clear();
   r.num_cells_tested = r.num_cells_flagged = r.num_flagged = 0;
   r.cells.clear();
-  if (g < 1 || g > 8 || !(options.sigmas > T(0)) || !(options.min_noise_px > T(0)) || !(options.min_median_px >= T(0)) ||
-      options.min_points < 1) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "invalid options: 1 <= grid <= 8, sigmas > 0, min_noise_px > 0, min_median_px >= 0, min_points >= 1";
+    r.reason = "invalid options: " + why;
     return;
   }
   const std::size_t cells_per_box = static_cast<std::size_t>(g * g);

@@ -19,6 +19,7 @@
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -124,6 +125,47 @@ struct DepthMaskOptions {
   double occluded_cluster_fraction = 0.15;
 
   std::uint8_t mask_value = 255;
+
+  /// InvalidInput naming the first field out of its range: enums in range; depths in metres finite, >= 0
+  /// and at most 1e4; histogram_bin_m >= 1 mm and histogram_max_m in (0, 1e4] with at most 65536 bins;
+  /// fractions in [0, 1]; strides, radii and gaps >= 0 (a stride at most 65536, a centre patch radius at
+  /// most 7); histogram_target_samples >= 1.
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    if (static_cast<int>(mode) > 1) return invalid_option(reason, "mode", "must be Plain or Robust");
+    if (static_cast<int>(form) > 1) return invalid_option(reason, "form", "must be Seed000 or DynamicVins");
+    if (static_cast<int>(missing_depth) > 2)
+      return invalid_option(reason, "missing_depth", "must be Nearest, InMask or OutOfMask");
+    if (!finite_in(eps_m, 0, 1e4)) return invalid_option(reason, "eps_m", "must be finite and in [0, 1e4] m");
+    if (!finite_in(dynamic_vins_eps_m, 0, 1e4))
+      return invalid_option(reason, "dynamic_vins_eps_m", "must be finite and in [0, 1e4] m");
+    if (centre_patch_radius_px < 0 || centre_patch_radius_px > 7)
+      return invalid_option(reason, "centre_patch_radius_px", "must be in [0, 7]");
+    if (!finite_in(histogram_bin_m, 1e-3, 1e4))
+      return invalid_option(reason, "histogram_bin_m", "must be positive and finite (at least 0.001 m)");
+    if (!(histogram_max_m > 0) || !finite_in(histogram_max_m, 0, 1e4))
+      return invalid_option(reason, "histogram_max_m", "must be positive, finite and at most 1e4 m");
+    if (histogram_max_m / histogram_bin_m > 65536.0)
+      return invalid_option(reason, "histogram_max_m", "over histogram_bin_m must be at most 65536 bins");
+    if (histogram_stride_px < 0 || histogram_stride_px > 65536)
+      return invalid_option(reason, "histogram_stride_px", "must be in [0, 65536] (0 = auto)");
+    if (histogram_target_samples < 1) return invalid_option(reason, "histogram_target_samples", "must be >= 1");
+    if (!finite_in(histogram_occupied_fraction, 0, 1))
+      return invalid_option(reason, "histogram_occupied_fraction", "must be in [0, 1]");
+    if (histogram_max_gap_bins < 0) return invalid_option(reason, "histogram_max_gap_bins", "must be >= 0");
+    if (!finite_in(max_object_depth_extent_m, 0, 1e4))
+      return invalid_option(reason, "max_object_depth_extent_m", "must be finite and in [0, 1e4] m");
+    if (!finite_in(min_valid_fraction, 0, 1)) return invalid_option(reason, "min_valid_fraction", "must be in [0, 1]");
+    if (!finite_in(near_margin_m, 0, 1e4))
+      return invalid_option(reason, "near_margin_m", "must be finite and in [0, 1e4] m");
+    if (!finite_in(occluded_centre_max_fraction, 0, 1))
+      return invalid_option(reason, "occluded_centre_max_fraction", "must be in [0, 1]");
+    if (!finite_in(occluded_cluster_fraction, 0, 1))
+      return invalid_option(reason, "occluded_cluster_fraction", "must be in [0, 1]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Per-box outcome. Depths in metres (0 = no measurement); threshold_m is exclusive.
@@ -192,9 +234,16 @@ RawRange<Raw> valid_raw_range(const DepthView<Raw>& v) {
     // Smallest positive Raw, so that 0 stays "no measurement" after the cast back to Raw.
     r.lo = std::max(static_cast<double>(v.min_m) * upm,
                     static_cast<double>(std::numeric_limits<Raw>::denorm_min()));
-    r.hi = static_cast<double>(v.max_m) * upm;
+    // Capped at the largest finite Raw: converting it back to Raw stays in range (Inf is no measurement).
+    r.hi = std::min(static_cast<double>(v.max_m) * upm, static_cast<double>(std::numeric_limits<Raw>::max()));
   }
   return r;
+}
+
+/// Bin of a non-negative position in bins, clamped to [0, nb - 1] before the conversion to int (NaN: 0).
+inline int clamped_bin(double position, int nb) {
+  const double top = static_cast<double>(nb - 1);
+  return position >= 0 ? static_cast<int>(std::min(position, top)) : 0;
 }
 
 template <class Raw>
@@ -715,10 +764,12 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     }
     const float inv_bin = static_cast<float>(1.0 / bin_raw);
     const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
+    // Bin index clamped in float before the conversion (a valid float depth may be 1e20 m).
+    const float last_bin = static_cast<float>(nb - 1);
     auto bin_of = [&](Raw r) {
       const float f = static_cast<float>(r);
       const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
-      return static_cast<std::size_t>(ok ? std::min(nb - 1, static_cast<int>(f * inv_bin)) : nb);
+      return static_cast<std::size_t>(ok ? static_cast<int>(std::min(last_bin, f * inv_bin)) : nb);
     };
     std::uint32_t* h0 = hist4.data();
     std::uint32_t* h1 = h0 + nh;
@@ -749,7 +800,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
           std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));
       int start = -1;
       if (dc > 0) {
-        start = std::min(nb - 1, static_cast<int>(dc * inv_bin));
+        start = detail::clamped_bin(dc * inv_bin, nb);
       } else {
         // No centre depth: the nearest bin holding 5 % of the valid pixels seeds the cluster.
         const auto seed = static_cast<std::uint32_t>(std::max(1.0, 0.05 * static_cast<double>(valid)));
@@ -758,8 +809,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
         if (start < 0) start = 0;
       }
       const double seed_raw = dc > 0 ? dc : (start + 0.5) * bin_raw;
-      const int last_allowed =
-          std::min(nb - 1, static_cast<int>((seed_raw + o.max_object_depth_extent_m * upm) * inv_bin));
+      const int last_allowed = detail::clamped_bin((seed_raw + o.max_object_depth_extent_m * upm) * inv_bin, nb);
       int end = start, gap = 0;
       for (int b = start + 1; b <= last_allowed; ++b) {
         if (hist[static_cast<std::size_t>(b)] >= occupied) {
@@ -804,13 +854,13 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
       const double m = static_cast<double>(d[x]) / upm;
       ++valid;
       near_centre += std::abs(m - b->d_c_m) <= o.eps_m;
-      ++hist[static_cast<std::size_t>(std::min(nb - 1, static_cast<int>(m / bin_m)))];
+      ++hist[static_cast<std::size_t>(clamped_bin(m / bin_m, nb))];
     }
   }
   if (valid < 50 || static_cast<double>(near_centre) >= o.occluded_centre_max_fraction * static_cast<double>(valid))
     return false;
   const double need = o.occluded_cluster_fraction * static_cast<double>(valid);
-  const int first = std::min(nb - 3, static_cast<int>((a.d_c_m + o.eps_m) / bin_m) + 1);
+  const int first = std::min(nb - 3, clamped_bin((a.d_c_m + o.eps_m) / bin_m, nb) + 1);
   for (int k = std::max(0, first); k + 2 < nb; ++k) {
     const double in_window = static_cast<double>(hist[static_cast<std::size_t>(k)]) + hist[static_cast<std::size_t>(k + 1)] +
                              hist[static_cast<std::size_t>(k + 2)];
@@ -830,6 +880,24 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
     return true;
   }
   return false;
+}
+
+/// The depth view and the options pass their validate(); else InvalidInput with the reason.
+template <class Raw>
+bool depth_mask_inputs_valid(const DepthView<Raw>& depth, const DepthMaskOptions& options, Status* status,
+                             std::string* reason) {
+  std::string why;
+  if (depth.validate(&why) != Status::Ok) {
+    *status = Status::InvalidInput;
+    *reason = why;
+    return false;
+  }
+  if (options.validate(&why) != Status::Ok) {
+    *status = Status::InvalidInput;
+    *reason = "invalid options: " + why;
+    return false;
+  }
+  return true;
 }
 
 template <class T> const Box<T>& as_box(const Box<T>& b) { return b; }
@@ -852,6 +920,7 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
     info.reason = "mask size differs from the depth image";
     return info;
   }
+  if (!detail::depth_mask_inputs_valid(depth, options, &info.status, &info.reason)) return info;
   const auto range = detail::valid_raw_range(depth);
   detail::DepthBand band;
   info = detail::plan_box(depth, range, box, options, &band);
@@ -863,7 +932,8 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
 /// Masks every box and labels every point: Dynamic (DepthMask) when the point's pixel (rounded)
 /// is in a box's mask, Candidate when it lies in a box whose plain rule did not apply, else Static.
 /// Non-finite points are Dynamic (InvalidInput). Bad boxes are reported per box; the call fails
-/// only when the depth image is missing (Skipped) or the mask has the wrong size (InvalidInput).
+/// only when the depth image is missing (Skipped), or the mask has the wrong size, the depth view or
+/// the options do not pass their validate() (InvalidInput; every point then stays Static).
 template <class Raw, class Boxes, class Points>
 DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& points,
                            const DepthMaskOptions& options, MaskView out = {}) {
@@ -884,6 +954,7 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
     r.reason = "mask size differs from the depth image";
     return r;
   }
+  if (!detail::depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) return r;
   const auto range = detail::valid_raw_range(depth);
   std::vector<detail::DepthBand> bands(boxes.size());
   r.boxes.reserve(boxes.size());

@@ -16,6 +16,7 @@
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/motion_levels.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -75,6 +76,30 @@ struct DynamicProbabilityOptions {
   TemporalSource temporal_source = TemporalSource::PreviousMotion;
   /// Reference features are those with these levels (in no mask, or in a low-level mask).
   bool low_level_in_reference = true;
+
+  /// InvalidInput naming the first field out of its range: weights finite, >= 0 and summing to 1 (within
+  /// 1e-3); threshold finite; the pixel thresholds and mad_scale finite and >= 0; temporal_source one of
+  /// its values.
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    constexpr double kBig = 1e30;
+    if (!finite_in(weight_semantic, 0, 1)) return invalid_option(reason, "weight_semantic", "must be in [0, 1]");
+    if (!finite_in(weight_motion, 0, 1)) return invalid_option(reason, "weight_motion", "must be in [0, 1]");
+    if (!finite_in(weight_temporal, 0, 1)) return invalid_option(reason, "weight_temporal", "must be in [0, 1]");
+    if (!(std::abs(weight_semantic + weight_motion + weight_temporal - T(1)) < T(1e-3)))
+      return invalid_option(reason, "weight_semantic + weight_motion + weight_temporal", "must be 1");
+    if (!std::isfinite(threshold)) return invalid_option(reason, "threshold", "must be finite");
+    if (!finite_in(min_motion_threshold_px, 0, kBig))
+      return invalid_option(reason, "min_motion_threshold_px", "must be finite and >= 0");
+    if (!finite_in(mad_scale, 0, kBig)) return invalid_option(reason, "mad_scale", "must be finite and >= 0");
+    if (!finite_in(fallback_motion_threshold_px, 0, kBig))
+      return invalid_option(reason, "fallback_motion_threshold_px", "must be finite and >= 0");
+    if (static_cast<int>(temporal_source) > 1)
+      return invalid_option(reason, "temporal_source", "must be PreviousMotion or PreviousDecision");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Per-track memory for K: the last flow result and decision of each track id. Owned by the
@@ -171,11 +196,15 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
     r.reason = "prev_points, curr_points, levels (and track_ids) must have the same size";
     return r;
   }
-  const T wsum = o.weight_semantic + o.weight_motion + o.weight_temporal;
-  if (!(std::abs(wsum - T(1)) < T(1e-3)) || o.weight_semantic < T(0) || o.weight_motion < T(0) ||
-      o.weight_temporal < T(0) || !std::isfinite(o.threshold)) {
+  std::string why;
+  if (o.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "weights must be non-negative and sum to 1, threshold finite";
+    r.reason = "invalid options: " + why;
+    return r;
+  }
+  if (static_cast<int>(ego.model) > 2) {
+    r.status = Status::InvalidInput;
+    r.reason = "ego.model must be MeanFlow, Fundamental or Homography";
     return r;
   }
   if (!ego.matrix.allFinite()) {

@@ -7,6 +7,7 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/validation.hpp"
 #include "dyncull/geometry/epipolar.hpp"
 #include "dyncull/geometry/fundamental.hpp"
 
@@ -38,12 +39,31 @@ struct MovingConsistencyOptions {
   /// the test scenes: the RANSAC model at small baselines is noticeably worse than a least-squares fit
   /// on its own inliers (docs/algorithms.md).
   int refit_iterations = 2;
+  static constexpr int kMaxRefitIterations = 100;  ///< upper bound of refit_iterations (each is one 8-point fit)
 
   MovingConsistencyOptions() {
     // The homography test of fundamental.hpp fires at small baselines, where F on the static tracks is
     // still well determined; and under pure rotation any F = [e]x H keeps static tracks at distance 0,
     // so the labels stay meaningful. Off by default here.
     fundamental.check_homography_degeneracy = false;
+  }
+
+  /// InvalidInput naming the first field out of its range: both epipolar thresholds positive and finite,
+  /// refit_iterations in [0, kMaxRefitIterations], fundamental (and fundamental.ransac) passing their own
+  /// validate().
+  Status validate(std::string* reason = nullptr) const {
+    using detail::invalid_option;
+    if (!(max_epipolar_distance_px > T(0)) || !std::isfinite(max_epipolar_distance_px))
+      return invalid_option(reason, "max_epipolar_distance_px", "must be positive and finite");
+    if (!(max_epipolar_distance_in_boxes_px > T(0)) || !std::isfinite(max_epipolar_distance_in_boxes_px))
+      return invalid_option(reason, "max_epipolar_distance_in_boxes_px", "must be positive and finite");
+    if (refit_iterations < 0 || refit_iterations > kMaxRefitIterations)
+      return invalid_option(reason, "refit_iterations", "must be in [0, 100]");
+    if (detail::validate_nested(fundamental, "fundamental", reason) != Status::Ok) return Status::InvalidInput;
+    if (detail::validate_nested(fundamental.ransac, "fundamental.ransac", reason) != Status::Ok)
+      return Status::InvalidInput;
+    if (reason) reason->clear();
+    return Status::Ok;
   }
 };
 
@@ -73,7 +93,9 @@ struct MovingConsistencyResult {
 
 /// Runs the check on n tracks prev[i] -> cur[i] (any point containers of equal size), writing into `out`
 /// (buffers reused). valid: optional per-track flag (0 = no track, e.g. LK failed); in_box: optional
-/// per-track flag (1 = inside a dynamic-class box: excluded from the F fit when possible, tighter threshold).
+/// per-track flag (1 = inside a dynamic-class box: excluded from the F fit when possible, tighter threshold);
+/// both raw pointers must hold cur.size() flags (cull_frame checks CullingFrame::track_valid's length).
+/// InvalidInput when prev and cur differ in size or the options fail MovingConsistencyOptions::validate.
 template <class T, class C1, class C2>
 void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsistencyOptions<T>& options,
                               MovingConsistencyResult<T>* out, const std::uint8_t* valid = nullptr,
@@ -96,9 +118,10 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
     r.reason = "prev and cur differ in size";
     return;
   }
-  if (!(options.max_epipolar_distance_px > T(0)) || !(options.max_epipolar_distance_in_boxes_px > T(0))) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "epipolar thresholds must be > 0";
+    r.reason = "invalid options: " + why;
     return;
   }
   // Compact the valid, finite tracks; count those outside boxes for the SG-SLAM fit subset.

@@ -11,6 +11,7 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -36,6 +37,27 @@ struct MultiViewOptions {
   T border_px = T(0);                ///< projections closer than this to the image edge are not used
   T region_depth_tolerance_m = T(0.2);  ///< region growing: |d - d_seed| below this joins the region
   std::size_t max_region_pixels = 0;     ///< cap per seed region (0 = no cap)
+
+  /// InvalidInput naming the first field out of its range: max_parallax_deg in (0, 180];
+  /// depth_threshold_m > 0; search_radius_px in [0, 256]; the depth gates > 0 (not NaN; +Inf = no gate);
+  /// border_px and region_depth_tolerance_m finite and >= 0.
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    if (!(max_parallax_deg > T(0)) || !finite_in(max_parallax_deg, 0, 180))
+      return invalid_option(reason, "max_parallax_deg", "must be in (0, 180]");
+    if (!(depth_threshold_m > T(0)) || !std::isfinite(depth_threshold_m))
+      return invalid_option(reason, "depth_threshold_m", "must be positive and finite");
+    if (search_radius_px < 0 || search_radius_px > 256)
+      return invalid_option(reason, "search_radius_px", "must be in [0, 256]");
+    if (!(max_reference_depth_m > T(0))) return invalid_option(reason, "max_reference_depth_m", "must be positive");
+    if (!(max_projected_depth_m > T(0))) return invalid_option(reason, "max_projected_depth_m", "must be positive");
+    if (!finite_in(border_px, 0, 1e9)) return invalid_option(reason, "border_px", "must be finite and >= 0");
+    if (!finite_in(region_depth_tolerance_m, 0, 1e9))
+      return invalid_option(reason, "region_depth_tolerance_m", "must be finite and >= 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// What happened to one keyframe point.
@@ -124,7 +146,9 @@ struct RawDepthRange<Raw, true> {
 
 /// Checks keyframe points against the current depth image, writing into `out` (its buffers are reused).
 /// ref_points: any point container (keyframe pixels); ref_depths_m: container of depths (metres) with
-/// operator[]; poses are cam_from_world. Status Skipped when there are no keyframe points or no pose.
+/// operator[] and size(), one per point (else InvalidInput); poses are cam_from_world. Status Skipped
+/// when there are no keyframe points, no pose or no depth image; InvalidInput for an invalid camera,
+/// depth view or options (MultiViewOptions::validate).
 template <class C, class D, class Raw, class T>
 void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>& cam_from_world_ref,
                      const Rigid3<T>& cam_from_world_cur, const DepthView<Raw>& depth, const PinholeCamera<T>& camera,
@@ -141,6 +165,12 @@ void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>
   r.projected.resize(n);
   r.projected_depth_m.assign(n, T(0));
   r.measured_depth_m.assign(n, T(0));
+  if (static_cast<std::size_t>(ref_depths_m.size()) != n) {
+    r.status = Status::InvalidInput;
+    r.reason = "ref_depths_m has " + std::to_string(ref_depths_m.size()) + " depths for " + std::to_string(n) +
+               " ref_points";
+    return;
+  }
   if (n == 0) {
     r.status = Status::Skipped;
     r.reason = "no keyframe points yet: the multi-view check needs a keyframe with depth";
@@ -156,10 +186,20 @@ void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>
     r.reason = "no current depth image";
     return;
   }
-  if (!camera.valid() || !(options.depth_threshold_m > T(0)) || !(options.max_parallax_deg > T(0)) ||
-      options.search_radius_px < 0) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "invalid camera or options (depth_threshold_m and max_parallax_deg must be > 0, search_radius_px >= 0)";
+    r.reason = "invalid options: " + why;
+    return;
+  }
+  if (depth.validate(&why) != Status::Ok) {
+    r.status = Status::InvalidInput;
+    r.reason = why;
+    return;
+  }
+  if (!camera.valid()) {
+    r.status = Status::InvalidInput;
+    r.reason = "invalid camera";
     return;
   }
   const Rigid3<T> cur_from_ref = cam_from_world_cur * cam_from_world_ref.inverse();
@@ -246,7 +286,10 @@ template <class Raw, class T>
 std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const DepthView<Raw>& depth,
                                    const MultiViewOptions<T>& options, Mask* mask, std::vector<std::uint32_t>* stack,
                                    const PixelRect* roi = nullptr) {
-  if (depth.empty()) return 0;
+  const std::size_t nr = result.labels.size();
+  if (depth.empty() || depth.validate() != Status::Ok || result.projected.size() != nr ||
+      result.measured_depth_m.size() != nr)
+    return 0;
   const int w = depth.width, h = depth.height;
   const int rc0 = roi ? std::max(0, roi->c0) : 0, rr0 = roi ? std::max(0, roi->r0) : 0;
   const int rc1 = roi ? std::min(w, roi->c1) : w, rr1 = roi ? std::min(h, roi->r1) : h;
@@ -337,9 +380,11 @@ class KeyframeRing {
     return slots_[(head_ + slots_.size() - 1 - i) % slots_.size()];
   }
 
-  /// Stores a keyframe: points with valid depth (and keep[i] != 0 when keep is given) are copied.
+  /// Stores a keyframe: points with valid depth (and keep[i] != 0 when keep is given, one flag per
+  /// point) are copied. InvalidInput, and nothing stored, when depths_m does not hold one depth per point.
   template <class C, class D>
-  void push(const Rigid3<T>& cam_from_world, const C& points, const D& depths_m, const std::uint8_t* keep = nullptr) {
+  Status push(const Rigid3<T>& cam_from_world, const C& points, const D& depths_m, const std::uint8_t* keep = nullptr) {
+    if (static_cast<std::size_t>(depths_m.size()) != static_cast<std::size_t>(points.size())) return Status::InvalidInput;
     MultiViewKeyframe<T>& slot = slots_[head_];
     head_ = (head_ + 1) % slots_.size();
     size_ = std::min(size_ + 1, slots_.size());
@@ -355,6 +400,7 @@ class KeyframeRing {
       slot.points.emplace_back(u, v);
       slot.depth_m.push_back(d);
     }
+    return Status::Ok;
   }
 
   /// Up to max_refs keyframe indices, largest pose difference first (DynaSLAM: 0.7 normalised

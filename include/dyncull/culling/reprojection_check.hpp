@@ -13,6 +13,7 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/validation.hpp"
 #include "dyncull/geometry/pnp.hpp"
 
 #include <Eigen/Cholesky>
@@ -63,6 +64,34 @@ struct ReprojectionCheckOptions {
   T depth_sigma_reference_m = T(0.4);
   std::size_t min_tracks = 15;  ///< fewer usable tracks: Skipped
 
+  /// InvalidInput naming the first field out of its range: the pixel thresholds positive and finite;
+  /// uncertainty_sigmas, min_noise_px, max_depth_residual_sigmas and the depth noise model finite and
+  /// >= 0; pnp (and pnp.ransac) passing their own validate().
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    constexpr double kBig = 1e30;
+    if (!(max_residual_px > T(0)) || !std::isfinite(max_residual_px))
+      return invalid_option(reason, "max_residual_px", "must be positive and finite");
+    if (!(max_residual_in_boxes_px > T(0)) || !std::isfinite(max_residual_in_boxes_px))
+      return invalid_option(reason, "max_residual_in_boxes_px", "must be positive and finite");
+    if (!finite_in(uncertainty_sigmas, 0, kBig))
+      return invalid_option(reason, "uncertainty_sigmas", "must be finite and >= 0");
+    if (!finite_in(min_noise_px, 0, kBig)) return invalid_option(reason, "min_noise_px", "must be finite and >= 0");
+    if (!finite_in(max_depth_residual_sigmas, 0, kBig))
+      return invalid_option(reason, "max_depth_residual_sigmas", "must be finite and >= 0");
+    if (!finite_in(depth_sigma_base_m, 0, kBig))
+      return invalid_option(reason, "depth_sigma_base_m", "must be finite and >= 0");
+    if (!finite_in(depth_sigma_quadratic, 0, kBig))
+      return invalid_option(reason, "depth_sigma_quadratic", "must be finite and >= 0");
+    if (!finite_in(depth_sigma_reference_m, 0, kBig))
+      return invalid_option(reason, "depth_sigma_reference_m", "must be finite and >= 0");
+    if (detail::validate_nested(pnp, "pnp", reason) != Status::Ok) return Status::InvalidInput;
+    if (detail::validate_nested(pnp.ransac, "pnp.ransac", reason) != Status::Ok) return Status::InvalidInput;
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+
   static PnpOptions<T> default_pnp() {
     PnpOptions<T> o;
     o.ransac.max_residual = 2.0;
@@ -110,7 +139,10 @@ struct ReprojectionCheckResult {
 /// reference keyframe's camera), pixels[i] its position in the current image; camera: the current
 /// image's intrinsics. Non-finite points (no depth) are not evaluated. valid: optional per-track flag;
 /// in_box: optional per-track flag (1 = inside a dynamic-class box: excluded from the fit when possible,
-/// tighter threshold); depth: the current depth image, used by the depth residual when enabled.
+/// tighter threshold); both raw pointers must hold pixels.size() flags (they carry no length to check:
+/// cull_frame checks CullingFrame::track_valid's). depth: the current depth image, used by the depth
+/// residual when enabled. InvalidInput when points and pixels differ in size, or the options
+/// (ReprojectionCheckOptions::validate), the depth view or the camera are invalid.
 /// Writes into `out` (buffers reused).
 template <class T, class Points3, class Pixels, class Raw = float>
 void check_reprojection(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera,
@@ -139,10 +171,15 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
     r.reason = "points and pixels differ in size";
     return;
   }
-  if (!(options.max_residual_px > T(0)) || !(options.max_residual_in_boxes_px > T(0)) ||
-      !(options.max_depth_residual_sigmas >= T(0))) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "reprojection thresholds must be > 0 (depth residual sigmas >= 0)";
+    r.reason = "invalid options: " + why;
+    return;
+  }
+  if (depth.validate(&why) != Status::Ok) {
+    r.status = Status::InvalidInput;
+    r.reason = why;
     return;
   }
   if (!camera.valid()) {

@@ -5,10 +5,12 @@
 #pragma once
 
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace dyncull {
@@ -23,6 +25,16 @@ struct StaticHistoryOptions {
   int min_frames = 0;
   /// Residual (px) a frame must stay below to count; above it, or flagged, the count restarts at 0.
   T max_residual_px = T(0.8);
+
+  /// InvalidInput naming the first field out of its range: min_frames in [0, 65535] (the counts are
+  /// 16-bit), max_residual_px finite and >= 0.
+  Status validate(std::string* reason = nullptr) const {
+    if (min_frames < 0 || min_frames > 0xFFFF) return detail::invalid_option(reason, "min_frames", "must be in [0, 65535]");
+    if (!detail::finite_in(max_residual_px, 0, 1e30))
+      return detail::invalid_option(reason, "max_residual_px", "must be finite and >= 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Consecutive still frames per track, owned by the caller (PipelineState holds one) and advanced once per
@@ -35,7 +47,8 @@ class StaticHistory {
   /// evaluated == false when this frame is no evidence (a baseline too short to see a slow mover, or the
   /// check did not run): the counts then carry over unchanged. A Candidate label leaves its track's count
   /// unchanged; Dynamic, a residual at or above max_residual_px, or a non-finite one resets it to 0.
-  /// counts (resized to n): the track's count after this frame.
+  /// counts (resized to n): the track's count after this frame. labels and residual_px are raw pointers
+  /// that must hold ids.size() entries.
   template <class T>
   void update(const std::vector<std::int64_t>& ids, const FeatureLabel* labels, const T* residual_px, bool evaluated,
               T max_residual_px, std::vector<std::uint16_t>* counts) {

@@ -44,12 +44,16 @@ class SubBoxMemory {
   }
 
   /// Cells (per box grid*grid, box-major like SubBoxResult::cells) that a vote of the last `frames`
-  /// frames before `frame` made dynamic in the same tracked box. grid*grid must be at most 64.
+  /// frames before `frame` made dynamic in the same tracked box. A grid outside [1, 8] recalls nothing
+  /// (cells cleared).
   void recall(const std::vector<std::int64_t>& box_ids, int grid, std::uint64_t frame, int frames,
               std::vector<std::uint8_t>* cells) const {
+    if (!grid_ok(grid)) {  // no cells to recall: empty, not a huge or wrapped allocation
+      cells->clear();
+      return;
+    }
     const std::size_t cpb = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
     cells->assign(box_ids.size() * cpb, 0);
-    if (cpb > kMaxCells) return;
     const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
     for (std::size_t b = 0; b < box_ids.size(); ++b) {
       const BoxCells* m = find(box_ids[b]);
@@ -65,8 +69,9 @@ class SubBoxMemory {
   template <class T>
   void remember(const std::vector<std::int64_t>& box_ids, const SubBoxResult<T>& votes, const SubBoxOptions<T>& options,
                 std::uint64_t frame, int frames) {
+    if (!grid_ok(options.grid) || (votes.grid != 0 && votes.grid != options.grid)) return;
     const std::size_t cpb = static_cast<std::size_t>(options.grid) * static_cast<std::size_t>(options.grid);
-    if (cpb > kMaxCells || votes.dyn_count.size() < box_ids.size() * cpb) return;
+    if (votes.dyn_count.size() < box_ids.size() * cpb || votes.static_count.size() < box_ids.size() * cpb) return;
     for (std::size_t b = 0; b < box_ids.size(); ++b) {
       if (box_ids[b] < 0) continue;
       BoxCells* m = find(box_ids[b]);
@@ -94,8 +99,10 @@ class SubBoxMemory {
   template <class T>
   void remember_states(const std::vector<std::int64_t>& box_ids, const SubBoxResult<T>& votes,
                        const SubBoxOptions<T>& options, std::uint64_t frame, int frames) {
+    if (!grid_ok(options.grid) || (votes.grid != 0 && votes.grid != options.grid)) return;
     const std::size_t cpb = static_cast<std::size_t>(options.grid) * static_cast<std::size_t>(options.grid);
-    if (cpb > kMaxCells || votes.cells.size() < box_ids.size() * cpb || votes.dyn_count.size() < box_ids.size() * cpb)
+    if (votes.cells.size() < box_ids.size() * cpb || votes.dyn_count.size() < box_ids.size() * cpb ||
+        votes.static_count.size() < box_ids.size() * cpb)
       return;
     for (std::size_t b = 0; b < box_ids.size(); ++b) {
       if (box_ids[b] < 0) continue;
@@ -119,9 +126,12 @@ class SubBoxMemory {
   /// before `frame`, box-major; 2 (unknown) for boxes without one. Returns how many boxes had one.
   std::size_t recall_states(const std::vector<std::int64_t>& box_ids, int grid, std::uint64_t frame, int frames,
                             std::vector<std::uint8_t>* states) const {
+    if (!grid_ok(grid)) {
+      states->clear();
+      return 0;
+    }
     const std::size_t cpb = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
     states->assign(box_ids.size() * cpb, 2);
-    if (cpb > kMaxCells) return 0;
     const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
     std::size_t found = 0;
     for (std::size_t b = 0; b < box_ids.size(); ++b) {
@@ -146,6 +156,7 @@ class SubBoxMemory {
 
  private:
   static constexpr std::size_t kMaxCells = 64;  ///< SubBoxOptions::grid is at most 8
+  static bool grid_ok(int grid) { return grid >= 1 && grid <= 8; }
   struct BoxCells {
     std::int64_t id = -1;
     std::uint64_t last_seen = 0;

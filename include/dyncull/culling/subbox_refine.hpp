@@ -9,6 +9,7 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -54,6 +55,27 @@ struct SubBoxOptions {
   std::size_t whole_box_spare_min_points = 0;
   T whole_box_spare_max_ratio = T(0.1);
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
+
+  /// InvalidInput naming the first field out of its range: grid in [1, 8]; sigma1, merge_ratio,
+  /// static_max_dynamic_ratio and whole_box_spare_max_ratio finite and >= 0 (above 1 they switch their
+  /// rule off); sigma2 >= 0; dilation_radius_px in [0, 1024].
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    constexpr double kBig = 1e30;
+    if (grid < 1 || grid > 8) return invalid_option(reason, "grid", "must be in [1, 8]");
+    if (!finite_in(sigma1, 0, kBig)) return invalid_option(reason, "sigma1", "must be finite and >= 0");
+    if (sigma2 < 0) return invalid_option(reason, "sigma2", "must be >= 0");
+    if (!finite_in(merge_ratio, 0, kBig)) return invalid_option(reason, "merge_ratio", "must be finite and >= 0");
+    if (!finite_in(static_max_dynamic_ratio, 0, kBig))
+      return invalid_option(reason, "static_max_dynamic_ratio", "must be finite and >= 0");
+    if (!finite_in(whole_box_spare_max_ratio, 0, kBig))
+      return invalid_option(reason, "whole_box_spare_max_ratio", "must be finite and >= 0");
+    if (dilation_radius_px < 0 || dilation_radius_px > 1024)
+      return invalid_option(reason, "dilation_radius_px", "must be in [0, 1024]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Per-box vote. Cell (row, col) is cells[row * grid + col]; state 1 = dynamic.
@@ -73,6 +95,7 @@ struct SubBoxResult {
   std::vector<FeatureLabel> labels;  ///< per feature: Static or Dynamic
   std::vector<CullReason> reasons;   ///< SubBox inside a dynamic sub-box, Epipolar outside boxes, else None
   std::vector<SubBoxVote> votes;     ///< per box
+  int grid = 0;                      ///< the grid of the vote (cells below); 0 when nothing was voted
   std::vector<std::uint8_t> cells;   ///< per box grid*grid dynamic flags, box-major
   std::vector<std::uint32_t> dyn_count, static_count;  ///< per box grid*grid vote counts
   std::size_t num_dynamic = 0, num_static = 0;
@@ -86,15 +109,36 @@ template <class T> const Box<T>& subbox_as_box(const Box<T>& b) { return b; }
 template <class T> const Box<T>& subbox_as_box(const Detection<T>& d) { return d.box; }
 
 /// Cell of (x, y) in box b, or -1 when outside. Cells split the box evenly in continuous coordinates.
+/// Index in [0, grid) of position p in [lo, hi] split into grid equal parts. Differences of huge finite
+/// coordinates overflow to Inf, so they fall back to halves; the index is clamped before the conversion.
+template <class T>
+int subbox_index(T p, T lo, T hi, int grid) {
+  T span = hi - lo, off = p - lo;
+  if (!std::isfinite(span)) {
+    span = hi * T(0.5) - lo * T(0.5);
+    off = p * T(0.5) - lo * T(0.5);
+  }
+  if (!(span > T(0))) return 0;
+  T c = off * T(grid);
+  c = std::isfinite(c) ? c / span : off / span * T(grid);
+  if (!(c > T(0))) return 0;
+  return c < T(grid - 1) ? static_cast<int>(c) : grid - 1;
+}
+
 template <class T>
 int subbox_cell(const Box<T>& b, int grid, T x, T y) {
   if (!(x >= b.x0 && x <= b.x1 && y >= b.y0 && y <= b.y1)) return -1;
-  const T w = b.x1 - b.x0, h = b.y1 - b.y0;
-  int cx = w > T(0) ? static_cast<int>((x - b.x0) * T(grid) / w) : 0;
-  int cy = h > T(0) ? static_cast<int>((y - b.y0) * T(grid) / h) : 0;
-  cx = std::min(std::max(cx, 0), grid - 1);
-  cy = std::min(std::max(cy, 0), grid - 1);
-  return cy * grid + cx;
+  return subbox_index(y, b.y0, b.y1, grid) * grid + subbox_index(x, b.x0, b.x1, grid);
+}
+
+/// Corner k (0..grid) of the cells along [lo, hi]: lo + k (hi - lo) / grid, or the weighted form when the
+/// width overflows (a finite box of +-3e38 in float).
+template <class T>
+T subbox_edge(T lo, T hi, int k, int grid) {
+  const T w = (hi - lo) / T(grid);
+  if (std::isfinite(w)) return lo + T(k) * w;
+  const T t = T(k) / T(grid);
+  return lo * (T(1) - t) + hi * t;
 }
 
 /// The vote of one cell from its counts (Algorithm 1 l. 3-12): 2 = empty (fewer than min_points labelled
@@ -125,9 +169,23 @@ void subbox_begin(SubBoxResult<T>* out, std::size_t n, std::size_t nb) {
   r.num_whole_boxes = r.num_invalid_boxes = 0;
 }
 
+/// options.validate() into the result started by subbox_begin (InvalidInput, every feature Static).
+template <class T>
+bool subbox_options_valid(const SubBoxOptions<T>& options, SubBoxResult<T>* r) {
+  std::string why;
+  if (options.validate(&why) == Status::Ok) return true;
+  r->status = Status::InvalidInput;
+  r->reason = "invalid options: " + why;
+  r->votes.clear();
+  r->cells.clear();
+  r->grid = 0;
+  return false;
+}
+
 /// Zeroed per-box votes and per-cell buffers for nb boxes of grid*grid cells; returns grid*grid.
 template <class T>
 std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
+  out->grid = grid;
   const std::size_t cells_per_box = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
   out->votes.assign(nb, SubBoxVote{});
   out->cells.assign(nb * cells_per_box, 0);
@@ -205,15 +263,7 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
-  if (g < 1 || g > 8 || !(options.sigma1 >= T(0)) || options.sigma2 < 0 ||
-      (options.static_needs_evidence && !(options.static_max_dynamic_ratio >= T(0))) ||
-      (options.whole_box_spare_min_points > 0 && !(options.whole_box_spare_max_ratio >= T(0)))) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid options: 1 <= grid <= 8, sigma1 >= 0, sigma2 >= 0, static_max_dynamic_ratio >= 0 and "
-               "whole_box_spare_max_ratio >= 0 required";
-    r.votes.clear();
-    return;
-  }
+  if (!detail::subbox_options_valid(options, &r)) return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
 
   // Votes: every labelled feature counts in every box containing it (boxes may overlap).
@@ -317,12 +367,7 @@ void apply_subbox_states(const Points& points, const FeatureLabel* geometric, co
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
-  if (g < 1 || g > 8) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid options: 1 <= grid <= 8 required";
-    r.votes.clear();
-    return;
-  }
+  if (!detail::subbox_options_valid(options, &r)) return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
   for (std::size_t b = 0; b < nb; ++b) {
     if (!detail::subbox_as_box(boxes[b]).valid()) {
@@ -350,6 +395,8 @@ inline void dilate_square(MaskView mask, PixelRect roi, int radius, std::vector<
   roi.r1 = std::min(roi.r1, mask.height);
   if (roi.empty()) return;
   const int w = roi.width(), h = roi.height();
+  // A radius beyond the roi's size reaches every roi pixel: same mask, bounded scratch and counts.
+  radius = std::min(radius, std::max(w, h));
   const std::size_t uw = static_cast<std::size_t>(w);
   // Layout (uint16 words): h rows of horizontal results (0/1), one row of vertical window counts, then
   // an OR-doubling row buffer of w + 2r + 1 bytes (reached through a byte pointer: char may alias).
@@ -397,24 +444,27 @@ inline void dilate_square(MaskView mask, PixelRect roi, int radius, std::vector<
 
 /// Rasterises the final mask of Algorithm 1 into `mask` (cleared first; must be the image size):
 /// the object mask (or the whole cell when object_mask is empty) inside every dynamic sub-box, then
-/// dilated by options.dilation_radius_px. Returns the number of set pixels.
+/// dilated by options.dilation_radius_px (clamped to [0, 1024]). The cells are split on the grid the
+/// vote used (result.grid), whatever options.grid says. Returns the number of set pixels; 0 (mask
+/// cleared) when the result does not hold grid*grid cells for each of `boxes` (not a vote's result).
 template <class T, class Boxes>
 std::size_t subbox_mask(const SubBoxResult<T>& result, const Boxes& boxes, const SubBoxOptions<T>& options,
                         ConstMaskView object_mask, MaskView mask, std::vector<std::uint16_t>* scratch) {
   if (mask.empty()) return 0;
   for (int y = 0; y < mask.height; ++y) std::fill(mask.row(y), mask.row(y) + mask.width, std::uint8_t(0));
-  const int g = options.grid;
-  if (g < 1 || result.votes.size() != static_cast<std::size_t>(boxes.size())) return 0;
+  const int g = result.grid;
+  if (g < 1 || g > 8 || result.votes.size() != static_cast<std::size_t>(boxes.size())) return 0;
   const std::size_t cells_per_box = static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  if (result.cells.size() != result.votes.size() * cells_per_box) return 0;
   PixelRect bound{mask.width, mask.height, 0, 0};
   for (std::size_t b = 0; b < result.votes.size(); ++b) {
     const Box<T>& box = detail::subbox_as_box(boxes[b]);
     if (!box.valid()) continue;
-    const T cw = box.width() / T(g), ch = box.height() / T(g);
     for (int c = 0; c < static_cast<int>(cells_per_box); ++c) {
       if (!result.cells[b * cells_per_box + static_cast<std::size_t>(c)]) continue;
       const int row = c / g, col = c % g;
-      const Box<T> cell{box.x0 + T(col) * cw, box.y0 + T(row) * ch, box.x0 + T(col + 1) * cw, box.y0 + T(row + 1) * ch};
+      const Box<T> cell{detail::subbox_edge(box.x0, box.x1, col, g), detail::subbox_edge(box.y0, box.y1, row, g),
+                        detail::subbox_edge(box.x0, box.x1, col + 1, g), detail::subbox_edge(box.y0, box.y1, row + 1, g)};
       const PixelRect pr = pixel_rect(cell, mask.width, mask.height);
       if (pr.empty()) continue;
       bound.c0 = std::min(bound.c0, pr.c0);
@@ -434,7 +484,7 @@ std::size_t subbox_mask(const SubBoxResult<T>& result, const Boxes& boxes, const
     }
   }
   if (bound.empty()) return 0;
-  const int rad = std::max(0, options.dilation_radius_px);
+  const int rad = std::min(std::max(0, options.dilation_radius_px), 1024);
   const PixelRect grown{std::max(0, bound.c0 - rad), std::max(0, bound.r0 - rad), std::min(mask.width, bound.c1 + rad),
                         std::min(mask.height, bound.r1 + rad)};
   dilate_square(mask, grown, rad, scratch);
