@@ -236,6 +236,7 @@ struct DeskMotion {
   double arm[2] = {0, 0};               ///< shoulder pitch of the right (0) and left (1) arm, added to the rest pose
   double swivel = 0;                    ///< chair (and whole person) about the vertical through the seat
   bool swivel_moving = false;           ///< the swivel changes somewhere in (t - dt, t + dt)
+  bool upper_moving = false;            ///< upper body, head and arms move (scale != 0)
 };
 
 /// Swivel profile over one 9 s cycle: out over 1.2 s, hold, back over 1.2 s, rest. Episodic, so
@@ -263,6 +264,7 @@ inline DeskMotion desk_motion(double t, double dt, double phase, double scale) {
   m.arm[0] = scale * -0.9 * envelope * (0.6 + 0.4 * std::sin(kTwoPi * u / 1.1));
   m.arm[1] = scale * -0.35 * std::max(0.0, std::sin(kTwoPi * u / 7.9 + 1.0));
   m.swivel = scale * 0.3 * (desk_swivel_profile(u) - 0.5);
+  m.upper_moving = scale != 0;
   if (scale != 0) {
     // Moving when the profile differs at either end of the window (sampled finely: ramps are 1.2 s).
     const double p0 = desk_swivel_profile(u);
@@ -294,15 +296,15 @@ inline void add_desk_person(PrimitiveSink& sink, const Rigid3<double>& world_fro
   }
   const Rigid3<double> person_from_upper = make_pose(rot_z(m.sway_yaw) * rot_y(m.sway_pitch + 0.05), {0, 0, 0.62});
   auto U = [&](const Rigid3<double>& upper_from_part) { return world_from_person * person_from_upper * upper_from_part; };
-  sink.add(PrimitiveShape::Ellipsoid, U(make_pose(I, {0, 0, 0.31})), {0.13, 0.21, 0.29}, instance, true, c.seed + 2,
+  sink.add(PrimitiveShape::Ellipsoid, U(make_pose(I, {0, 0, 0.31})), {0.13, 0.21, 0.29}, instance, m.upper_moving, c.seed + 2,
            kCloth, c.shirt);
   sink.add(PrimitiveShape::Ellipsoid, U(make_pose(rot_z(m.head_yaw), {0, 0, 0.72})), {0.10, 0.085, 0.12}, instance,
-           true, c.seed + 3, kSkin, c.skin);
+           m.upper_moving, c.seed + 3, kSkin, c.skin);
   for (int side = -1; side <= 1; side += 2) {
     const double s = static_cast<double>(side);
     const double pitch = -0.35 + m.arm[side > 0 ? 1 : 0];  // arms rest forward on the lap
     sink.add(PrimitiveShape::Ellipsoid, U(limb({0, 0.25 * s, 0.52}, rot_y(pitch) * rot_x(-0.12 * s), 0.64)),
-             {0.055, 0.055, 0.32}, instance, true, c.seed + 5, kCloth, c.shirt);
+             {0.055, 0.055, 0.32}, instance, m.upper_moving, c.seed + 5, kCloth, c.shirt);
   }
 }
 
@@ -326,12 +328,12 @@ inline void add_desk_clutter(PrimitiveSink& sink, const Rigid3<double>& world_fr
     box(I, {x, 0.22, top + 0.01}, {0.12, 0.09, 0.01}, id, 14u + k, 0.05, dark);    // foot
     box(R, {x, -0.12, top + 0.016}, {0.23, 0.08, 0.016}, static_cast<std::uint16_t>(SceneInstance::kKeyboardA + k),
         16u + k, 0.02, grey);
-    box(I, {x + 0.34, -0.12, top + 0.022}, {0.04, 0.06, 0.022}, static_cast<std::uint16_t>(SceneInstance::kMouseA + k),
-        18u + k, 0.02, dark);
+    box(I, {k == 0 ? x + 0.32 : x - 0.36, k == 0 ? -0.27 : -0.12, top + 0.022}, {0.04, 0.06, 0.022},
+        static_cast<std::uint16_t>(SceneInstance::kMouseA + k), 18u + k, 0.02, dark);
   }
-  box(I, {1.05, 0.05, top + 0.13}, {0.04, 0.04, 0.13}, SceneInstance::kBottle, 20u, 0.03, {0.4, 0.7, 0.5});
+  box(I, {0.3, 0.06, top + 0.13}, {0.04, 0.04, 0.13}, SceneInstance::kBottle, 20u, 0.03, {0.4, 0.7, 0.5});
   box(I, {0.1, 0.0, top + 0.055}, {0.045, 0.045, 0.055}, SceneInstance::kCup, 21u, 0.02, {0.9, 0.9, 0.85});
-  box(rot_z(0.4), {-1.05, -0.05, top + 0.025}, {0.12, 0.16, 0.025}, SceneInstance::kBook, 22u, 0.03, {0.8, 0.3, 0.3});
+  box(rot_z(0.4), {0.0, -0.2, top + 0.025}, {0.1, 0.13, 0.025}, SceneInstance::kBook, 22u, 0.03, {0.8, 0.3, 0.3});
   // Laptop: base on the desk, lid open at 110 degrees.
   box(I, {-0.05, 0.12, top + 0.01}, {0.17, 0.12, 0.01}, SceneInstance::kLaptop, 23u, 0.03, grey);
   box(rot_x(-0.35), {-0.05, 0.27, top + 0.12}, {0.17, 0.01, 0.115}, SceneInstance::kLaptop, 24u, 0.03, dark);
@@ -433,8 +435,8 @@ inline void build_scene(double t, double frame_dt, std::uint64_t seed, const Act
     if (options.desk_clutter) detail::add_desk_clutter(sink, world_from_desk, kTop, tex + 1000);
     const detail::Clothes desk_clothes[2] = {{{0.3, 0.35, 0.6}, {0.25, 0.25, 0.3}, {0.85, 0.7, 0.55}, tex + 1100},
                                              {{0.8, 0.75, 0.7}, {0.35, 0.3, 0.25}, {0.75, 0.6, 0.5}, tex + 1200}};
-    const Rigid3<double> seats[2] = {make_pose(detail::rot_z(0.55), {-0.75, 1.15, 0.0}),
-                                     make_pose(detail::rot_z(3.141592653589793 - 0.75), {0.6, 1.25, 0.0})};
+    const Rigid3<double> seats[2] = {make_pose(detail::rot_z(0.55), {-0.7, 0.92, 0.0}),
+                                     make_pose(detail::rot_z(3.141592653589793 - 0.75), {0.55, 1.02, 0.0})};
     for (int k = 0; k < options.desk_people && k < 2; ++k) {
       const double phase = 2.3 * k + 0.37 * static_cast<double>(seed % 13);
       const detail::DeskMotion m = detail::desk_motion(t, frame_dt, phase, options.desk_motion_scale);
