@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -160,8 +161,8 @@ TEST(SimTrajectory, UnusableRecordingsAreNamedAndGiveTheRestPose) {
   cases.back().o.recorded_poses.pop_back();
   cases.push_back({good, "trajectory.recorded_stamps_s[7] is not finite"});
   cases.back().o.recorded_stamps_s[7] = std::nan("");
-  cases.push_back({good, "trajectory.recorded_stamps_s[9] is not after the previous stamp"});
-  cases.back().o.recorded_stamps_s[9] = cases.back().o.recorded_stamps_s[8];
+  cases.push_back({good, "trajectory.recorded_stamps_s[9] is before the previous stamp"});
+  cases.back().o.recorded_stamps_s[9] = cases.back().o.recorded_stamps_s[8] - 1e-4;
   cases.push_back({good, "trajectory.recorded_poses[3] is not finite"});
   cases.back().o.recorded_poses[3].t.x() = INFINITY;
   cases.push_back({good, "trajectory.recorded_poses[4] has a rotation that is not orthonormal"});
@@ -183,6 +184,14 @@ TEST(SimTrajectory, UnusableRecordingsAreNamedAndGiveTheRestPose) {
     EXPECT_EQ(scene.status(), Status::InvalidInput) << c.field;
     EXPECT_NE(scene.reason().find(c.field), std::string::npos) << scene.reason();
   }
+  // A repeated stamp (as fr3_walking_static's ground truth has) is usable: the later pose wins.
+  TrajectoryOptions repeated = good;
+  repeated.recorded_stamps_s[9] = repeated.recorded_stamps_s[8];
+  EXPECT_TRUE(repeated.validate_recorded(true, &why)) << why;
+  const Rigid3<double> at = camera_pose(CameraMotion::Recorded, repeated.recorded_stamps_s[8] - 1000.0, 1, repeated);
+  const Rigid3<double> want = rest * (repeated.recorded_poses[0].inverse() * repeated.recorded_poses[9]);
+  EXPECT_LT((at.t - want.t).norm(), 1e-12);
+  EXPECT_LT((at.R - want.R).norm(), 1e-12);
   // A broken recording is refused even when another motion is chosen (it was given for a reason).
   SceneOptions xyz;
   xyz.trajectory = cases[1].o;
@@ -203,7 +212,8 @@ Rigid3<double> interpolate(const eval::Trajectory<double>& rec, double stamp) {
 TEST(SimTrajectory, RecordedMotionFollowsTheRealTumGroundTruth) {
   const char* root = std::getenv("DYNCULL_DATA_DIR");
   if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
-  for (const char* name : {"fr3_walking_xyz", "fr3_walking_rpy", "fr3_sitting_static"}) {
+  for (const char* name : {"fr3_walking_xyz", "fr3_walking_static", "fr3_walking_rpy", "fr3_walking_halfsphere",
+                           "fr3_sitting_static", "fr3_sitting_xyz"}) {
     const auto read = eval::read_tum_trajectory<double>(std::string(root) + "/tum/" + name + "/groundtruth.txt");
     ASSERT_TRUE(read.ok()) << read.reason;
     SceneOptions o;
@@ -233,7 +243,8 @@ TEST(SimTrajectory, RecordedMotionFollowsTheRealTumGroundTruth) {
     EXPECT_LT(worst_t, 1e-9) << name;
     EXPECT_LT(worst_r, 1e-9) << name;
     EXPECT_NEAR(sim_path, real_path, 1e-8) << name;
-    EXPECT_GT(real_path, 0.05) << name << " moved";  // even sitting_static's tripod-less camera drifts
+    std::printf("%s: %.3f m of camera path in 10 s\n", name, real_path);
+    EXPECT_GT(real_path, 0.01) << name << " moved";  // even the *_static cameras drift by centimetres
     FrameData f;
     scene.render(150, &f);
     EXPECT_TRUE(f.ok()) << f.reason;

@@ -45,7 +45,7 @@ struct TrajectoryOptions {
   double halfsphere_radius_m = 0.5;           ///< Halfsphere: ~1 m diameter
   double halfsphere_azimuth_deg = 70.0;       ///< Halfsphere: azimuth swing (< 90 keeps one hemisphere)
   double halfsphere_elevation_deg = 35.0;     ///< Halfsphere: elevation swing
-  /// Recorded: stamps (seconds, strictly increasing) and world_from_cam poses of a real trajectory,
+  /// Recorded: stamps (seconds, non-decreasing) and world_from_cam poses of a real trajectory,
   /// e.g. a TUM groundtruth.txt read by the caller with eval::read_tum_trajectory. The pose at
   /// recorded_start_s becomes the rest pose (eye_m looking at target_m); later frames move relative
   /// to it exactly as the recording does, interpolated at the frame times (slerp / linear). Past the
@@ -69,8 +69,9 @@ struct TrajectoryOptions {
     for (std::size_t k = 0; k < n; ++k) {
       if (!std::isfinite(recorded_stamps_s[k]))
         return bad("trajectory.recorded_stamps_s[" + std::to_string(k) + "] is not finite");
-      if (k > 0 && !(recorded_stamps_s[k] > recorded_stamps_s[k - 1]))
-        return bad("trajectory.recorded_stamps_s[" + std::to_string(k) + "] is not after the previous stamp");
+      // Equal stamps are allowed: TUM files round to 0.1 ms and repeat one now and then (the later wins).
+      if (k > 0 && recorded_stamps_s[k] < recorded_stamps_s[k - 1])
+        return bad("trajectory.recorded_stamps_s[" + std::to_string(k) + "] is before the previous stamp");
       const Rigid3<double>& p = recorded_poses[k];
       if (!p.R.allFinite() || !p.t.allFinite())
         return bad("trajectory.recorded_poses[" + std::to_string(k) + "] is not finite");
