@@ -16,11 +16,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -47,6 +49,7 @@ struct Args {
   bool families_set = false;
   std::string scene;  // key=value,... applied on top of each family
   int jobs = 1;       // sequences run in parallel
+  std::string tum_trajectories;  // directory of TUM fr3_* directories (default $DYNCULL_DATA_DIR/tum)
   bool suite = false;
 };
 
@@ -60,7 +63,10 @@ void usage(const char* argv0) {
       "  then prints ATE RMSE, improvement over no culling, label precision/recall and timings.\n"
       "options:\n"
       "  --frames N          frames per sequence (default 300; --quick: 60)\n"
-      "  --sequences LIST    synthetic sequences, comma separated: static,xyz,rpy,halfsphere (default all)\n"
+      "  --sequences LIST    synthetic sequences, comma separated: static,xyz,rpy,halfsphere (default all),\n"
+      "                      or a TUM fr3 recording's camera motion, e.g. fr3_walking_xyz, fr3_sitting_static\n"
+      "                      (its groundtruth.txt under --tum-trajectories; seed s starts it 7 (s - 1) s in)\n"
+      "  --tum-trajectories DIR  directory of the fr3_* recordings (default $DYNCULL_DATA_DIR/tum)\n"
       "  --seeds LIST        scene seeds, comma separated (default 1,2,3). Every sequence runs once per seed\n"
       "                      and, with several, a summary gives the median ATE and pooled labels per strategy\n"
       "  --tum DIR           run on a TUM RGB-D directory (rgb.txt, depth.txt, optional groundtruth.txt)\n"
@@ -185,6 +191,8 @@ bool parse_args(int argc, char** argv, Args* a) {
       a->scene += (a->scene.empty() ? "" : ",") + v;
     } else if (arg == "--jobs") {
       if (!value(&v) || !parse_int(arg, v, 1, 64, &a->jobs)) return false;
+    } else if (arg == "--tum-trajectories") {
+      if (!value(&a->tum_trajectories)) return false;
     } else if (arg == "--suite") {
       a->suite = true;
     } else if (arg == "--quick") {
@@ -197,6 +205,10 @@ bool parse_args(int argc, char** argv, Args* a) {
       std::fprintf(stderr, "dynamic_vo: unknown option '%s' (try --help)\n", arg.c_str());
       return false;
     }
+  }
+  if (a->tum_trajectories.empty()) {
+    const char* data = std::getenv("DYNCULL_DATA_DIR");
+    if (data != nullptr && *data != '\0') a->tum_trajectories = std::string(data) + "/tum";
   }
   if (a->suite) {
     if (!a->families_set) {
@@ -221,7 +233,30 @@ bool parse_args(int argc, char** argv, Args* a) {
 }
 
 bool motion_from_name(const std::string& name, sim::CameraMotion* m) {
-  return sim::camera_motion_from_string(name, m);
+  sim::CameraMotion motion{};
+  if (!sim::camera_motion_from_string(name, &motion) || motion == sim::CameraMotion::Recorded) return false;
+  *m = motion;
+  return true;
+}
+
+/// A sequence named after a TUM fr3 directory ("fr3_walking_xyz") follows that recording's ground truth.
+bool is_recorded(const std::string& name) { return name.rfind("fr3_", 0) == 0; }
+
+/// Loads <dir>/<name>/groundtruth.txt as the recorded camera motion; false with a reason.
+bool load_recorded(const std::string& dir, const std::string& name, sim::TrajectoryOptions* t, std::string* error) {
+  if (dir.empty()) {
+    *error = "sequence '" + name + "' needs the TUM trajectories: set DYNCULL_DATA_DIR or give --tum-trajectories DIR";
+    return false;
+  }
+  const std::string path = dir + "/" + name + "/groundtruth.txt";
+  const eval::TrajectoryReadResult<double> gt = eval::read_tum_trajectory<double>(path);
+  if (!gt.ok() || gt.trajectory.size() < 2) {
+    *error = "sequence '" + name + "': " + (gt.ok() ? path + " has fewer than 2 poses" : gt.reason);
+    return false;
+  }
+  t->recorded_stamps_s = gt.trajectory.stamps;
+  t->recorded_poses = gt.trajectory.poses;
+  return true;
 }
 
 /// One synthetic sequence of the run: a family's scene with one motion and seed.
@@ -307,10 +342,18 @@ int main(int argc, char** argv) {
     }
     reports.push_back(std::move(rep));
   } else {
+    std::map<std::string, sim::TrajectoryOptions> recorded;  // the recordings, loaded once
     for (const std::string& seq : args.sequences) {
       sim::CameraMotion m{};
-      if (!motion_from_name(seq, &m)) {
-        std::fprintf(stderr, "dynamic_vo: unknown sequence '%s' (static, xyz, rpy, halfsphere)\n", seq.c_str());
+      if (is_recorded(seq)) {
+        std::string error;
+        if (!load_recorded(args.tum_trajectories, seq, &recorded[seq], &error)) {
+          std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
+          return 2;
+        }
+      } else if (!motion_from_name(seq, &m)) {
+        std::fprintf(stderr, "dynamic_vo: unknown sequence '%s' (static, xyz, rpy, halfsphere, fr3_<TUM sequence>)\n",
+                     seq.c_str());
         return 2;
       }
     }
@@ -326,9 +369,21 @@ int main(int argc, char** argv) {
           job.sequence = seq;
           job.seed = seed;
           job.options = f.options;
-          motion_from_name(seq, &job.options.motion);
           job.options.num_frames = args.frames;
           job.options.seed = seed;
+          if (is_recorded(seq)) {
+            // The recording replaces the synthetic motion; each seed starts it 7 s later (wrapped so the
+            // run fits), so seeds see different parts of the real trajectory.
+            const sim::TrajectoryOptions& rec = recorded[seq];
+            job.options.motion = sim::CameraMotion::Recorded;
+            job.options.trajectory.recorded_stamps_s = rec.recorded_stamps_s;
+            job.options.trajectory.recorded_poses = rec.recorded_poses;
+            const double span = rec.recorded_stamps_s.back() - rec.recorded_stamps_s.front() -
+                                args.frames / job.options.fps;
+            job.options.trajectory.recorded_start_s = span > 0 ? std::fmod(7.0 * static_cast<double>(seed - 1), span) : 0.0;
+          } else {
+            motion_from_name(seq, &job.options.motion);
+          }
           job.name = (args.families_set ? family + "-" : std::string()) + seq +
                      (args.seeds.size() > 1 ? "-s" + std::to_string(seed) : std::string());
           jobs.push_back(std::move(job));
