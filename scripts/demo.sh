@@ -1,11 +1,18 @@
 #!/usr/bin/env bash
-# Builds the examples (Release) and runs the main demo: dynamic_vo on the synthetic dynamic
-# RGB-D sequences, every culling preset against no culling. Extra arguments go to dynamic_vo
-# (try --help). Output (table, plots, frames) goes to ./dynamic_vo_out unless --out is given.
+# Builds the examples (Release) and runs the main demo: dynamic_vo on the synthetic dynamic RGB-D
+# sequences, every culling preset against no culling. Without arguments it runs the scene-family suite
+# (dynamic_vo --suite: every family x static,xyz,rpy,halfsphere x seeds 1,2,3, 150 frames each, on
+# DYNCULL_JOBS threads, default all cores) and prints one summary table, a row per family; it also writes
+# family_summary.md / family_summary.csv. With arguments they go to dynamic_vo instead (try --help).
+# Output (tables, plots, frames) goes to ./dynamic_vo_out unless --out is given. DYNCULL_DEMO_BUILD sets
+# the build directory (default build/demo).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-build="$root/build/demo"
+build="${DYNCULL_DEMO_BUILD:-$root/build/demo}"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_BUILD_TESTS=OFF \
   -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=ON >/dev/null
 cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dynamic_vo
+if (($# == 0)); then
+  set -- --suite --jobs "${DYNCULL_JOBS:-$(nproc)}"
+fi
 exec "$build/examples/dynamic_vo" "$@"
