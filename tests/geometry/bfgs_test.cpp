@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include <cmath>
 
 namespace {
@@ -146,6 +148,42 @@ TEST(Bfgs, StartAtMinimumReturnsImmediately) {
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r.iterations, 0);
   EXPECT_EQ(r.evaluations, 1);
+}
+
+TEST(BfgsOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
+  std::string why;
+  EXPECT_EQ(dyncull::BfgsOptions{}.validate(&why), dyncull::Status::Ok);
+  EXPECT_TRUE(why.empty());
+  auto check = [&](dyncull::BfgsOptions o, const char* field) {
+    EXPECT_EQ(o.validate(&why), dyncull::Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+    const auto r = dyncull::bfgs_minimize(
+        [](const Eigen::Vector2d& x, Eigen::Vector2d* g) {
+          *g = 2 * x;
+          return x.squaredNorm();
+        },
+        Eigen::Vector2d(1, 1), o);
+    EXPECT_EQ(r.status, dyncull::Status::InvalidInput);
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+  };
+  dyncull::BfgsOptions o;
+  o.gradient_tolerance = std::nan("");
+  check(o, "gradient_tolerance");
+  o = {};
+  o.function_tolerance = -1;
+  check(o, "function_tolerance");
+  o = {};
+  o.parameter_tolerance = HUGE_VAL;
+  check(o, "parameter_tolerance");
+  o = {};
+  o.max_iterations = 1 << 30;  // unbounded time: refused
+  check(o, "max_iterations");
+  o = {};
+  o.max_line_search_steps = 0;
+  check(o, "max_line_search_steps");
+  o = {};
+  o.wolfe_c2 = 1.5;
+  check(o, "wolfe_c2");
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -372,6 +374,30 @@ TEST(FundamentalOpenCV, AgreesWithFindFundamentalMat) {
   }
 }
 #endif
+
+TEST(FundamentalOptionsValidate, NamesTheFieldIncludingNestedRansac) {
+  std::string why;
+  FundamentalOptions<double> o;
+  EXPECT_EQ(o.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  const auto d = clean_data<double>(40, 3);
+  auto check = [&](const FundamentalOptions<double>& bad, const char* field) {
+    EXPECT_EQ(bad.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+    const auto r = estimate_fundamental_ransac(d.points1, d.points2, bad);
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+  };
+  FundamentalOptions<double> bad = o;
+  bad.degenerate_homography_fraction = 5;  // a fraction above 1 silently disabled the check
+  check(bad, "degenerate_homography_fraction");
+  bad = o;
+  bad.homography_threshold_factor = HUGE_VAL;
+  check(bad, "homography_threshold_factor");
+  bad = o;
+  bad.ransac.max_iterations = static_cast<std::size_t>(-1);
+  check(bad, "ransac.max_iterations");
+}
 
 }  // namespace
 }  // namespace dyncull

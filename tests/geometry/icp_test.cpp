@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include <limits>
 #include <vector>
 
@@ -129,6 +131,33 @@ TYPED_TEST(IcpTest, BadInputReportsStatus) {
   std::vector<Vec3<T>> line;
   for (int i = 0; i < 50; ++i) line.push_back(Vec3<T>(T(0.01) * T(i), T(0), T(0)));
   EXPECT_EQ(dyncull::icp_point_to_point(line, line, Rigid3<T>{}).status, Status::Degenerate);
+}
+
+TEST(IcpOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
+  std::string why;
+  EXPECT_EQ(IcpOptions<double>{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  Random rng(85);
+  const auto target = room_cloud<double>(rng, 100);
+  auto check = [&](const IcpOptions<double>& bad, const char* field) {
+    EXPECT_EQ(bad.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+    const auto r = dyncull::icp_point_to_point(target, target, Rigid3<double>{}, bad);
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+  };
+  IcpOptions<double> bad;
+  bad.max_iterations = 1 << 30;
+  check(bad, "max_iterations");
+  bad = {};
+  bad.max_correspondence_distance_m = HUGE_VAL;
+  check(bad, "max_correspondence_distance_m");
+  bad = {};
+  bad.relative_fitness = std::nan("");
+  check(bad, "relative_fitness");
+  bad = {};
+  bad.relative_rmse = HUGE_VAL;
+  check(bad, "relative_rmse");
 }
 
 }  // namespace

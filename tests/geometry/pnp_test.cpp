@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include <limits>
 #include <vector>
 
@@ -283,5 +285,42 @@ TEST(PnpVsOpenCV, RefinementMatchesSolvePnPIterative) {
   EXPECT_LT(translation_error(c, r.cam_from_world), 1e-5);
 }
 #endif
+
+TEST(PnpOptionsValidate, NamesTheFieldIncludingNestedOptions) {
+  std::string why;
+  EXPECT_EQ(PnpOptions<double>{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  EXPECT_EQ(dyncull::PoseRefinementOptions<float>{}.validate(&why), Status::Ok);
+  const auto s = make_pnp_scene<double>(5, 30);
+  auto check = [&](const PnpOptions<double>& bad, const char* field) {
+    EXPECT_EQ(bad.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+    for (const auto& r : {dyncull::solve_pnp(s.world, s.pixels, s.camera, bad),
+                          dyncull::solve_pnp_ransac(s.world, s.pixels, s.camera, bad)}) {
+      EXPECT_EQ(r.status, Status::InvalidInput);
+      EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+      EXPECT_EQ(r.inlier_mask.size(), s.world.size());
+    }
+    const auto rr = dyncull::refine_pose(s.world, s.pixels, s.camera, s.cam_from_world, bad.refinement);
+    if (bad.refinement.validate() != Status::Ok) {
+      EXPECT_EQ(rr.status, Status::InvalidInput);
+    }
+  };
+  PnpOptions<double> bad;
+  bad.refinement.max_iterations = 1 << 30;  // unbounded time: refused
+  check(bad, "refinement.max_iterations");
+  bad = {};
+  bad.refinement.huber_threshold_px = std::nan("");  // accepted while huber was off
+  check(bad, "refinement.huber_threshold_px");
+  bad = {};
+  bad.refinement.step_tolerance = -1;
+  check(bad, "refinement.step_tolerance");
+  bad = {};
+  bad.refinement.initial_damping = HUGE_VAL;
+  check(bad, "refinement.initial_damping");
+  bad = {};
+  bad.ransac.max_residual = 0;
+  check(bad, "ransac.max_residual");
+}
 
 }  // namespace

@@ -297,5 +297,30 @@ TEST(RansacDefaults, OptionsAndResult) {
   EXPECT_EQ(r.num_inliers, 0u);
 }
 
+TEST(RansacOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
+  std::string why;
+  EXPECT_EQ(RansacOptions{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  auto expect_field = [&](const RansacOptions& o, const char* field) {
+    EXPECT_EQ(o.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+  };
+  RansacOptions o;
+  o.max_iterations = static_cast<std::size_t>(-1);  // hours of sampling: refused
+  expect_field(o, "max_iterations");
+  o = RansacOptions{};
+  o.max_residual = std::nan("");
+  expect_field(o, "max_residual");
+  o = RansacOptions{};
+  o.confidence = 2;
+  expect_field(o, "confidence");
+  o = RansacOptions{};
+  o.min_iterations = 20000;
+  expect_field(o, "min_iterations");
+  o = RansacOptions{};
+  o.max_iterations = RansacOptions::kMaxIterations;
+  EXPECT_EQ(o.validate(), Status::Ok);
+}
+
 }  // namespace
 }  // namespace dyncull

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #ifdef DYNCULL_HAS_CERES
 #include <ceres/ceres.h>
 #endif
@@ -342,5 +344,43 @@ TEST(RotationCentre, AgreesWithCeresBfgs) {
   }
 }
 #endif
+
+TEST(RotationCentreOptionsValidate, NamesTheFieldIncludingNestedBfgs) {
+  std::string why;
+  EXPECT_EQ(RotationCentreOptions{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  const auto flow = rotation_flow<double>(60, 300, 200, 0.4, 0.0, 9);
+  auto check = [&](const RotationCentreOptions& bad, const char* field) {
+    EXPECT_EQ(bad.validate(&why), Status::InvalidInput);
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+    const auto r = dyncull::estimate_rotation_centre(flow.p1, flow.p2, 640, 480, bad);
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+  };
+  RotationCentreOptions bad;
+  bad.loss_scale_px = std::nan("");
+  check(bad, "loss_scale_px");
+  bad = {};
+  bad.solver = static_cast<RotationCentreSolver>(7);
+  check(bad, "solver");
+  bad = {};
+  bad.loss = static_cast<RobustLoss>(9);
+  check(bad, "loss");
+  bad = {};
+  bad.min_eigenvalue_ratio = 2;
+  check(bad, "min_eigenvalue_ratio");
+  bad = {};
+  bad.distance_threshold_px = HUGE_VAL;
+  check(bad, "distance_threshold_px");
+  bad = {};
+  bad.max_irls_iterations = 1 << 30;
+  check(bad, "max_irls_iterations");
+  bad = {};
+  bad.min_flow_px = std::nan("");
+  check(bad, "min_flow_px");
+  bad = {};
+  bad.bfgs.max_iterations = -1;
+  check(bad, "bfgs.max_iterations");
+}
 
 }  // namespace

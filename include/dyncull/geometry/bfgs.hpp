@@ -27,6 +27,31 @@ struct BfgsOptions {
   double armijo_c1 = 1e-4;            ///< sufficient-decrease constant of the Armijo condition
   double wolfe_c2 = 0.9;              ///< curvature constant: extrapolate while g_new.p < c2 g.p
   int max_line_search_steps = 30;     ///< function evaluations per line search
+
+  static constexpr int kMaxIterations = 100000;       ///< upper bound of max_iterations
+  static constexpr int kMaxLineSearchSteps = 1000;    ///< upper bound of max_line_search_steps
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (max_iterations < 0 || max_iterations > kMaxIterations)
+      return bad("BfgsOptions: max_iterations must be in [0, 100000]");
+    if (max_line_search_steps < 1 || max_line_search_steps > kMaxLineSearchSteps)
+      return bad("BfgsOptions: max_line_search_steps must be in [1, 1000]");
+    if (!(gradient_tolerance >= 0.0) || !std::isfinite(gradient_tolerance))
+      return bad("BfgsOptions: gradient_tolerance must be finite and >= 0");
+    if (!(function_tolerance >= 0.0) || !std::isfinite(function_tolerance))
+      return bad("BfgsOptions: function_tolerance must be finite and >= 0");
+    if (!(parameter_tolerance >= 0.0) || !std::isfinite(parameter_tolerance))
+      return bad("BfgsOptions: parameter_tolerance must be finite and >= 0");
+    if (!(armijo_c1 > 0.0)) return bad("BfgsOptions: armijo_c1 must be > 0");
+    if (!(wolfe_c2 > armijo_c1) || !(wolfe_c2 < 1.0)) return bad("BfgsOptions: wolfe_c2 must be in (armijo_c1, 1)");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Outcome of bfgs_minimize. status: Ok (a tolerance was met), NotConverged (iteration limit or a
@@ -73,11 +98,13 @@ BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x
 
   BfgsResult<T, N> result;
   result.x = x0;
-  if (options.max_iterations < 0 || options.max_line_search_steps < 1 || !(options.armijo_c1 > 0) ||
-      !(options.wolfe_c2 > options.armijo_c1) || !(options.wolfe_c2 < 1)) {
-    result.status = Status::InvalidInput;
-    result.reason = "bfgs: need max_iterations >= 0, max_line_search_steps >= 1 and 0 < armijo_c1 < wolfe_c2 < 1";
-    return result;
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) {
+      result.status = Status::InvalidInput;
+      result.reason = "bfgs: " + why;
+      return result;
+    }
   }
   if (!x0.allFinite()) {
     result.status = Status::NonFinite;

@@ -45,6 +45,26 @@ struct FundamentalOptions {
   /// Homography transfer threshold (px) as a multiple of ransac.max_residual: the one-sided transfer error
   /// of a correct H is about sqrt(2) times the Sampson error of the same correspondence, plus noise.
   double homography_threshold_factor = 2.0;
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    std::string why;
+    if (ransac.validate(&why) != Status::Ok) {
+      if (reason) *reason = detail::nested_reason("FundamentalOptions", "ransac", why);
+      return Status::InvalidInput;
+    }
+    auto bad = [&](const char* text) {
+      if (reason) *reason = text;
+      return Status::InvalidInput;
+    };
+    if (!(degenerate_homography_fraction > 0.0 && degenerate_homography_fraction <= 1.0))
+      return bad("FundamentalOptions: degenerate_homography_fraction must be in (0, 1]");
+    if (!(homography_threshold_factor > 0.0) || !std::isfinite(homography_threshold_factor) ||
+        !std::isfinite(homography_threshold_factor * ransac.max_residual))
+      return bad("FundamentalOptions: homography_threshold_factor must be finite and > 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Result of an F estimation. F has unit Frobenius norm and rank 2; inlier_mask has one entry per input
@@ -653,9 +673,8 @@ FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& po
     r.reason = "points1 and points2 differ in size";
     return r;
   }
-  if (!(options.degenerate_homography_fraction > 0) || !(options.homography_threshold_factor > 0)) {
+  if (options.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "degenerate_homography_fraction and homography_threshold_factor must be > 0";
     return r;
   }
   const FundamentalEstimator<T> est(points1, points2, options.sampson_weighted_refit);

@@ -25,12 +25,22 @@ struct IcpOptions {
   T relative_rmse = T(1e-6);                   ///< ... and |rmse change| below this (metres), as Open3D
   bool estimate_scale = false;                 ///< Sim(3) instead of SE(3) per step
 
-  Status validate(std::string* reason) const {
-    if (max_iterations < 0 || !(max_correspondence_distance_m > T(0)) || !(relative_fitness >= T(0)) ||
-        !(relative_rmse >= T(0))) {
-      if (reason) *reason = "IcpOptions: max_iterations >= 0, max_correspondence_distance_m > 0, tolerances >= 0";
+  static constexpr int kMaxIterations = 10000;  ///< upper bound of max_iterations
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
       return Status::InvalidInput;
-    }
+    };
+    if (max_iterations < 0 || max_iterations > kMaxIterations) return bad("IcpOptions: max_iterations must be in [0, 10000]");
+    if (!(max_correspondence_distance_m > T(0)) || !std::isfinite(max_correspondence_distance_m))
+      return bad("IcpOptions: max_correspondence_distance_m must be finite and > 0");
+    if (!(relative_fitness >= T(0)) || !std::isfinite(relative_fitness))
+      return bad("IcpOptions: relative_fitness must be finite and >= 0");
+    if (!(relative_rmse >= T(0)) || !std::isfinite(relative_rmse))
+      return bad("IcpOptions: relative_rmse must be finite and >= 0");
+    if (reason) reason->clear();
     return Status::Ok;
   }
 };

@@ -38,6 +38,28 @@ struct PoseRefinementOptions {
   /// Levenberg-Marquardt with a cost check per step; false runs plain Gauss-Newton steps (cheaper:
   /// one pass per iteration) for callers that score the result themselves, as RANSAC's LO does.
   bool check_cost = true;
+
+  static constexpr int kMaxIterations = 10000;  ///< upper bound of max_iterations
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (max_iterations < 0 || max_iterations > kMaxIterations)
+      return bad("PoseRefinementOptions: max_iterations must be in [0, 10000]");
+    if (!(huber_threshold_px > T(0)) || !std::isfinite(huber_threshold_px))
+      return bad("PoseRefinementOptions: huber_threshold_px must be finite and > 0");
+    if (!(step_tolerance >= T(0)) || !std::isfinite(step_tolerance))
+      return bad("PoseRefinementOptions: step_tolerance must be finite and >= 0");
+    if (!(cost_tolerance >= T(0)) || !std::isfinite(cost_tolerance))
+      return bad("PoseRefinementOptions: cost_tolerance must be finite and >= 0");
+    if (!(initial_damping >= T(0)) || !std::isfinite(initial_damping))
+      return bad("PoseRefinementOptions: initial_damping must be finite and >= 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 template <class T>
@@ -65,6 +87,21 @@ struct PnpOptions {
     o.max_residual = 2.0;
     o.max_iterations = 1000;
     return o;
+  }
+
+  /// Ok, or InvalidInput with a reason naming the field (ransac.* and refinement.* as nested).
+  Status validate(std::string* reason = nullptr) const {
+    std::string why;
+    if (ransac.validate(&why) != Status::Ok) {
+      if (reason) *reason = detail::nested_reason("PnpOptions", "ransac", why);
+      return Status::InvalidInput;
+    }
+    if (refinement.validate(&why) != Status::Ok) {
+      if (reason) *reason = detail::nested_reason("PnpOptions", "refinement", why);
+      return Status::InvalidInput;
+    }
+    if (reason) reason->clear();
+    return Status::Ok;
   }
 };
 
@@ -706,10 +743,13 @@ PoseRefinementResult<T> refine_pose(const Points3& world, const Points2& pixels,
   PoseRefinementResult<T> res;
   res.cam_from_world = initial_cam_from_world;
   if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) return res;
-  if (options.max_iterations < 0 || (options.huber && !(options.huber_threshold_px > T(0)))) {
-    res.status = Status::InvalidInput;
-    res.reason = "refine_pose: max_iterations must be >= 0 and huber_threshold_px > 0";
-    return res;
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) {
+      res.status = Status::InvalidInput;
+      res.reason = "refine_pose: " + why;
+      return res;
+    }
   }
   detail::PnpData<T> d;
   detail::load_pnp_data(world, pixels, camera, &d);
@@ -728,6 +768,12 @@ PnpResult<T> solve_pnp(const Points3& world, const Points2& pixels, const Pinhol
                        const PnpOptions<T>& options) {
   PnpResult<T> res;
   if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) return res;
+  if (options.validate(&res.reason) != Status::Ok) {
+    res.status = Status::InvalidInput;
+    res.reason = "solve_pnp: " + res.reason;
+    res.inlier_mask.assign(static_cast<std::size_t>(world.size()), 0);
+    return res;
+  }
   detail::PnpData<T> d;
   const std::size_t skipped = detail::load_pnp_data(world, pixels, camera, &d);
   const std::size_t n_total = static_cast<std::size_t>(world.size());
@@ -758,6 +804,12 @@ PnpResult<T> solve_pnp_ransac(const Points3& world, const Points2& pixels, const
                               const PnpOptions<T>& options) {
   PnpResult<T> res;
   if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) return res;
+  if (options.validate(&res.reason) != Status::Ok) {
+    res.status = Status::InvalidInput;
+    res.reason = "solve_pnp_ransac: " + res.reason;
+    res.inlier_mask.assign(static_cast<std::size_t>(world.size()), 0);
+    return res;
+  }
   const std::size_t n_total = static_cast<std::size_t>(world.size());
   detail::PnpData<T> d;
   const std::size_t skipped = detail::load_pnp_data(world, pixels, camera, &d);

@@ -18,24 +18,40 @@
 
 namespace dyncull {
 
+namespace detail {
+/// "Outer: member.field ..." from a nested struct's "Inner: field ..." reason, so the reason names the
+/// field as the caller spells it (FundamentalOptions: ransac.max_residual ...).
+inline std::string nested_reason(const char* outer, const char* member, const std::string& inner) {
+  const std::size_t colon = inner.find(": ");
+  return std::string(outer) + ": " + member + "." + (colon == std::string::npos ? inner : inner.substr(colon + 2));
+}
+}  // namespace detail
+
 /// Options shared by every RANSAC in dyncull (F, PnP, rigid alignment).
 struct RansacOptions {
   double max_residual = 1.0;      ///< inlier threshold in the estimator's residual units (NOT squared)
   double confidence = 0.99;       ///< probability p of drawing at least one all-inlier sample; in [0, 1]
-  std::size_t min_iterations = 0, max_iterations = 10000;  ///< bounds on drawn samples; max >= 1
+  /// Bounds on drawn samples: 1 <= max_iterations <= kMaxIterations, min_iterations <= max_iterations.
+  std::size_t min_iterations = 0, max_iterations = 10000;
   std::uint64_t seed = 0;         ///< deterministic for a seed (the generator is owned by the call)
   bool local_optimisation = true; ///< refit on inliers when a new best model is found, and at the end
 
-  /// Ok, or InvalidInput with a readable reason.
+  /// Largest accepted max_iterations: 1e7 samples bound one call to seconds, never hours.
+  static constexpr std::size_t kMaxIterations = 10000000;
+
+  /// Ok, or InvalidInput with a reason naming the field.
   Status validate(std::string* reason = nullptr) const {
     auto fail = [&](const char* why) {
       if (reason) *reason = why;
       return Status::InvalidInput;
     };
-    if (!(max_residual > 0.0) || !std::isfinite(max_residual)) return fail("max_residual must be finite and > 0");
-    if (!(confidence >= 0.0 && confidence <= 1.0)) return fail("confidence must be in [0, 1]");
-    if (max_iterations == 0) return fail("max_iterations must be >= 1");
-    if (min_iterations > max_iterations) return fail("min_iterations must be <= max_iterations");
+    if (!(max_residual > 0.0) || !std::isfinite(max_residual))
+      return fail("RansacOptions: max_residual must be finite and > 0");
+    if (!(confidence >= 0.0 && confidence <= 1.0)) return fail("RansacOptions: confidence must be in [0, 1]");
+    if (max_iterations == 0 || max_iterations > kMaxIterations)
+      return fail("RansacOptions: max_iterations must be in [1, 1e7]");
+    if (min_iterations > max_iterations) return fail("RansacOptions: min_iterations must be <= max_iterations");
+    if (reason) reason->clear();
     return Status::Ok;
   }
 };

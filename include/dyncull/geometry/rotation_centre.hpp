@@ -56,6 +56,40 @@ struct RotationCentreOptions {
   std::size_t min_inliers = 8;         ///< ... and as an absolute count ("sufficient", Algorithm 2 l. 13)
   int max_irls_iterations = 50;        ///< NormalEquations with a robust loss
   BfgsOptions bfgs{};                  ///< Bfgs solver
+
+  static constexpr int kMaxIrlsIterations = 10000;  ///< upper bound of max_irls_iterations
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (solver != RotationCentreSolver::NormalEquations && solver != RotationCentreSolver::Bfgs)
+      return bad("RotationCentreOptions: solver is not a RotationCentreSolver value");
+    if (loss != RobustLoss::None && loss != RobustLoss::Huber && loss != RobustLoss::Cauchy)
+      return bad("RotationCentreOptions: loss is not a RobustLoss value");
+    if (!(loss_scale_px > 0.0) || !std::isfinite(loss_scale_px))
+      return bad("RotationCentreOptions: loss_scale_px must be finite and > 0");
+    if (!(min_flow_px >= 0.0) || !std::isfinite(min_flow_px))
+      return bad("RotationCentreOptions: min_flow_px must be finite and >= 0");
+    if (!(min_eigenvalue_ratio >= 0.0 && min_eigenvalue_ratio <= 1.0))
+      return bad("RotationCentreOptions: min_eigenvalue_ratio must be in [0, 1]");
+    if (!(distance_threshold_px >= 0.0) || !std::isfinite(distance_threshold_px))
+      return bad("RotationCentreOptions: distance_threshold_px must be finite and >= 0");
+    if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0))
+      return bad("RotationCentreOptions: min_inlier_fraction must be in [0, 1]");
+    if (max_irls_iterations < 0 || max_irls_iterations > kMaxIrlsIterations)
+      return bad("RotationCentreOptions: max_irls_iterations must be in [0, 10000]");
+    std::string why;
+    if (bfgs.validate(&why) != Status::Ok) {
+      const std::size_t colon = why.find(": ");
+      if (reason) *reason = "RotationCentreOptions: bfgs." + (colon == std::string::npos ? why : why.substr(colon + 2));
+      return Status::InvalidInput;
+    }
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Bisectors of the usable flow vectors, eq. 4 normalised: n_x x + n_y y = e with |n| = 1, in
@@ -418,9 +452,9 @@ auto estimate_rotation_centre(
                                           " vs " + std::to_string(points2.size()) + ")");
   }
   if (!start.allFinite()) return fail(Status::NonFinite, "rotation centre: non-finite start point");
-  if (!(options.distance_threshold_px >= 0) || !(options.min_flow_px >= 0) || !(options.min_eigenvalue_ratio >= 0) ||
-      !(options.min_inlier_fraction >= 0 && options.min_inlier_fraction <= 1)) {
-    return fail(Status::InvalidInput, "rotation centre: thresholds must be >= 0 and min_inlier_fraction in [0, 1]");
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, "rotation centre: " + why);
   }
 
   // Line 1 of Algorithm 2. Thread-local scratch keeps repeated per-frame calls allocation-free.
