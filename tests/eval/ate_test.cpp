@@ -1,10 +1,14 @@
 #include "dyncull/eval/ate.hpp"
 
+#include "dyncull/core/random.hpp"
+
 #include "eval/synthetic_trajectory.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 #include <type_traits>
 
 namespace {
@@ -188,6 +192,34 @@ TEST(AteFromPositions, MatchesTrajectoryVersion) {
   EXPECT_DOUBLE_EQ(a.error_m.rmse, b.error_m.rmse);
   EXPECT_GT(a.error_m.rmse, 0.001);
   EXPECT_TRUE(a.groundtruth_index.empty());
+}
+
+// For any positions: a non-Ok status with a reason, or finite errors and statistics.
+TYPED_TEST(AteTest, PropertyErrorsAreFiniteOrTheCallFails) {
+  using T = TypeParam;
+  dyncull::Random rng(43);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = static_cast<int>(rng.index(10));
+    const double magnitude = std::pow(10.0, rng.uniform(-20, std::is_same<T, double>::value ? 300 : 37));
+    Eigen::Matrix<T, 3, Eigen::Dynamic> e(3, n), g(3, n);
+    for (int i = 0; i < n; ++i) {
+      for (int r = 0; r < 3; ++r) {
+        const double u = rng.uniform();
+        e(r, i) = u < 0.03 ? std::numeric_limits<T>::quiet_NaN() : T(rng.uniform(-1, 1) * magnitude);
+        g(r, i) = u > 0.97 ? std::numeric_limits<T>::infinity() : T(rng.uniform(-1, 1) * magnitude);
+      }
+    }
+    const AteResult<T> ate = ate_from_positions(e, g, rng.uniform() < 0.5);
+    if (!ate.ok()) {
+      EXPECT_FALSE(ate.reason.empty()) << trial;
+      continue;
+    }
+    ASSERT_EQ(ate.errors_m.size(), static_cast<std::size_t>(n));
+    for (T x : ate.errors_m) EXPECT_TRUE(std::isfinite(x)) << trial;
+    for (T x : {ate.error_m.rmse, ate.error_m.mean, ate.error_m.median, ate.error_m.std, ate.error_m.max}) {
+      EXPECT_TRUE(std::isfinite(x)) << trial;
+    }
+  }
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include "dyncull/core/random.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/eval/statistics.hpp"
 
@@ -5,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -111,6 +113,38 @@ TEST(ImprovementRate, ReproducesPaperTable) {
   EXPECT_LT(improvement_rate(0.1, 0.2), 0.0);  // worse than the baseline: negative
   EXPECT_TRUE(std::isnan(improvement_rate(0.0, 0.1)));
   EXPECT_TRUE(std::isnan(improvement_rate(1.0, std::nan(""))));
+}
+
+// A value for property tests: mostly ordinary, sometimes NaN, +-Inf, huge or tiny.
+template <class T>
+T wild_value(dyncull::Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.03) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.05) return std::numeric_limits<T>::infinity();
+  if (u < 0.07) return -std::numeric_limits<T>::infinity();
+  if (u < 0.10) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.12) return std::numeric_limits<T>::denorm_min();
+  return T(rng.uniform(lo, hi));
+}
+
+TYPED_TEST(StatisticsTest, PropertyStatisticsAreFiniteOrTheCallFails) {
+  using T = TypeParam;
+  dyncull::Random rng(31);
+  for (int trial = 0; trial < 400; ++trial) {
+    const std::size_t n = rng.index(20);
+    const bool clean = rng.uniform() < 0.3;
+    std::vector<T> v(n);
+    for (auto& x : v) x = clean ? T(rng.uniform(0, 10)) : wild_value<T>(rng, 0, 10);
+    const ErrorStatistics<T> s = compute_statistics(v);
+    if (!s.ok()) {
+      EXPECT_FALSE(s.reason.empty());
+      EXPECT_TRUE(n == 0 || std::any_of(v.begin(), v.end(), [](T x) { return !std::isfinite(x); })) << trial;
+      continue;
+    }
+    for (T x : {s.rmse, s.mean, s.median, s.std, s.min, s.max}) EXPECT_TRUE(std::isfinite(x)) << trial;
+    EXPECT_LE(s.min, s.median);
+    EXPECT_LE(s.median, s.max);
+  }
 }
 
 }  // namespace

@@ -198,4 +198,47 @@ TEST(UmeyamaVsEigen, MatchesEigenUmeyamaTo1e12) {
   }
 }
 
+template <class T>
+T wild_value(Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.07) return std::numeric_limits<T>::denorm_min() * T(rng.uniform(-100, 100));
+  if (u < 0.09) return T(rng.uniform(lo, hi) * 1e30);
+  return T(rng.uniform(lo, hi));
+}
+
+// For any input: a non-Ok status with a reason, or a finite proper rotation, scale and translation.
+TYPED_TEST(UmeyamaTest, PropertyAlignmentIsFiniteOrTheCallFails) {
+  using T = TypeParam;
+  Random rng(41);
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = static_cast<int>(rng.index(12));
+    const bool clean = rng.uniform() < 0.2;
+    const double magnitude = std::pow(10.0, rng.uniform(-30, 30));
+    Points<T> src(3, n), dst(3, n);
+    for (int i = 0; i < n; ++i) {
+      for (int r = 0; r < 3; ++r) {
+        src(r, i) = clean ? T(rng.uniform(-1, 1) * magnitude) : wild_value<T>(rng, -magnitude, magnitude);
+        dst(r, i) = clean ? T(rng.uniform(-1, 1) * magnitude) : wild_value<T>(rng, -magnitude, magnitude);
+      }
+    }
+    std::vector<T> w(static_cast<std::size_t>(n));
+    for (auto& x : w) x = rng.uniform() < 0.1 ? wild_value<T>(rng, 0, 2) : T(rng.uniform(0, 2));
+    AlignmentOptions o;
+    o.estimate_scale = rng.uniform() < 0.5;
+    const bool weighted = rng.uniform() < 0.4;
+    const auto r = dyncull::umeyama(src, dst, o, weighted ? w.data() : nullptr);
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << trial;
+      continue;
+    }
+    EXPECT_TRUE(r.dst_from_src.R.allFinite()) << trial;
+    EXPECT_TRUE(r.dst_from_src.t.allFinite()) << trial;
+    EXPECT_TRUE(std::isfinite(r.dst_from_src.scale)) << trial;
+    EXPECT_NEAR(r.dst_from_src.R.determinant(), T(1), T(1e-3)) << trial;
+  }
+}
+
 }  // namespace

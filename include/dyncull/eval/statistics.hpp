@@ -68,25 +68,24 @@ ErrorStatistics<T> compute_statistics(const T* values, std::size_t n, std::vecto
   const double dn = static_cast<double>(n);
   // Only when a square or a sum overflowed (values near 1e154 and beyond): rerun the sums on values
   // divided by the largest magnitude, a power of two so the scaling itself is exact.
-  double scale = 1.0;
+  // ldexp, not a multiplication by 2^-exponent: 2^1024 itself is not a double.
+  int exponent = 0;
   if (!std::isfinite(sum_sq) || !std::isfinite(sum)) {
-    int exponent = 0;
     std::frexp(std::max(std::abs(lo), std::abs(hi)), &exponent);
-    scale = std::ldexp(1.0, exponent);
     sum = 0.0;
     sum_sq = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      const double v = static_cast<double>(values[i]) / scale;
+      const double v = std::ldexp(static_cast<double>(values[i]), -exponent);
       sum += v;
       sum_sq += v * v;
     }
   }
-  const double mean = sum / dn;  // in units of scale
+  const double mean = sum / dn;  // in units of 2^exponent
   // Two-pass variance (numpy: mean(|x - mean|^2)) rather than E[x^2] - mean^2, which cancels badly
   // when the spread is small against the mean.
   double sum_dev = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double d = static_cast<double>(values[i]) / scale - mean;
+    const double d = std::ldexp(static_cast<double>(values[i]), -exponent) - mean;
     sum_dev += d * d;
   }
 
@@ -103,10 +102,12 @@ ErrorStatistics<T> compute_statistics(const T* values, std::size_t n, std::vecto
     median = 0.5 * lower + 0.5 * median;  // not (lower + median) / 2: that sum can overflow
   }
 
-  out.rmse = static_cast<T>(std::sqrt(sum_sq / dn) * scale);
-  out.mean = static_cast<T>(mean * scale);
+  // Rounding can put an rmse or std of values at the limit one ulp above it: clamp into T's range.
+  const double top = static_cast<double>(std::numeric_limits<T>::max());
+  out.rmse = static_cast<T>(std::min(std::ldexp(std::sqrt(sum_sq / dn), exponent), top));
+  out.mean = static_cast<T>(std::max(std::min(std::ldexp(mean, exponent), top), -top));
   out.median = static_cast<T>(median);
-  out.std = static_cast<T>(std::sqrt(sum_dev / dn) * scale);
+  out.std = static_cast<T>(std::min(std::ldexp(std::sqrt(sum_dev / dn), exponent), top));
   out.min = static_cast<T>(lo);
   out.max = static_cast<T>(hi);
   return out;

@@ -317,7 +317,8 @@ Status normalised_fundamental(const Mat3<T>& F, Mat3<T>* out) {
   if (!(m > T(0))) return Status::Degenerate;
   int exponent = 0;
   std::frexp(m, &exponent);
-  *out = F * std::ldexp(T(1), -exponent);
+  // Element-wise ldexp: 2^-exponent itself is not representable for the largest and smallest m.
+  *out = F.unaryExpr([exponent](T x) { return std::ldexp(x, -exponent); });
   return Status::Ok;
 }
 }  // namespace detail

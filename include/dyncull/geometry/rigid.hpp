@@ -191,22 +191,19 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
       return result;
     }
   }
-  int exponent = 0;
+  // Element-wise ldexp: 2^-exponent itself is not representable for the largest and smallest c.
+  int exponent = 0, w_exponent = 0;
   std::frexp(c, &exponent);
-  const T inv_c = std::ldexp(T(1), -exponent);
-  T inv_w = T(1);
-  if (weights != nullptr && wmax > T(0)) {
-    std::frexp(wmax, &exponent);
-    inv_w = std::ldexp(T(1), -exponent);
-  }
-  AlignmentAccumulator<T> scaled(src.col(0) * inv_c, dst.col(0) * inv_c);
+  if (weights != nullptr && wmax > T(0)) std::frexp(wmax, &w_exponent);
+  auto down = [exponent](T x) { return std::ldexp(x, -exponent); };
+  AlignmentAccumulator<T> scaled(src.col(0).unaryExpr(down), dst.col(0).unaryExpr(down));
   for (Eigen::Index i = 0; i < n; ++i) {
-    const T w = weights != nullptr ? weights[i] * inv_w : T(1);
-    scaled.add(src.col(i) * inv_c, dst.col(i) * inv_c, w);
+    const T w = weights != nullptr ? std::ldexp(weights[i], -w_exponent) : T(1);
+    scaled.add(src.col(i).unaryExpr(down), dst.col(i).unaryExpr(down), w);
   }
   AlignmentResult<T> second = scaled.solve(options);
   if (!second.ok()) return second;
-  second.dst_from_src.t /= inv_c;
+  second.dst_from_src.t = second.dst_from_src.t.unaryExpr([exponent](T x) { return std::ldexp(x, exponent); });
   if (!second.dst_from_src.t.allFinite() || !second.dst_from_src.R.allFinite() ||
       !std::isfinite(second.dst_from_src.scale)) {
     second.status = Status::InvalidInput;
