@@ -201,6 +201,8 @@ TYPED_TEST(YoloJsonTest, ReadsADirectoryOfFramesAndChecksTheirNumbers) {
   const YoloJsonFrame<T> missing = read_yolo_json<T>((dir / "nope.json").string());
   EXPECT_EQ(missing.status, Status::IoError);
   EXPECT_NE(missing.reason.find("nope.json: cannot open"), std::string::npos);
+  const YoloJsonFrame<T> directory = read_yolo_json<T>(dir.string());
+  EXPECT_EQ(directory.status, Status::IoError) << directory.reason;
   const YoloJsonSequence<T> none = read_yolo_json_sequence<T>((dir / "empty").string());
   EXPECT_EQ(none.status, Status::IoError);
   fs::remove_all(dir);
