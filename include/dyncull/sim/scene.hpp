@@ -66,8 +66,8 @@ struct SceneOptions {
   CameraMotion motion = CameraMotion::Xyz;
   std::uint64_t seed = 1;          ///< textures, trajectory phases, walker start, noise, detections
   bool depth_noise = true;         ///< Kinect-like noise, quantisation, holes (depth_model); false = exact depth
-  double box_jitter_px = 2.0;      ///< std-dev of the Gaussian jitter added to each detection box edge
-  double miss_rate = 0.05;         ///< probability that a visible instance gets no detection
+  double box_jitter_px = 2.0;      ///< std-dev of the Gaussian jitter of each box edge (Calibrated: of its core)
+  double miss_rate = 0.05;         ///< probability that a visible instance gets no detection (i.i.d. per frame)
   double false_positive_rate = 0.02;  ///< probability per frame of one spurious detection
   int min_detection_pixels = 300;  ///< instances with fewer visible pixels are not detected
   double start_time_s = 1341846313.0;  ///< timestamp of frame 0 (TUM-like Unix seconds)
