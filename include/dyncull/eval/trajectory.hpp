@@ -175,10 +175,13 @@ inline std::size_t sorted_unique_stamp_order(const double* stamps, std::size_t n
 inline bool is_separator(char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r' || c == '\v' || c == '\f'; }
 
 /// Appends `v` in C-locale %.*f (fixed) or %.*g (general) form: std::to_chars never consults the locale.
-inline void append_number(std::string* out, double v, std::chars_format format, int precision) {
-  char buf[400];  // fixed DBL_MAX with 9 decimals is 319 characters; precision is validated to <= 17
+/// False (nothing appended) if it does not fit, which the validated precisions rule out.
+inline bool append_number(std::string* out, double v, std::chars_format format, int precision) {
+  char buf[400];  // fixed DBL_MAX with 9 decimals is 320 characters; precision is validated to <= 17
   const std::to_chars_result res = std::to_chars(buf, buf + sizeof(buf), v, format, precision);
-  if (res.ec == std::errc()) out->append(buf, static_cast<std::size_t>(res.ptr - buf));
+  if (res.ec != std::errc()) return false;
+  out->append(buf, static_cast<std::size_t>(res.ptr - buf));
+  return true;
 }
 
 }  // namespace detail
@@ -346,12 +349,18 @@ WriteResult format_tum_trajectory(const Trajectory<T>& trajectory, std::string* 
       out->clear();
       return result;
     }
-    detail::append_number(out, trajectory.stamps[i], std::chars_format::fixed, options.stamp_decimals);
+    bool written = detail::append_number(out, trajectory.stamps[i], std::chars_format::fixed, options.stamp_decimals);
     const double values[7] = {static_cast<double>(p.t.x()), static_cast<double>(p.t.y()),
                               static_cast<double>(p.t.z()), q.x(), q.y(), q.z(), q.w()};
     for (double x : values) {
       out->push_back(' ');
-      detail::append_number(out, x, std::chars_format::general, digits);
+      written = written && detail::append_number(out, x, std::chars_format::general, digits);
+    }
+    if (!written) {
+      result.status = Status::InvalidInput;
+      result.reason = "pose " + std::to_string(i) + ": a value does not fit the number format";
+      out->clear();
+      return result;
     }
     out->push_back('\n');
   }
