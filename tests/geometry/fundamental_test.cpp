@@ -399,5 +399,66 @@ TEST(FundamentalOptionsValidate, NamesTheFieldIncludingNestedRansac) {
   check(bad, "ransac.max_iterations");
 }
 
+template <class T>
+T wild_pixel(Random& rng) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return -std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
+  if (u < 0.08) return T(rng.uniform(-1, 1) * 1e18);
+  return T(rng.uniform(0, 640));
+}
+
+// For any correspondences and options: a non-Ok status with a reason, or a finite F with a consistent
+// mask (8-point, 7-point and RANSAC).
+TYPED_TEST(FundamentalTyped, PropertyModelIsFiniteOrTheCallFails) {
+  using T = TypeParam;
+  Random rng(51);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::size_t n = rng.index(40);
+    const bool half_clean = rng.uniform() < 0.5;
+    TwoViewOptions tv;
+    tv.num_points = static_cast<int>(n);
+    tv.seed = trial;
+    auto d = make_two_view<T>(tv);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (half_clean && rng.uniform() < 0.8) continue;
+      d.points1[i] = Vec2<T>(wild_pixel<T>(rng), wild_pixel<T>(rng));
+      if (rng.uniform() < 0.5) d.points2[i] = Vec2<T>(wild_pixel<T>(rng), wild_pixel<T>(rng));
+    }
+    FundamentalOptions<T> o;
+    o.ransac.max_iterations = 1 + rng.index(300);
+    o.ransac.max_residual = rng.uniform() < 0.1 ? -1.0 : rng.uniform(0.1, 5);
+    o.ransac.seed = trial;
+    o.sampson_weighted_refit = rng.uniform() < 0.5;
+    if (rng.uniform() < 0.1) o.degenerate_homography_fraction = std::nan("");
+    const auto check = [&](const FundamentalResult<T>& r, const char* which) {
+      if (!r.ok()) {
+        EXPECT_FALSE(r.reason.empty()) << which << " trial " << trial;
+        return;
+      }
+      EXPECT_TRUE(r.F.allFinite()) << which << " trial " << trial;
+      ASSERT_EQ(r.inlier_mask.size(), n) << which;
+      std::size_t count = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        count += r.inlier_mask[i];
+        if (r.inlier_mask[i]) {
+          EXPECT_TRUE(d.points1[i].allFinite() && d.points2[i].allFinite()) << which << " trial " << trial;
+        }
+      }
+      EXPECT_EQ(count, r.num_inliers) << which << " trial " << trial;
+    };
+    check(estimate_fundamental_ransac(d.points1, d.points2, o), "ransac");
+    check(fundamental_8point(d.points1, d.points2), "8-point");
+    const auto seven = fundamental_7point(d.points1, d.points2);
+    if (seven.ok()) {
+      for (int k = 0; k < seven.count; ++k) EXPECT_TRUE(seven.F[static_cast<std::size_t>(k)].allFinite()) << trial;
+    } else {
+      EXPECT_FALSE(seven.reason.empty()) << trial;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace dyncull

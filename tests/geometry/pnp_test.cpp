@@ -323,4 +323,68 @@ TEST(PnpOptionsValidate, NamesTheFieldIncludingNestedOptions) {
   check(bad, "ransac.max_residual");
 }
 
+template <class T>
+T wild_value(Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
+  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
+  return T(rng.uniform(lo, hi));
+}
+
+// For any correspondences, camera and options: a non-Ok status with a reason, or a finite pose with a
+// consistent mask (solve_pnp, solve_pnp_ransac, solve_pnp_dlt, refine_pose), float and double.
+template <class T>
+void pnp_property(std::uint64_t seed) {
+  Random rng(seed);
+  for (int trial = 0; trial < 150; ++trial) {
+    const int n = static_cast<int>(rng.index(30));
+    auto s = make_pnp_scene<T>(seed + static_cast<std::uint64_t>(trial), n, 0.5, 0.2);
+    const bool half_clean = rng.uniform() < 0.5;
+    for (std::size_t i = 0; i < s.world.size(); ++i) {
+      if (half_clean && rng.uniform() < 0.8) continue;
+      if (rng.uniform() < 0.5) s.world[i] = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, 0, 8));
+      if (rng.uniform() < 0.5) s.pixels[i] = Vec2<T>(wild_value<T>(rng, 0, 640), wild_value<T>(rng, 0, 480));
+    }
+    if (rng.uniform() < 0.1) s.camera.fx = wild_value<T>(rng, 1, 1000);
+    PnpOptions<T> o;
+    o.ransac.max_iterations = 1 + rng.index(200);
+    o.ransac.seed = static_cast<std::uint64_t>(trial);
+    o.refine = rng.uniform() < 0.7;
+    o.refinement.huber = rng.uniform() < 0.3;
+    if (rng.uniform() < 0.1) o.refinement.max_iterations = -3;
+    if (rng.uniform() < 0.1) o.ransac.max_residual = std::nan("");
+    const std::size_t n_total = s.world.size();
+    auto check = [&](const dyncull::PnpResult<T>& r, const char* which) {
+      if (!r.ok()) {
+        EXPECT_FALSE(r.reason.empty()) << which << " trial " << trial;
+        return;
+      }
+      EXPECT_TRUE(r.cam_from_world.all_finite()) << which << " trial " << trial;
+      EXPECT_TRUE(std::isfinite(r.rmse_px)) << which << " trial " << trial;
+      ASSERT_EQ(r.inlier_mask.size(), n_total) << which;
+      std::size_t count = 0;
+      for (auto m : r.inlier_mask) count += m;
+      EXPECT_EQ(count, r.num_inliers) << which << " trial " << trial;
+    };
+    check(dyncull::solve_pnp(s.world, s.pixels, s.camera, o), "solve_pnp");
+    check(dyncull::solve_pnp_ransac(s.world, s.pixels, s.camera, o), "solve_pnp_ransac");
+    check(dyncull::solve_pnp_dlt(s.world, s.pixels, s.camera), "solve_pnp_dlt");
+    Rigid3<T> start = s.cam_from_world;
+    if (rng.uniform() < 0.2) start.t.x() = wild_value<T>(rng, -1, 1);
+    const auto r = dyncull::refine_pose(s.world, s.pixels, s.camera, start, o.refinement);
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << "refine_pose trial " << trial;
+    } else {
+      EXPECT_TRUE(r.cam_from_world.all_finite()) << "refine_pose trial " << trial;
+      EXPECT_TRUE(std::isfinite(r.final_cost) && std::isfinite(r.rmse_px)) << "refine_pose trial " << trial;
+    }
+  }
+}
+
+TEST(PnpProperty, FloatPoseIsFiniteOrTheCallFails) { pnp_property<float>(61); }
+TEST(PnpProperty, DoublePoseIsFiniteOrTheCallFails) { pnp_property<double>(62); }
+
 }  // namespace

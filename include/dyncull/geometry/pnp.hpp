@@ -161,7 +161,7 @@ struct PnpData {
   std::size_t size() const { return X.size(); }
 };
 
-/// Copies finite correspondences; returns the number of non-finite ones skipped.
+/// Copies finite correspondences (world point and normalised pixel); returns the number skipped.
 template <class T, class Points3, class Points2>
 std::size_t load_pnp_data(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
                           PnpData<T>* d) {
@@ -179,15 +179,16 @@ std::size_t load_pnp_data(const Points3& world, const Points2& pixels, const Pin
   for (std::size_t i = 0; i < n; ++i) {
     const T X = point_x<T>(world[i]), Y = point_y<T>(world[i]), Z = point_z<T>(world[i]);
     const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
-    if (!(std::isfinite(X) && std::isfinite(Y) && std::isfinite(Z) && std::isfinite(u) && std::isfinite(v))) {
+    const T xn = (u - camera.cx) * ifx, yn = (v - camera.cy) * ify;  // NaN / Inf in u, v propagate
+    if (!(std::isfinite(X) && std::isfinite(Y) && std::isfinite(Z) && std::isfinite(xn) && std::isfinite(yn))) {
       ++skipped;
       continue;
     }
     d->X.push_back(X);
     d->Y.push_back(Y);
     d->Z.push_back(Z);
-    d->x.push_back((u - camera.cx) * ifx);
-    d->y.push_back((v - camera.cy) * ify);
+    d->x.push_back(xn);
+    d->y.push_back(yn);
     d->index.push_back(static_cast<std::uint32_t>(i));
   }
   return skipped;
@@ -263,6 +264,7 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
       const double du = fx * (p(0) / p(2) - static_cast<double>(d.x[i]));
       const double dv = fy * (p(1) / p(2) - static_cast<double>(d.y[i]));
       const double s = du * du + dv * dv;
+      if (!std::isfinite(s)) continue;  // an overflowing reprojection is unusable, like a point behind
       cost += huber_rho(s, k, k2);
       sq += s;
       ++m;
@@ -283,6 +285,12 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
     }
   }
   res.initial_cost = cost;
+  if (!std::isfinite(cost)) {
+    res.status = Status::InvalidInput;
+    res.reason = "refine_pose: the reprojection cost overflows (coordinates near the floating-point limit)";
+    res.initial_cost = res.final_cost = 0;
+    return res;
+  }
   if (used < 3) {
     res.status = Status::TooFewPoints;
     res.reason = "refine_pose: " + std::to_string(used) + " points in front of the camera, need 3";
@@ -319,6 +327,8 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
         g(r) += w0 * du + w1 * dv;
       }
     }
+    // A point whose Jacobian overflows (huge coordinates, z -> 0+) poisons the step: stop at the pose so far.
+    if (!H.allFinite() || !g.allFinite()) break;
     H.template triangularView<Eigen::StrictlyLower>() = H.transpose();
     if (!o.check_cost) {
       // Plain Gauss-Newton (RANSAC's local optimisation scores the result itself).
@@ -375,6 +385,12 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
   if (!res.cam_from_world.all_finite()) {
     res.status = Status::NonFinite;
     res.reason = "refine_pose: the refinement diverged to a non-finite pose";
+  } else if (!std::isfinite(res.final_cost) || !std::isfinite(res.rmse_px)) {
+    res.status = Status::InvalidInput;
+    res.reason = "refine_pose: the reprojection cost overflows (coordinates near the floating-point limit)";
+  } else if (used < 3) {
+    res.status = Status::TooFewPoints;
+    res.reason = "refine_pose: " + std::to_string(used) + " usable points at the final pose, need 3";
   }
   return res;
 }
