@@ -1,0 +1,557 @@
+/// @file keyframe_matcher.hpp
+/// Correspondences of the current frame's binary-descriptor keypoints to a reference keyframe by guided
+/// matching: each keyframe point is predicted in the current image through the predicted pose and its
+/// depth, u = pi(R X + t) (Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-D "track local map" search by
+/// projection), then matched by Hamming distance (Rublee et al. 2011, ORB) among the current keypoints
+/// within a radius, with the nearest / second-nearest ratio test (Lowe 2004) and a mutual check.
+///
+/// API:
+///   KeyframeMatchWorkspace<float> ws;  KeyframeMatchResult<float> r;   // reused every frame
+///   match_to_keyframe(kf_keypoints, kf_points, DescriptorRows(kf_desc.data, n_kf, kf_desc.step),
+///                     cur_keypoints, DescriptorRows(cur_desc.data, n_cur, cur_desc.step),
+///                     camera, &cam_from_keyframe /* or nullptr */, options, ws, &r);
+///   r.keyframe_index[i]: keyframe keypoint matched to current keypoint i, or -1.
+#pragma once
+
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace dyncull {
+
+/// Read-only rows of binary descriptors: row i starts at data + i * stride_bytes and has row_bytes bytes
+/// (ORB: 32). A cv::Mat of descriptors is DescriptorRows(m.ptr(0), m.rows, m.step, m.cols). Anything with
+/// the members data, rows, row_bytes and stride() (culling/keep_mask.hpp's RowsView) converts.
+struct DescriptorRows {
+  const std::uint8_t* data = nullptr;
+  std::size_t rows = 0;
+  std::size_t stride_bytes = 0;  ///< 0 means row_bytes
+  std::size_t row_bytes = 32;
+
+  DescriptorRows() = default;
+  DescriptorRows(const std::uint8_t* data_, std::size_t rows_, std::size_t stride_bytes_ = 0,
+                 std::size_t row_bytes_ = 32)
+      : data(data_), rows(rows_), stride_bytes(stride_bytes_), row_bytes(row_bytes_) {}
+  template <class R, class = decltype(std::declval<const R&>().stride()),
+            class = decltype(std::declval<const R&>().row_bytes), class = decltype(std::declval<const R&>().rows),
+            class = decltype(std::declval<const R&>().data)>
+  DescriptorRows(const R& view)  // NOLINT: implicit on purpose, RowsView reads as DescriptorRows
+      : data(view.data), rows(view.rows), stride_bytes(view.stride()), row_bytes(view.row_bytes) {}
+
+  std::size_t stride() const { return stride_bytes ? stride_bytes : row_bytes; }
+  const std::uint8_t* row(std::size_t i) const { return data + i * stride(); }
+};
+
+struct KeyframeMatchOptions {
+  /// Search radius (px) around a keyframe point's prediction through the pose and its depth: the pose
+  /// prediction's error plus keypoint noise. ORB-SLAM searches 15 px (its th = 15 at the finest level
+  /// when the motion model is uncertain). In (0, 4096].
+  double radius_px = 15.0;
+  /// Search radius (px) when the prediction has no depth (rotation only, or the same pixel when no pose
+  /// is given): the whole inter-frame parallax must fit in it. In (0, 4096].
+  double radius_unpredicted_px = 40.0;
+  /// Largest Hamming distance accepted for a match, in bits; ORB-SLAM accepts 100 of 256 in its search by
+  /// projection and 50 for its tighter searches. In [0, 8 * row_bytes], at most 2048.
+  int max_hamming = 80;
+  /// Nearest / second-nearest ratio: a keyframe point is matched only when best <= ratio * second among
+  /// its candidates (ORB-SLAM's 0.9 for guided search, 0.8 in Lowe 2004). 1 disables the test. In (0, 1].
+  double ratio = 0.9;
+  /// Keep a pair only when the current keypoint's nearest keyframe point (over all keyframe points that
+  /// searched it) is the same keyframe point. Without it, a current keypoint chosen by several keyframe
+  /// points takes the one at the smallest distance (lowest index on a tie).
+  bool mutual_check = true;
+  /// Side (px) of the grid cells the current keypoints are bucketed in; a radius of about a cell visits
+  /// 3 x 3 cells. The grid has at most 256 cells per side: a larger keypoint spread widens the cells. In [1, 4096].
+  double grid_cell_px = 16.0;
+
+  /// Ok, or InvalidInput with the reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* field, const char* why) {
+      if (reason) *reason = std::string("KeyframeMatchOptions: ") + field + " " + why;
+      return Status::InvalidInput;
+    };
+    if (!(radius_px > 0.0 && radius_px <= 4096.0)) return bad("radius_px", "must be in (0, 4096]");
+    if (!(radius_unpredicted_px > 0.0 && radius_unpredicted_px <= 4096.0))
+      return bad("radius_unpredicted_px", "must be in (0, 4096]");
+    if (max_hamming < 0 || max_hamming > 2048) return bad("max_hamming", "must be in [0, 2048]");
+    if (!(ratio > 0.0 && ratio <= 1.0)) return bad("ratio", "must be in (0, 1]");
+    if (!(grid_cell_px >= 1.0 && grid_cell_px <= 4096.0)) return bad("grid_cell_px", "must be in [1, 4096]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// Per current keypoint: its keyframe correspondence. Vectors are parallel to the current keypoints
+/// (resized on every call, also on a non-Ok status: then every entry says "no match").
+template <class T>
+struct KeyframeMatchResult {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  std::vector<int> keyframe_index;     ///< matched keyframe keypoint, -1 for none
+  std::vector<Vec2<T>> keyframe_pixel; ///< that keypoint's position in the keyframe; NaN for none
+  std::vector<int> distance;           ///< Hamming distance of the pair in bits, -1 for none
+
+  std::size_t matched = 0;
+  std::size_t predicted_by_depth = 0;     ///< keyframe points predicted through the pose and their depth
+  std::size_t predicted_without_depth = 0;///< predicted by rotation only, or the same pixel without a pose
+  std::size_t behind_camera = 0;          ///< keyframe points the predicted pose puts behind the camera
+  std::size_t keyframe_nonfinite = 0;     ///< keyframe keypoints with a NaN / Inf coordinate (not matched)
+  std::size_t current_nonfinite = 0;      ///< current keypoints with a NaN / Inf coordinate (not matched)
+  bool used_pose = false;                 ///< a predicted pose was given and used
+};
+
+/// Buffers reused across calls: after the first frames of a sequence no call allocates.
+template <class T>
+struct KeyframeMatchWorkspace {
+  std::vector<T> cur_x, cur_y;                 // current keypoints (NaN marks a non-finite one)
+  std::vector<T> pred_x, pred_y;               // keyframe points' predictions (NaN: not searched)
+  std::vector<std::uint8_t> pred_depth;        // 1: predicted through depth (radius_px)
+  std::vector<std::uint32_t> cell_start;       // grid: cell c holds cell_items[cell_start[c] .. cell_start[c+1])
+  std::vector<std::uint32_t> cell_items;
+  std::vector<std::uint32_t> cell_of;          // grid cell of each current keypoint (kNone: not in the grid)
+  std::vector<int> kf_best_cur, kf_best_dist;  // per keyframe point: nearest current keypoint, -1 none
+  std::vector<int> kf_second_dist;             // and the second-nearest distance
+  std::vector<int> cur_best_kf, cur_best_dist; // per current keypoint: nearest keyframe point that searched it
+};
+
+namespace detail {
+
+inline std::uint64_t kfm_load_u64(const std::uint8_t* p) noexcept {
+  std::uint64_t v;
+  std::memcpy(&v, p, sizeof v);  // cv::Mat rows carry no alignment promise
+  return v;
+}
+
+inline int kfm_popcount_swar(std::uint64_t x) noexcept {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
+}
+
+/// Plain data the scan reads: the keyframe predictions and the current grid.
+template <class T>
+struct KfmScan {
+  const T* pred_x;  // per keyframe point, NaN = do not search
+  const T* pred_y;
+  const std::uint8_t* pred_depth;  // 1: radius_px, 0: radius_unpredicted_px
+  std::size_t n_kf;
+  const T* cur_x;
+  const T* cur_y;
+  DescriptorRows kf_desc, cur_desc;
+  std::size_t words;  // 64-bit words per descriptor
+  std::size_t tail;   // bytes after the words
+  T r2_depth, r2_free, r_depth, r_free;
+  T grid_x0, grid_y0, cell;
+  int cols, rows;
+  const std::uint32_t* cell_start;
+  const std::uint32_t* cell_items;
+  int* kf_best_cur;
+  int* kf_best_dist;
+  int* kf_second_dist;
+  int* cur_best_kf;
+  int* cur_best_dist;
+};
+
+/// Cell index along one axis, clamped in the floating type before the int conversion (NaN -> 0).
+template <class T>
+inline int kfm_cell(T v, T origin, T cell, int count) {
+  const T c = (v - origin) / cell;
+  if (!(c >= T(0))) return 0;
+  if (c >= T(count - 1)) return count - 1;
+  return static_cast<int>(c);
+}
+
+template <bool UseBuiltin>
+inline int kfm_hamming(const std::uint8_t* a, const std::uint8_t* b, std::size_t words, std::size_t tail) {
+  int d = 0;
+  for (std::size_t w = 0; w < words; ++w) {
+    const std::uint64_t x = kfm_load_u64(a + 8 * w) ^ kfm_load_u64(b + 8 * w);
+    d += UseBuiltin ? __builtin_popcountll(x) : kfm_popcount_swar(x);
+  }
+  for (std::size_t k = 8 * words; k < 8 * words + tail; ++k)
+    d += kfm_popcount_swar(static_cast<std::uint64_t>(a[k] ^ b[k]));
+  return d;
+}
+
+/// For every keyframe point: the nearest and second-nearest current keypoints in its search disc; for
+/// every current keypoint: the nearest keyframe point among those whose disc held it.
+template <class T, bool UseBuiltin>
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+inline void kfm_scan_impl(const KfmScan<T>& s) {
+  for (std::size_t k = 0; k < s.n_kf; ++k) {
+    const T px = s.pred_x[k], py = s.pred_y[k];
+    if (!(px == px) || !(py == py)) continue;  // NaN: not searched
+    const T r = s.pred_depth[k] ? s.r_depth : s.r_free;
+    const T r2 = s.pred_depth[k] ? s.r2_depth : s.r2_free;
+    const int c0 = kfm_cell(px - r, s.grid_x0, s.cell, s.cols), c1 = kfm_cell(px + r, s.grid_x0, s.cell, s.cols);
+    const int q0 = kfm_cell(py - r, s.grid_y0, s.cell, s.rows), q1 = kfm_cell(py + r, s.grid_y0, s.cell, s.rows);
+    const std::uint8_t* kd = s.kf_desc.row(k);
+    int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max(), best_i = -1;
+    for (int q = q0; q <= q1; ++q) {
+      for (int c = c0; c <= c1; ++c) {
+        const std::size_t cell = static_cast<std::size_t>(q) * static_cast<std::size_t>(s.cols) + static_cast<std::size_t>(c);
+        for (std::uint32_t it = s.cell_start[cell]; it < s.cell_start[cell + 1]; ++it) {
+          const std::uint32_t i = s.cell_items[it];
+          const T dx = s.cur_x[i] - px, dy = s.cur_y[i] - py;
+          if (!(dx * dx + dy * dy <= r2)) continue;
+          const int d = kfm_hamming<UseBuiltin>(kd, s.cur_desc.row(i), s.words, s.tail);
+          if (d < best) {
+            second = best;
+            best = d;
+            best_i = static_cast<int>(i);
+          } else if (d < second) {
+            second = d;
+          }
+          if (d < s.cur_best_dist[i]) {  // ties keep the lower keyframe index
+            s.cur_best_dist[i] = d;
+            s.cur_best_kf[i] = static_cast<int>(k);
+          }
+        }
+      }
+    }
+    s.kf_best_cur[k] = best_i;
+    s.kf_best_dist[k] = best_i >= 0 ? best : -1;
+    s.kf_second_dist[k] = second;
+  }
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__POPCNT__)
+#define DYNCULL_KFM_POPCNT_DISPATCH 1
+// Baseline x86-64 has no POPCNT: __builtin_popcountll would call a library routine. The scan is compiled
+// twice and the POPCNT one chosen at run time.
+template <class T>
+__attribute__((target("popcnt"))) void kfm_scan_popcnt(const KfmScan<T>& s) {
+  kfm_scan_impl<T, true>(s);
+}
+template <class T>
+void kfm_scan_portable(const KfmScan<T>& s) {
+  kfm_scan_impl<T, false>(s);
+}
+inline bool kfm_cpu_has_popcnt() {
+  static const bool has = __builtin_cpu_supports("popcnt");
+  return has;
+}
+#endif
+
+template <class T>
+void kfm_scan(const KfmScan<T>& s) {
+#ifdef DYNCULL_KFM_POPCNT_DISPATCH
+  if (kfm_cpu_has_popcnt()) {
+    kfm_scan_popcnt<T>(s);
+  } else {
+    kfm_scan_portable<T>(s);
+  }
+#else
+  kfm_scan_impl<T, true>(s);
+#endif
+}
+
+inline bool kfm_rows_ok(const DescriptorRows& d, std::size_t n, const char* name, std::string* reason) {
+  if (d.rows != n) {
+    *reason = std::string(name) + " has " + std::to_string(d.rows) + " rows for " + std::to_string(n) + " keypoints";
+    return false;
+  }
+  if (n > 0 && d.data == nullptr) {
+    *reason = std::string(name) + ": data is null with " + std::to_string(n) + " rows";
+    return false;
+  }
+  if (d.row_bytes == 0 || d.row_bytes > 256) {
+    *reason = std::string(name) + ": row_bytes must be in [1, 256], got " + std::to_string(d.row_bytes);
+    return false;
+  }
+  if (d.stride() < d.row_bytes) {
+    *reason = std::string(name) + ": stride_bytes " + std::to_string(d.stride_bytes) + " is below row_bytes " +
+              std::to_string(d.row_bytes) + ": rows would overlap";
+    return false;
+  }
+  return true;
+}
+
+/// Keeps T deduced from the camera alone, so a literal nullptr pose is accepted.
+template <class X>
+struct kfm_identity {
+  using type = X;
+};
+
+template <class V>
+void kfm_fill(std::vector<V>& v, std::size_t n, const V& value) {
+  v.resize(n);  // keeps the capacity: no allocation once grown
+  for (auto& x : v) x = value;
+}
+
+}  // namespace detail
+
+/// Matches the current keypoints to the keyframe's (see the file comment). Inputs:
+/// - kf_keypoints (n_kf points, keyframe pixels) with kf_desc (n_kf rows); kf_points: the keyframe
+///   keypoints' 3-D points in the keyframe camera frame (n_kf points, NaN / z <= 0 for no depth) or an
+///   empty container (no depth at all: monocular);
+/// - cur_keypoints (n points, current pixels) with cur_desc (n rows, the same row_bytes);
+/// - camera: the pinhole model both keypoint sets follow (pass undistorted keypoints for a distorted
+///   camera; opencv/frame.hpp has undistort_keypoints);
+/// - cam_from_keyframe: the predicted pose of the current camera from the keyframe camera, or nullptr.
+/// A keyframe point with depth and a pose is searched within radius_px of its projection; without depth
+/// but with a pose, around its rotated ray (the prediction of a point at infinity), and without a pose
+/// around the same pixel, both within radius_unpredicted_px. Points the pose puts behind the camera are
+/// not searched. Non-finite keypoints are never matched.
+/// Status: InvalidInput (options, camera, sizes, descriptor rows: the reason names the input), NonFinite
+/// (a non-finite pose), TooFewPoints (no keyframe or no current keypoints); every non-Ok status leaves
+/// every current keypoint unmatched. `out`'s vectors are sized to the current keypoints in all cases.
+template <class T, class KfKeypoints, class KfPoints, class CurKeypoints>
+void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_points, DescriptorRows kf_desc,
+                       const CurKeypoints& cur_keypoints, DescriptorRows cur_desc, const PinholeCamera<T>& camera,
+                       const typename detail::kfm_identity<Rigid3<T>>::type* cam_from_keyframe, const KeyframeMatchOptions& options,
+                       KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* out) {
+  static_assert(std::is_floating_point<T>::value, "dyncull::match_to_keyframe: T is float or double");
+  static_assert(is_point_container_v<KfKeypoints> && is_point_container_v<CurKeypoints>,
+                "dyncull::match_to_keyframe: keypoints must be containers of points (PointTraits)");
+  static_assert(is_point_container_v<KfPoints> && PointTraits<container_point_t<KfPoints>>::dim == 3,
+                "dyncull::match_to_keyframe: kf_points must be a container of 3-D points");
+  KeyframeMatchResult<T>& r = *out;
+  const std::size_t n = cur_keypoints.size();
+  const std::size_t n_kf = kf_keypoints.size();
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.matched = r.predicted_by_depth = r.predicted_without_depth = r.behind_camera = 0;
+  r.keyframe_nonfinite = r.current_nonfinite = 0;
+  r.used_pose = false;
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  detail::kfm_fill(r.keyframe_index, n, -1);
+  detail::kfm_fill(r.keyframe_pixel, n, Vec2<T>(nan, nan));
+  detail::kfm_fill(r.distance, n, -1);
+
+  auto fail = [&](Status s, std::string why) {
+    r.status = s;
+    r.reason = "match_to_keyframe: " + why;
+  };
+  std::string why;
+  if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, why);
+  if (!camera.valid()) return fail(Status::InvalidInput, "camera needs finite, positive focal lengths, a finite "
+                                                         "principal point and a positive image size");
+  if (kf_points.size() != 0 && kf_points.size() != n_kf)
+    return fail(Status::InvalidInput, "kf_points has " + std::to_string(kf_points.size()) + " points for " +
+                                          std::to_string(n_kf) + " keyframe keypoints (give one per keypoint, or none)");
+  if (!detail::kfm_rows_ok(kf_desc, n_kf, "kf_desc", &why)) return fail(Status::InvalidInput, why);
+  if (!detail::kfm_rows_ok(cur_desc, n, "cur_desc", &why)) return fail(Status::InvalidInput, why);
+  if (kf_desc.row_bytes != cur_desc.row_bytes)
+    return fail(Status::InvalidInput, "kf_desc rows have " + std::to_string(kf_desc.row_bytes) +
+                                          " bytes, cur_desc rows " + std::to_string(cur_desc.row_bytes));
+  if (static_cast<std::size_t>(options.max_hamming) > 8 * kf_desc.row_bytes)
+    return fail(Status::InvalidInput, "KeyframeMatchOptions: max_hamming " + std::to_string(options.max_hamming) +
+                                          " exceeds the descriptor's " + std::to_string(8 * kf_desc.row_bytes) + " bits");
+  if (n > std::numeric_limits<std::uint32_t>::max() - 1 || n_kf > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    return fail(Status::InvalidInput, "more keypoints than the matcher indexes (2^31)");
+  if (cam_from_keyframe != nullptr && !cam_from_keyframe->all_finite())
+    return fail(Status::NonFinite, "cam_from_keyframe has a NaN or Inf entry");
+  if (n_kf == 0) return fail(Status::TooFewPoints, "the keyframe has no keypoints");
+  if (n == 0) return fail(Status::TooFewPoints, "the current frame has no keypoints");
+
+  // Current keypoints: read once, bucketed in a grid over their own extent (not the camera's image size,
+  // which may be bogus; keypoints off the image are still found).
+  ws.cur_x.resize(n);
+  ws.cur_y.resize(n);
+  T x0 = std::numeric_limits<T>::max(), y0 = x0, x1 = std::numeric_limits<T>::lowest(), y1 = x1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const T x = point_x<T>(cur_keypoints[i]), y = point_y<T>(cur_keypoints[i]);
+    if (!std::isfinite(x) || !std::isfinite(y)) {
+      ws.cur_x[i] = ws.cur_y[i] = nan;
+      ++r.current_nonfinite;
+      continue;
+    }
+    ws.cur_x[i] = x;
+    ws.cur_y[i] = y;
+    x0 = x < x0 ? x : x0;
+    x1 = x > x1 ? x : x1;
+    y0 = y < y0 ? y : y0;
+    y1 = y > y1 ? y : y1;
+  }
+  constexpr int kMaxCellsPerSide = 256;
+  int cols = 1, rows = 1;
+  T cell = T(1);
+  if (r.current_nonfinite < n) {
+    // Extents in double: (x1 - x0) of two huge finite floats stays finite.
+    const double ex = static_cast<double>(x1) - static_cast<double>(x0);
+    const double ey = static_cast<double>(y1) - static_cast<double>(y0);
+    double c = options.grid_cell_px;
+    const double spread = (ex > ey ? ex : ey) / double(kMaxCellsPerSide - 1);
+    if (spread > c) c = spread;
+    if (std::isfinite(c) && c <= static_cast<double>(std::numeric_limits<T>::max())) {
+      cell = static_cast<T>(c);
+      cols = static_cast<int>(ex / c) + 1;
+      rows = static_cast<int>(ey / c) + 1;
+      cols = cols > kMaxCellsPerSide ? kMaxCellsPerSide : cols;
+      rows = rows > kMaxCellsPerSide ? kMaxCellsPerSide : rows;
+    } else {
+      x0 = y0 = T(0);
+      cell = std::numeric_limits<T>::max();
+    }
+  } else {
+    x0 = y0 = T(0);
+  }
+  const std::size_t cells = static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  detail::kfm_fill(ws.cell_start, cells + 1, std::uint32_t(0));
+  ws.cell_of.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(ws.cur_x[i] == ws.cur_x[i])) {
+      ws.cell_of[i] = kNone;
+      continue;
+    }
+    const int c = detail::kfm_cell(ws.cur_x[i], x0, cell, cols), q = detail::kfm_cell(ws.cur_y[i], y0, cell, rows);
+    const std::uint32_t id = static_cast<std::uint32_t>(q) * static_cast<std::uint32_t>(cols) + static_cast<std::uint32_t>(c);
+    ws.cell_of[i] = id;
+    ++ws.cell_start[id + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) ws.cell_start[c + 1] += ws.cell_start[c];
+  ws.cell_items.resize(n);
+  // cell_of becomes the write cursor per cell: stable order (ascending index) within a cell.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (ws.cell_of[i] == kNone) continue;
+    ws.cell_items[ws.cell_start[ws.cell_of[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  for (std::size_t c = cells; c > 0; --c) ws.cell_start[c] = ws.cell_start[c - 1];
+  ws.cell_start[0] = 0;
+
+  // Keyframe predictions.
+  ws.pred_x.resize(n_kf);
+  ws.pred_y.resize(n_kf);
+  ws.pred_depth.resize(n_kf);
+  T* pred_x = ws.pred_x.data();
+  T* pred_y = ws.pred_y.data();
+  const bool have_depth = kf_points.size() == n_kf;
+  const bool have_pose = cam_from_keyframe != nullptr;
+  r.used_pose = have_pose;
+  Mat3<T> H = Mat3<T>::Identity();  // infinite homography K R K^-1: a ray's prediction without depth
+  if (have_pose) H = camera.K() * cam_from_keyframe->R * camera.K().inverse();
+  for (std::size_t k = 0; k < n_kf; ++k) {
+    const T u = point_x<T>(kf_keypoints[k]), v = point_y<T>(kf_keypoints[k]);
+    pred_x[k] = pred_y[k] = nan;
+    ws.pred_depth[k] = 0;
+    if (!std::isfinite(u) || !std::isfinite(v)) {
+      ++r.keyframe_nonfinite;
+      continue;
+    }
+    if (!have_pose) {
+      pred_x[k] = u;
+      pred_y[k] = v;
+      ++r.predicted_without_depth;
+      continue;
+    }
+    Vec3<T> X(nan, nan, nan);
+    if (have_depth) {
+      const auto& P = kf_points[k];
+      X = Vec3<T>(point_x<T>(P), point_y<T>(P), point_z<T>(P));
+    }
+    if (X.allFinite() && X.z() > T(0)) {
+      const Vec3<T> Xc = cam_from_keyframe->apply(X);
+      if (!(Xc.z() > T(0))) {
+        ++r.behind_camera;
+        continue;
+      }
+      const Vec2<T> p = camera.project(Xc);
+      if (!p.allFinite()) {  // a point at z ~ 0 projects to Inf: nowhere to search
+        ++r.behind_camera;
+        continue;
+      }
+      pred_x[k] = p.x();
+      pred_y[k] = p.y();
+      ws.pred_depth[k] = 1;
+      ++r.predicted_by_depth;
+    } else {
+      const Vec3<T> h = H * Vec3<T>(u, v, T(1));
+      if (!(h.z() > T(0))) {  // the ray turned more than 90 degrees away
+        ++r.behind_camera;
+        continue;
+      }
+      const T px = h.x() / h.z(), py = h.y() / h.z();
+      if (!std::isfinite(px) || !std::isfinite(py)) {
+        ++r.behind_camera;
+        continue;
+      }
+      pred_x[k] = px;
+      pred_y[k] = py;
+      ++r.predicted_without_depth;
+    }
+  }
+
+  detail::kfm_fill(ws.kf_best_cur, n_kf, -1);
+  detail::kfm_fill(ws.kf_second_dist, n_kf, std::numeric_limits<int>::max());
+  detail::kfm_fill(ws.kf_best_dist, n_kf, -1);
+  detail::kfm_fill(ws.cur_best_kf, n, -1);
+  detail::kfm_fill(ws.cur_best_dist, n, std::numeric_limits<int>::max());
+
+  detail::KfmScan<T> s;
+  s.pred_x = pred_x;
+  s.pred_y = pred_y;
+  s.pred_depth = ws.pred_depth.data();
+  s.n_kf = n_kf;
+  s.cur_x = ws.cur_x.data();
+  s.cur_y = ws.cur_y.data();
+  s.kf_desc = kf_desc;
+  s.cur_desc = cur_desc;
+  s.words = kf_desc.row_bytes / 8;
+  s.tail = kf_desc.row_bytes % 8;
+  s.r_depth = static_cast<T>(options.radius_px);
+  s.r_free = static_cast<T>(options.radius_unpredicted_px);
+  s.r2_depth = s.r_depth * s.r_depth;
+  s.r2_free = s.r_free * s.r_free;
+  s.grid_x0 = x0;
+  s.grid_y0 = y0;
+  s.cell = cell;
+  s.cols = cols;
+  s.rows = rows;
+  s.cell_start = ws.cell_start.data();
+  s.cell_items = ws.cell_items.data();
+  s.kf_best_cur = ws.kf_best_cur.data();
+  s.kf_best_dist = ws.kf_best_dist.data();
+  s.kf_second_dist = ws.kf_second_dist.data();
+  s.cur_best_kf = ws.cur_best_kf.data();
+  s.cur_best_dist = ws.cur_best_dist.data();
+  detail::kfm_scan(s);
+
+  // Accept: distance and ratio per keyframe point, then one keyframe point per current keypoint.
+  const int* second = ws.kf_second_dist.data();
+  for (std::size_t k = 0; k < n_kf; ++k) {
+    const int c = ws.kf_best_cur[k];
+    if (c < 0) continue;
+    const int d = ws.kf_best_dist[k];
+    if (d > options.max_hamming) continue;
+    if (second[k] != std::numeric_limits<int>::max() && !(double(d) <= options.ratio * double(second[k]))) continue;
+    const std::size_t ci = static_cast<std::size_t>(c);
+    if (options.mutual_check && ws.cur_best_kf[ci] != static_cast<int>(k)) continue;
+    if (r.keyframe_index[ci] >= 0 && r.distance[ci] <= d) continue;  // a closer (or earlier) keyframe point won
+    if (r.keyframe_index[ci] < 0) ++r.matched;
+    r.keyframe_index[ci] = static_cast<int>(k);
+    r.distance[ci] = d;
+    r.keyframe_pixel[ci] = Vec2<T>(point_x<T>(kf_keypoints[k]), point_y<T>(kf_keypoints[k]));
+  }
+}
+
+/// Convenience form that allocates its workspace and result (tests, one-off calls).
+template <class T, class KfKeypoints, class KfPoints, class CurKeypoints>
+KeyframeMatchResult<T> match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_points,
+                                         DescriptorRows kf_desc, const CurKeypoints& cur_keypoints,
+                                         DescriptorRows cur_desc, const PinholeCamera<T>& camera,
+                                         const typename detail::kfm_identity<Rigid3<T>>::type* cam_from_keyframe, const KeyframeMatchOptions& options = {}) {
+  KeyframeMatchWorkspace<T> ws;
+  KeyframeMatchResult<T> r;
+  match_to_keyframe(kf_keypoints, kf_points, kf_desc, cur_keypoints, cur_desc, camera, cam_from_keyframe, options, ws,
+                    &r);
+  return r;
+}
+
+}  // namespace dyncull
