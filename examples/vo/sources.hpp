@@ -6,6 +6,7 @@
 
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/text.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/detections.hpp"
 #include "dyncull/sim/scene.hpp"
@@ -19,7 +20,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <locale>
 #include <map>
 #include <sstream>
 #include <string>
@@ -99,38 +99,6 @@ struct StampedFile {
   std::string path;
 };
 
-/// TUM list file: "timestamp filename" per line, '#' comments.
-inline bool read_tum_list(const std::string& file, std::vector<StampedFile>* out, std::string* error) {
-  std::ifstream in(file);
-  if (!in) {
-    *error = "cannot open " + file;
-    return false;
-  }
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ss(line);
-    ss.imbue(std::locale::classic());  // '.' decimals whatever the global locale
-    StampedFile f;
-    if (!(ss >> f.timestamp >> f.path)) {
-      *error = file + ":" + std::to_string(line_no) + ": expected 'timestamp filename'";
-      return false;
-    }
-    out->push_back(f);
-  }
-  return true;
-}
-
-/// File name without directory and extension: rgb/1341846313.592026.png -> 1341846313.592026.
-inline std::string stem(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  const std::size_t dot = name.find_last_of('.');
-  return dot == std::string::npos ? name : name.substr(0, dot);
-}
-
 /// Reads a whole text file; false with "path: why" for a directory or an unreadable path.
 inline bool read_text_file(const std::string& path, std::string* text, std::string* error) {
   std::error_code ec;
@@ -151,6 +119,59 @@ inline bool read_text_file(const std::string& path, std::string* text, std::stri
   }
   *text = ss.str();
   return true;
+}
+
+/// TUM list file: "timestamp filename" per line (more fields ignored), '#' comments. The stamp is a
+/// number as Python's float() reads it, whatever the locale; errors name file:line.
+inline bool read_tum_list(const std::string& file, std::vector<StampedFile>* out, std::string* error) {
+  std::string text;
+  if (!read_text_file(file, &text, error)) return false;
+  const std::string_view all(text);
+  int line_no = 0;
+  for (std::size_t pos = 0; pos < all.size();) {
+    std::size_t end = all.find('\n', pos);
+    if (end == std::string_view::npos) end = all.size();
+    const std::string_view line = all.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    std::size_t k = 0;
+    while (k < line.size() && space(line[k])) ++k;
+    if (k == line.size() || line[k] == '#') continue;
+    const std::string where = file + ":" + std::to_string(line_no) + ": ";
+    if (line.size() > text::kMaxLineChars) {
+      *error = where + "line is " + std::to_string(line.size()) + " bytes long";
+      return false;
+    }
+    std::string_view fields[2];
+    int n = 0;
+    while (k < line.size() && n < 2) {
+      const std::size_t start = k;
+      while (k < line.size() && !space(line[k])) ++k;
+      fields[n++] = line.substr(start, k - start);
+      while (k < line.size() && space(line[k])) ++k;
+    }
+    if (n < 2) {
+      *error = where + "expected 'timestamp filename'";
+      return false;
+    }
+    StampedFile f;
+    if (text::parse_python_float(fields[0], &f.timestamp) != text::NumberStatus::Ok || !std::isfinite(f.timestamp)) {
+      *error = where + "timestamp " + text::quote_token(fields[0]) + " is not a number";
+      return false;
+    }
+    f.path = std::string(fields[1]);
+    out->push_back(std::move(f));
+  }
+  return true;
+}
+
+/// File name without directory and extension: rgb/1341846313.592026.png -> 1341846313.592026.
+inline std::string stem(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = name.find_last_of('.');
+  return dot == std::string::npos ? name : name.substr(0, dot);
 }
 
 /// Malformed detection lines: the count and the first few as "file:line: reason".

@@ -101,6 +101,25 @@ TEST_F(TumDetections, MissingOrDirectoryPathsAreErrors) {
   EXPECT_NE(error.find("1.000000.txt"), std::string::npos) << error;
 }
 
+TEST_F(TumDetections, ImageListsAreCheckedLineByLine) {
+  std::string error;
+  std::filesystem::remove(dir_ / "rgb.txt");
+  std::filesystem::create_directories(dir_ / "rgb.txt");
+  EXPECT_FALSE(open("", &error));
+  EXPECT_NE(error.find("rgb.txt: is a directory"), std::string::npos) << error;
+  std::filesystem::remove_all(dir_ / "rgb.txt");
+  std::ofstream(dir_ / "rgb.txt") << "# color\n1.000000 rgb/1.000000.png\n2,000000 rgb/2.000000.png\n";
+  EXPECT_FALSE(open("", &error));
+  EXPECT_NE(error.find("rgb.txt:3: timestamp '2,000000' is not a number"), std::string::npos) << error;
+  std::ofstream(dir_ / "rgb.txt") << "1.000000 rgb/1.000000.png\r\n2.000000\n";
+  EXPECT_FALSE(open("", &error));
+  EXPECT_NE(error.find("rgb.txt:2: expected 'timestamp filename'"), std::string::npos) << error;
+  std::ofstream(dir_ / "rgb.txt") << "1.000000 rgb/1.000000.png\r\n";  // CRLF: the file name has no '\r'
+  ASSERT_TRUE(open("", &error)) << error;
+  vo::SequenceFrame f;
+  EXPECT_TRUE(source_.load(0, &f, &error)) << error;
+}
+
 }  // namespace
 
 #else
