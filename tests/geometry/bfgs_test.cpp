@@ -2,7 +2,11 @@
 // iteration limit, non-finite input and objectives that are undefined in part of the domain.
 #include "dyncull/geometry/bfgs.hpp"
 
+#include "dyncull/core/random.hpp"
+
 #include <gtest/gtest.h>
+
+#include <limits>
 
 #include <string>
 
@@ -184,6 +188,49 @@ TEST(BfgsOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
   o = {};
   o.wolfe_c2 = 1.5;
   check(o, "wolfe_c2");
+}
+
+// For any start, objective behaviour (NaN / Inf / huge values) and options: a non-Ok status with a
+// reason, or a finite point, value and gradient.
+TYPED_TEST(BfgsTest, PropertyResultIsFiniteOrTheCallFails) {
+  using T = TypeParam;
+  using V = Eigen::Matrix<T, 2, 1>;
+  dyncull::Random rng(88);
+  for (int trial = 0; trial < 300; ++trial) {
+    const double kind = rng.uniform();
+    const T scale = T(std::pow(10.0, rng.uniform(-30, 30)));
+    const auto f = [&](const V& x, V* g) -> T {
+      if (kind < 0.1 && x.norm() > T(3)) {  // NaN outside a ball
+        g->setConstant(std::numeric_limits<T>::quiet_NaN());
+        return std::numeric_limits<T>::quiet_NaN();
+      }
+      if (kind < 0.2 && x(0) > T(1)) {  // +inf beyond a wall
+        g->setConstant(T(1));
+        return std::numeric_limits<T>::infinity();
+      }
+      *g = T(2) * scale * x;
+      return scale * x.squaredNorm();
+    };
+    dyncull::BfgsOptions o;
+    o.max_iterations = static_cast<int>(rng.index(50));
+    if (rng.uniform() < 0.1) o.gradient_tolerance = std::nan("");
+    if (rng.uniform() < 0.1) o.armijo_c1 = -1;
+    const double u = rng.uniform();
+    const V x0(u < 0.05 ? std::numeric_limits<T>::quiet_NaN() : T(rng.uniform(-5, 5)),
+               u > 0.95 ? std::numeric_limits<T>::max() : T(rng.uniform(-5, 5)));
+    const auto r = dyncull::bfgs_minimize(f, x0, o);
+    if (r.status == dyncull::Status::InvalidInput || r.status == dyncull::Status::NonFinite) {
+      EXPECT_FALSE(r.reason.empty()) << trial;
+      continue;
+    }
+    // Ok and NotConverged both return the last accepted iterate: it must be finite.
+    EXPECT_TRUE(r.x.allFinite()) << trial;
+    EXPECT_TRUE(std::isfinite(r.value)) << trial;
+    EXPECT_TRUE(r.gradient.allFinite()) << trial;
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << trial;
+    }
+  }
 }
 
 }  // namespace

@@ -160,4 +160,50 @@ TEST(IcpOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
   check(bad, "relative_rmse");
 }
 
+template <class T>
+T wild_value(Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
+  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
+  return T(rng.uniform(lo, hi));
+}
+
+// For any clouds, start and options: a non-Ok status with a reason, or a finite transform and statistics.
+TYPED_TEST(IcpTest, PropertyTransformIsFiniteOrTheCallFails) {
+  using T = TypeParam;
+  Random rng(86);
+  for (int trial = 0; trial < 150; ++trial) {
+    auto target = room_cloud<T>(rng, static_cast<int>(rng.index(60)));
+    const bool clean = rng.uniform() < 0.3;
+    std::vector<Vec3<T>> source = target;
+    const Rigid3<T> motion = dyncull::test::random_rigid<T>(rng, 0.05, 0.05);
+    for (auto& p : source) p = motion.apply(p);
+    if (!clean) {
+      for (auto* cloud : {&source, &target}) {
+        for (auto& p : *cloud) {
+          if (rng.uniform() < 0.2) p = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3));
+        }
+      }
+    }
+    IcpOptions<T> o;
+    o.max_iterations = static_cast<int>(rng.index(40)) - (rng.uniform() < 0.05 ? 50 : 0);
+    o.max_correspondence_distance_m = rng.uniform() < 0.1 ? wild_value<T>(rng, 0, 1) : T(rng.uniform(0.01, 1));
+    o.estimate_scale = rng.uniform() < 0.3;
+    Rigid3<T> start;
+    if (rng.uniform() < 0.1) start.t.y() = wild_value<T>(rng, -1, 1);
+    const auto r = dyncull::icp_point_to_point(source, target, start, o);
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << trial;
+      continue;
+    }
+    EXPECT_TRUE(r.target_from_source.all_finite()) << trial;
+    EXPECT_TRUE(std::isfinite(r.scale) && std::isfinite(r.rmse) && std::isfinite(r.fitness)) << trial;
+    EXPECT_GE(r.fitness, T(0));
+    EXPECT_LE(r.fitness, T(1));
+  }
+}
+
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -114,6 +115,62 @@ TYPED_TEST(KdTreeTest, DuplicatesNonFiniteAndEmpty) {
   EXPECT_TRUE(empty.empty());
   EXPECT_EQ(empty.nearest(Vec3<T>(0, 0, 0), &d), KdTree3<T>::kNone);
   EXPECT_EQ(empty.build(dup, 0), Status::InvalidInput);
+}
+
+template <class T>
+T wild_value(Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
+  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
+  return T(rng.uniform(lo, hi));
+}
+
+// A container claiming 2^32 + 5 points (indices would wrap): refused before any point is read.
+struct HugeCloud {
+  std::size_t size() const { return (std::size_t{1} << 32) + 5; }
+  Vec3<double> operator[](std::size_t) const { return Vec3<double>::Constant(std::nan("")); }
+};
+
+TEST(KdTree, RefusesMorePointsThanThirtyTwoBitIndices) {
+  KdTree3<double> tree;
+  EXPECT_EQ(tree.build(HugeCloud{}), Status::InvalidInput);
+  EXPECT_TRUE(tree.empty());
+}
+
+// For any points and queries: a returned neighbour is a finite point at the reported finite distance,
+// and no finite point is strictly nearer (checked by brute force).
+TYPED_TEST(KdTreeTest, PropertyNearestIsExactAndFinite) {
+  using T = TypeParam;
+  Random rng(87);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<Vec3<T>> pts(rng.index(80));
+    for (auto& p : pts) p = Vec3<T>(wild_value<T>(rng, -5, 5), wild_value<T>(rng, -5, 5), wild_value<T>(rng, -5, 5));
+    KdTree3<T> tree;
+    const int leaf = rng.uniform() < 0.05 ? 0 : 1 + static_cast<int>(rng.index(16));
+    const Status s = tree.build(pts, leaf);
+    if (s != Status::Ok) {
+      EXPECT_TRUE(tree.empty());
+      continue;
+    }
+    for (int q = 0; q < 10; ++q) {
+      const Vec3<T> query(wild_value<T>(rng, -6, 6), wild_value<T>(rng, -6, 6), wild_value<T>(rng, -6, 6));
+      T d2 = T(-1);
+      const std::uint32_t i = tree.nearest(query, &d2);
+      if (i == KdTree3<T>::kNone) continue;
+      ASSERT_LT(i, pts.size());
+      EXPECT_TRUE(pts[i].allFinite());
+      EXPECT_TRUE(std::isfinite(d2)) << trial;
+      for (const auto& p : pts) {
+        if (!p.allFinite()) continue;
+        const T d = (p - query).squaredNorm();
+        // The tree sums dx^2 + dy^2 + dz^2 in its own order: equal distances may differ by an ulp.
+        EXPECT_FALSE(d < d2 * (T(1) - T(8) * std::numeric_limits<T>::epsilon())) << "trial " << trial;
+      }
+    }
+  }
 }
 
 }  // namespace

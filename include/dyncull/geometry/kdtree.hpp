@@ -32,7 +32,8 @@ class KdTree3 {
   }
 
   /// (Re)builds from any container of 3-D points (PointTraits). Returns Ok, TooFewPoints when no
-  /// finite point remains (queries then return kNone), or InvalidInput for leaf_size < 1.
+  /// finite point remains (queries then return kNone), or InvalidInput for leaf_size < 1 or a container
+  /// of 2^32 - 1 points or more (indices are 32-bit; kNone is reserved).
   template <class Points>
   Status build(const Points& points, int leaf_size = 12) {
     static_assert(is_point_container_v<Points> && PointTraits<container_point_t<Points>>::dim == 3,
@@ -45,6 +46,7 @@ class KdTree3 {
     if (leaf_size < 1) return Status::InvalidInput;
     leaf_size_ = static_cast<std::uint32_t>(leaf_size);
     const std::size_t n = static_cast<std::size_t>(points.size());
+    if (n >= static_cast<std::size_t>(kNone)) return Status::InvalidInput;
     std::vector<std::uint32_t> order;
     std::vector<T> px, py, pz;
     order.reserve(n);
