@@ -7,6 +7,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/sim/actors.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -111,7 +112,8 @@ constexpr const char* to_string(KeptWhy w) noexcept {
 /// low precision or recall can be traced to the actor and the stage (dynamic_vo --diagnose). A kept
 /// feature's reason is None; `kept_why` (optional) then says at which stage it stayed static.
 struct LabelBreakdown {
-  static constexpr int kInstances = 8, kReasons = 12, kKeptWhy = 8;
+  /// Every sim instance id (sim::SceneInstance), then "other".
+  static constexpr int kInstances = sim::SceneInstance::kCount + 1, kReasons = 12, kKeptWhy = 8;
   static constexpr int kCells = kReasons + kKeptWhy;  ///< reasons, then None split by KeptWhy
   std::array<std::size_t, kInstances * 2 * 2 * kCells> counts{};
 
@@ -135,8 +137,12 @@ struct LabelBreakdown {
   }
   /// Name of a sim instance id (sim::SceneInstance order; ids past the table are "other").
   static const char* instance_name(int instance) {
-    static const char* names[kInstances] = {"background", "walker_a", "walker_b", "sitting_person",
-                                            "pushed_chair", "sitting_chair", "tv", "other"};
+    static const char* names[kInstances] = {
+        "background",    "walker_a",      "walker_b",    "sitting_person", "pushed_chair", "sitting_chair",
+        "tv",            "walker_c",      "walker_d",    "desk_person_a",  "desk_person_b", "desk_chair_a",
+        "desk_chair_b",  "monitor_a",     "monitor_b",   "keyboard_a",     "keyboard_b",    "mouse_a",
+        "mouse_b",       "bottle",        "cup",         "book",           "laptop",        "other"};
+    static_assert(sim::SceneInstance::kCount == 23, "name the sim's new instances here");
     return names[instance < 0 || instance >= kInstances ? kInstances - 1 : instance];
   }
   /// One line per non-empty cell: "instance truth decision reason count".

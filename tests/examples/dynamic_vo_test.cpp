@@ -553,6 +553,25 @@ TEST(DynamicVo, FamilySceneRunsThroughTheFrontEnd) {
   EXPECT_GT(report.runs[1].labels.true_positive, 0u) << "the seated person's moving parts are culled";
 }
 
+
+// --diagnose names every instance the sim can render (the crowd's third and fourth walkers, the desk people
+// and clutter), so their labels are not lumped into "other".
+TEST(DynamicVo, DiagnoseNamesEverySimInstance) {
+  std::set<std::string> names;
+  for (int id = 0; id < sim::SceneInstance::kCount; ++id) {
+    const std::string name = vo::LabelBreakdown::instance_name(id);
+    EXPECT_NE(name, "other") << "instance " << id;
+    EXPECT_TRUE(names.insert(name).second) << "instance " << id << " shares the name " << name;
+  }
+  EXPECT_STREQ(vo::LabelBreakdown::instance_name(sim::SceneInstance::kWalkerC), "walker_c");
+  EXPECT_STREQ(vo::LabelBreakdown::instance_name(sim::SceneInstance::kDeskPersonB), "desk_person_b");
+  EXPECT_STREQ(vo::LabelBreakdown::instance_name(sim::SceneInstance::kCount), "other");
+  EXPECT_STREQ(vo::LabelBreakdown::instance_name(-1), "other");
+  vo::LabelBreakdown b;
+  ++b.at(sim::SceneInstance::kWalkerD, true, true, 0);
+  EXPECT_NE(b.format().find("walker_d moving culled"), std::string::npos) << b.format();
+}
+
 }  // namespace
 
 #else
