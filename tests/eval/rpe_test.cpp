@@ -6,7 +6,9 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <type_traits>
 
@@ -227,6 +229,41 @@ TEST(Rpe, FailuresAreStatuses) {
   const RpeResult<double> r = evaluate_rpe(gt, late);
   EXPECT_EQ(r.status, Status::TooFewPoints);
   EXPECT_NE(r.reason.find("overlap"), std::string::npos) << r.reason;
+}
+
+// For any poses and options: a non-Ok status with a reason, or finite errors and statistics.
+TYPED_TEST(RpeTest, PropertyErrorsAreFiniteOrTheCallFails) {
+  using T = TypeParam;
+  std::mt19937_64 rng(90);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  for (int trial = 0; trial < 150; ++trial) {
+    const int n = static_cast<int>(uni(rng) * 40);
+    Trajectory<T> gt = synthetic::make_loop<T>(std::max(n, 1));
+    Trajectory<T> est = gt;
+    const double magnitude = std::pow(10.0, uni(rng) * (std::is_same<T, double>::value ? 310 : 40) - 5);
+    for (std::size_t i = 0; i < est.size(); ++i) {
+      const double u = uni(rng);
+      if (u < 0.3) est.poses[i].t *= T(std::min(magnitude, double(std::numeric_limits<T>::max())));
+      if (u > 0.97) est.poses[i].t.y() = std::numeric_limits<T>::quiet_NaN();
+      if (u > 0.95 && u <= 0.97) est.stamps[i] = std::numeric_limits<double>::infinity();
+    }
+    RpeOptions o;
+    const double k = uni(rng);
+    o.delta_unit = k < 0.25 ? DeltaUnit::Frames : k < 0.5 ? DeltaUnit::Seconds : k < 0.75 ? DeltaUnit::Metres
+                                                                                            : DeltaUnit::Degrees;
+    o.delta = uni(rng) < 0.05 ? -1.0 : 0.01 + uni(rng) * 5;
+    o.scale = uni(rng) < 0.05 ? std::nan("") : 0.5 + uni(rng);
+    const RpeResult<T> r = evaluate_rpe(gt, est, o);
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << trial;
+      continue;
+    }
+    for (const auto& p : r.pairs) EXPECT_TRUE(std::isfinite(p.translation_m) && std::isfinite(p.rotation_deg)) << trial;
+    for (const ErrorStatistics<T>* s : {&r.translation_m, &r.rotation_deg}) {
+      EXPECT_TRUE(s->ok()) << trial;
+      EXPECT_TRUE(std::isfinite(s->rmse) && std::isfinite(s->max)) << trial;
+    }
+  }
 }
 
 }  // namespace

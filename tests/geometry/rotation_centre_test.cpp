@@ -14,6 +14,7 @@
 #endif
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace {
@@ -381,6 +382,52 @@ TEST(RotationCentreOptionsValidate, NamesTheFieldIncludingNestedBfgs) {
   bad = {};
   bad.bfgs.max_iterations = -1;
   check(bad, "bfgs.max_iterations");
+}
+
+template <class T>
+T wild_value(dyncull::Random& rng, double lo, double hi) {
+  const double u = rng.uniform();
+  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
+  if (u < 0.03) return std::numeric_limits<T>::infinity();
+  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
+  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
+  return T(rng.uniform(lo, hi));
+}
+
+// For any flow and options (both solvers, every loss): a non-Ok status with a reason, or a finite
+// centre, angle, cost and conditioning.
+TYPED_TEST(RotationCentreTest, PropertyCentreIsFiniteOrTheCallFails) {
+  using T = TypeParam;
+  dyncull::Random rng(89);
+  for (int trial = 0; trial < 200; ++trial) {
+    auto flow = rotation_flow<T>(rng.index(60), rng.uniform(0, 640), rng.uniform(0, 480), rng.uniform(-1, 1),
+                                 rng.uniform(0, 2), static_cast<std::uint64_t>(trial));
+    if (rng.uniform() < 0.7) {
+      for (auto* pts : {&flow.p1, &flow.p2}) {
+        for (auto& p : *pts) {
+          if (rng.uniform() < 0.15) p = Eigen::Matrix<T, 2, 1>(wild_value<T>(rng, 0, 640), wild_value<T>(rng, 0, 480));
+        }
+      }
+    }
+    RotationCentreOptions o;
+    o.solver = rng.uniform() < 0.5 ? RotationCentreSolver::Bfgs : RotationCentreSolver::NormalEquations;
+    const double l = rng.uniform();
+    o.loss = l < 0.33 ? RobustLoss::None : l < 0.66 ? RobustLoss::Huber : RobustLoss::Cauchy;
+    o.loss_scale_px = rng.uniform() < 0.05 ? -1.0 : rng.uniform(0.5, 5);
+    o.min_vectors = rng.index(12);
+    o.min_inliers = rng.index(12);
+    o.min_inlier_fraction = rng.uniform() < 0.05 ? 2.0 : rng.uniform(0, 1);
+    const auto r = dyncull::estimate_rotation_centre(flow.p1, flow.p2, 640, 480, o);
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << trial;
+      continue;
+    }
+    EXPECT_TRUE(r.centre.allFinite()) << trial;
+    EXPECT_TRUE(std::isfinite(r.angle_rad) && std::isfinite(r.signed_angle_rad)) << trial;
+    EXPECT_TRUE(std::isfinite(r.cost) && std::isfinite(r.eigenvalue_ratio)) << trial;
+    EXPECT_EQ(r.inlier_mask.size(), flow.p1.size());
+  }
 }
 
 }  // namespace
