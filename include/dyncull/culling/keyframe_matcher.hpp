@@ -118,12 +118,14 @@ struct KeyframeMatchWorkspace {
   std::vector<T> cur_x, cur_y;                 // current keypoints (NaN marks a non-finite one)
   std::vector<T> pred_x, pred_y;               // keyframe points' predictions (NaN: not searched)
   std::vector<std::uint8_t> pred_depth;        // 1: predicted through depth (radius_px)
-  std::vector<std::uint32_t> cell_start;       // grid: cell c holds cell_items[cell_start[c] .. cell_start[c+1])
-  std::vector<std::uint32_t> cell_items;
+  std::vector<std::uint32_t> cell_start;       // grid: cell c holds sorted positions [cell_start[c], cell_start[c+1])
   std::vector<std::uint32_t> cell_of;          // grid cell of each current keypoint (kNone: not in the grid)
-  std::vector<int> kf_best_cur, kf_best_dist;  // per keyframe point: nearest current keypoint, -1 none
+  std::vector<T> sorted_x, sorted_y;           // finite current keypoints in cell order
+  std::vector<std::uint32_t> sorted_index;     // sorted position -> current keypoint index
+  std::vector<std::uint8_t> sorted_desc;       // their descriptor rows, row_bytes apart
+  std::vector<int> kf_best_cur, kf_best_dist;  // per keyframe point: nearest sorted position, -1 none
   std::vector<int> kf_second_dist;             // and the second-nearest distance
-  std::vector<int> cur_best_kf, cur_best_dist; // per current keypoint: nearest keyframe point that searched it
+  std::vector<int> cur_best_kf, cur_best_dist; // per sorted position: nearest keyframe point that searched it
 };
 
 namespace detail {
@@ -141,27 +143,28 @@ inline int kfm_popcount_swar(std::uint64_t x) noexcept {
   return static_cast<int>((x * 0x0101010101010101ull) >> 56);
 }
 
-/// Plain data the scan reads: the keyframe predictions and the current grid.
+/// Plain data the scan reads: the keyframe predictions and the current keypoints sorted by grid cell
+/// (positions, original indices and descriptor rows contiguous per cell row).
 template <class T>
 struct KfmScan {
   const T* pred_x;  // per keyframe point, NaN = do not search
   const T* pred_y;
   const std::uint8_t* pred_depth;  // 1: radius_px, 0: radius_unpredicted_px
   std::size_t n_kf;
-  const T* cur_x;
+  const T* cur_x;  // sorted by cell
   const T* cur_y;
-  DescriptorRows kf_desc, cur_desc;
-  std::size_t words;  // 64-bit words per descriptor
-  std::size_t tail;   // bytes after the words
+  const std::uint32_t* cur_index;  // sorted position -> current keypoint index
+  DescriptorRows kf_desc;
+  const std::uint8_t* cur_desc;  // sorted rows, row_bytes apart
+  std::size_t row_bytes;
   T r2_depth, r2_free, r_depth, r_free;
   T grid_x0, grid_y0, cell;
   int cols, rows;
-  const std::uint32_t* cell_start;
-  const std::uint32_t* cell_items;
-  int* kf_best_cur;
+  const std::uint32_t* cell_start;  // sorted positions of cell c: [cell_start[c], cell_start[c + 1])
+  int* kf_best_cur;                 // sorted position, -1 none
   int* kf_best_dist;
   int* kf_second_dist;
-  int* cur_best_kf;
+  int* cur_best_kf;  // by sorted position
   int* cur_best_dist;
 };
 
@@ -174,21 +177,24 @@ inline int kfm_cell(T v, T origin, T cell, int count) {
   return static_cast<int>(c);
 }
 
-template <bool UseBuiltin>
-inline int kfm_hamming(const std::uint8_t* a, const std::uint8_t* b, std::size_t words, std::size_t tail) {
+/// Hamming distance of two rows; kWords > 0 fixes the length at compile time (ORB: 4 words, no tail).
+template <bool UseBuiltin, int kWords>
+inline int kfm_hamming(const std::uint8_t* a, const std::uint8_t* b, std::size_t row_bytes) {
+  const std::size_t words = kWords > 0 ? std::size_t(kWords) : row_bytes / 8;
   int d = 0;
   for (std::size_t w = 0; w < words; ++w) {
     const std::uint64_t x = kfm_load_u64(a + 8 * w) ^ kfm_load_u64(b + 8 * w);
     d += UseBuiltin ? __builtin_popcountll(x) : kfm_popcount_swar(x);
   }
-  for (std::size_t k = 8 * words; k < 8 * words + tail; ++k)
-    d += kfm_popcount_swar(static_cast<std::uint64_t>(a[k] ^ b[k]));
+  if (kWords == 0)
+    for (std::size_t k = 8 * words; k < row_bytes; ++k) d += kfm_popcount_swar(static_cast<std::uint64_t>(a[k] ^ b[k]));
   return d;
 }
 
-/// For every keyframe point: the nearest and second-nearest current keypoints in its search disc; for
-/// every current keypoint: the nearest keyframe point among those whose disc held it.
-template <class T, bool UseBuiltin>
+/// For every keyframe point: the nearest (ties: lowest current index) and second-nearest current
+/// keypoints in its search disc; for every current keypoint: the nearest keyframe point (ties: lowest
+/// index) among those whose disc held it.
+template <class T, bool UseBuiltin, int kWords>
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((always_inline))
 #endif
@@ -201,32 +207,57 @@ inline void kfm_scan_impl(const KfmScan<T>& s) {
     const int c0 = kfm_cell(px - r, s.grid_x0, s.cell, s.cols), c1 = kfm_cell(px + r, s.grid_x0, s.cell, s.cols);
     const int q0 = kfm_cell(py - r, s.grid_y0, s.cell, s.rows), q1 = kfm_cell(py + r, s.grid_y0, s.cell, s.rows);
     const std::uint8_t* kd = s.kf_desc.row(k);
-    int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max(), best_i = -1;
+    // Key = distance << 32 | current index: one comparison orders by distance, then index. The updates
+    // are selects, not branches: which candidate wins is unpredictable.
+    std::uint64_t best = std::numeric_limits<std::uint64_t>::max();
+    int best_d = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max(), best_pos = -1;
+    std::uint32_t hits[64];
     for (int q = q0; q <= q1; ++q) {
-      for (int c = c0; c <= c1; ++c) {
-        const std::size_t cell = static_cast<std::size_t>(q) * static_cast<std::size_t>(s.cols) + static_cast<std::size_t>(c);
-        for (std::uint32_t it = s.cell_start[cell]; it < s.cell_start[cell + 1]; ++it) {
-          const std::uint32_t i = s.cell_items[it];
+      // Cells c0..c1 of one grid row are one contiguous run of sorted positions.
+      const std::size_t row0 = static_cast<std::size_t>(q) * static_cast<std::size_t>(s.cols);
+      const std::uint32_t end = s.cell_start[row0 + static_cast<std::size_t>(c1) + 1];
+      for (std::uint32_t a = s.cell_start[row0 + static_cast<std::size_t>(c0)]; a < end; a += 64) {
+        const std::uint32_t b = end - a > 64 ? a + 64 : end;
+        // Branch-free compaction of the keypoints inside the disc.
+        std::uint32_t nh = 0;
+        for (std::uint32_t i = a; i < b; ++i) {
           const T dx = s.cur_x[i] - px, dy = s.cur_y[i] - py;
-          if (!(dx * dx + dy * dy <= r2)) continue;
-          const int d = kfm_hamming<UseBuiltin>(kd, s.cur_desc.row(i), s.words, s.tail);
-          if (d < best) {
-            second = best;
-            best = d;
-            best_i = static_cast<int>(i);
-          } else if (d < second) {
-            second = d;
-          }
-          if (d < s.cur_best_dist[i]) {  // ties keep the lower keyframe index
-            s.cur_best_dist[i] = d;
-            s.cur_best_kf[i] = static_cast<int>(k);
-          }
+          hits[nh] = i;
+          nh += (dx * dx + dy * dy <= r2) ? 1u : 0u;
+        }
+        for (std::uint32_t h = 0; h < nh; ++h) {
+          const std::uint32_t i = hits[h];
+          const int d = kfm_hamming<UseBuiltin, kWords>(kd, s.cur_desc + std::size_t(i) * s.row_bytes, s.row_bytes);
+          const std::uint64_t key = (static_cast<std::uint64_t>(d) << 32) | s.cur_index[i];
+          const bool better = key < best;
+          const int loser = better ? best_d : d;  // best_d <= second always
+          second = loser < second ? loser : second;
+          best = better ? key : best;
+          best_d = better ? d : best_d;
+          best_pos = better ? static_cast<int>(i) : best_pos;
+          // Keyframe points come in ascending order: ties keep the lower one.
+          const int cur = s.cur_best_dist[i];
+          const bool nearer = d < cur;
+          s.cur_best_dist[i] = nearer ? d : cur;
+          s.cur_best_kf[i] = nearer ? static_cast<int>(k) : s.cur_best_kf[i];
         }
       }
     }
-    s.kf_best_cur[k] = best_i;
-    s.kf_best_dist[k] = best_i >= 0 ? best : -1;
+    s.kf_best_cur[k] = best_pos;
+    s.kf_best_dist[k] = best_pos >= 0 ? best_d : -1;
     s.kf_second_dist[k] = second;
+  }
+}
+
+template <class T, bool UseBuiltin>
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+inline void kfm_scan_words(const KfmScan<T>& s) {
+  if (s.row_bytes == 32) {
+    kfm_scan_impl<T, UseBuiltin, 4>(s);
+  } else {
+    kfm_scan_impl<T, UseBuiltin, 0>(s);
   }
 }
 
@@ -236,11 +267,11 @@ inline void kfm_scan_impl(const KfmScan<T>& s) {
 // twice and the POPCNT one chosen at run time.
 template <class T>
 __attribute__((target("popcnt"))) void kfm_scan_popcnt(const KfmScan<T>& s) {
-  kfm_scan_impl<T, true>(s);
+  kfm_scan_words<T, true>(s);
 }
 template <class T>
 void kfm_scan_portable(const KfmScan<T>& s) {
-  kfm_scan_impl<T, false>(s);
+  kfm_scan_words<T, false>(s);
 }
 inline bool kfm_cpu_has_popcnt() {
   static const bool has = __builtin_cpu_supports("popcnt");
@@ -257,7 +288,7 @@ void kfm_scan(const KfmScan<T>& s) {
     kfm_scan_portable<T>(s);
   }
 #else
-  kfm_scan_impl<T, true>(s);
+  kfm_scan_words<T, true>(s);
 #endif
 }
 
@@ -417,11 +448,21 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
     ++ws.cell_start[id + 1];
   }
   for (std::size_t c = 0; c < cells; ++c) ws.cell_start[c + 1] += ws.cell_start[c];
-  ws.cell_items.resize(n);
-  // cell_of becomes the write cursor per cell: stable order (ascending index) within a cell.
+  // Counting sort by cell, stable (ascending index within a cell): positions, indices and descriptor
+  // rows become contiguous, so a search reads one run of memory per grid row.
+  const std::size_t n_sorted = n - r.current_nonfinite;
+  const std::size_t row_bytes = cur_desc.row_bytes;
+  ws.sorted_x.resize(n_sorted);
+  ws.sorted_y.resize(n_sorted);
+  ws.sorted_index.resize(n_sorted);
+  ws.sorted_desc.resize(n_sorted * row_bytes);
   for (std::size_t i = 0; i < n; ++i) {
     if (ws.cell_of[i] == kNone) continue;
-    ws.cell_items[ws.cell_start[ws.cell_of[i]]++] = static_cast<std::uint32_t>(i);
+    const std::uint32_t pos = ws.cell_start[ws.cell_of[i]]++;  // cell_start[c] is c's write cursor here
+    ws.sorted_x[pos] = ws.cur_x[i];
+    ws.sorted_y[pos] = ws.cur_y[i];
+    ws.sorted_index[pos] = static_cast<std::uint32_t>(i);
+    std::memcpy(ws.sorted_desc.data() + std::size_t(pos) * row_bytes, cur_desc.row(i), row_bytes);
   }
   for (std::size_t c = cells; c > 0; --c) ws.cell_start[c] = ws.cell_start[c - 1];
   ws.cell_start[0] = 0;
@@ -491,20 +532,20 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
   detail::kfm_fill(ws.kf_best_cur, n_kf, -1);
   detail::kfm_fill(ws.kf_second_dist, n_kf, std::numeric_limits<int>::max());
   detail::kfm_fill(ws.kf_best_dist, n_kf, -1);
-  detail::kfm_fill(ws.cur_best_kf, n, -1);
-  detail::kfm_fill(ws.cur_best_dist, n, std::numeric_limits<int>::max());
+  detail::kfm_fill(ws.cur_best_kf, n_sorted, -1);
+  detail::kfm_fill(ws.cur_best_dist, n_sorted, std::numeric_limits<int>::max());
 
   detail::KfmScan<T> s;
   s.pred_x = pred_x;
   s.pred_y = pred_y;
   s.pred_depth = ws.pred_depth.data();
   s.n_kf = n_kf;
-  s.cur_x = ws.cur_x.data();
-  s.cur_y = ws.cur_y.data();
+  s.cur_x = ws.sorted_x.data();
+  s.cur_y = ws.sorted_y.data();
+  s.cur_index = ws.sorted_index.data();
   s.kf_desc = kf_desc;
-  s.cur_desc = cur_desc;
-  s.words = kf_desc.row_bytes / 8;
-  s.tail = kf_desc.row_bytes % 8;
+  s.cur_desc = ws.sorted_desc.data();
+  s.row_bytes = row_bytes;
   s.r_depth = static_cast<T>(options.radius_px);
   s.r_free = static_cast<T>(options.radius_unpredicted_px);
   s.r2_depth = s.r_depth * s.r_depth;
@@ -515,7 +556,6 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
   s.cols = cols;
   s.rows = rows;
   s.cell_start = ws.cell_start.data();
-  s.cell_items = ws.cell_items.data();
   s.kf_best_cur = ws.kf_best_cur.data();
   s.kf_best_dist = ws.kf_best_dist.data();
   s.kf_second_dist = ws.kf_second_dist.data();
@@ -531,8 +571,8 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
     const int d = ws.kf_best_dist[k];
     if (d > options.max_hamming) continue;
     if (second[k] != std::numeric_limits<int>::max() && !(double(d) <= options.ratio * double(second[k]))) continue;
-    const std::size_t ci = static_cast<std::size_t>(c);
-    if (options.mutual_check && ws.cur_best_kf[ci] != static_cast<int>(k)) continue;
+    if (options.mutual_check && ws.cur_best_kf[static_cast<std::size_t>(c)] != static_cast<int>(k)) continue;
+    const std::size_t ci = ws.sorted_index[static_cast<std::size_t>(c)];
     if (r.keyframe_index[ci] >= 0 && r.distance[ci] <= d) continue;  // a closer (or earlier) keyframe point won
     if (r.keyframe_index[ci] < 0) ++r.matched;
     r.keyframe_index[ci] = static_cast<int>(k);
