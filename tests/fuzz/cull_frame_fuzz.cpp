@@ -1,6 +1,7 @@
 // libFuzzer target: cull_frame (culling/pipeline.hpp) on frames decoded from the input, for float
 // and double: keypoints with NaN / Inf / huge values, tracks of matching or mismatched length, random
-// boxes and classes, random depth, a pose, a preset with random option values (through
+// boxes and classes, random depth (uint16 sensor units with float, metres with double; random
+// units_per_metre), a pose, a preset with random option values (through
 // PipelineOptions::validate()), several frames on one state. Checks the contract: an Ok result labels
 // every keypoint Static or Dynamic with keep = (Static) and consistent counts; a non-Ok one has a reason.
 #include "dyncull/culling/pipeline.hpp"
@@ -32,6 +33,17 @@ void set_flags(View& dst, const std::vector<std::uint8_t>& flags) {
     dst = flags.data();
   } else {
     dst = View(flags);
+  }
+}
+
+// Metres as the view's raw type: uint16 TUM units (x 5000, clamped, NaN -> 0 = no measurement) or float as is.
+template <class Raw>
+Raw raw_depth(double m) {
+  if constexpr (std::is_floating_point<Raw>::value) {
+    return static_cast<Raw>(m);
+  } else {
+    const double units = m * 5000.0;
+    return static_cast<Raw>(units >= 0 && units <= 65535 ? units : (units > 65535 ? 65535 : 0));
   }
 }
 
@@ -92,7 +104,7 @@ void perturb(fuzz::Input& in, PipelineOptions<T>* o) {
   }
 }
 
-template <class T>
+template <class T, class Raw>
 void run(fuzz::Input& in) {
   PipelineOptions<T> options = preset<T>(in.range(0, 6));
   // RANSAC on random tracks runs to its iteration cap (10000 by default, 90 % of the time here): a
@@ -113,7 +125,7 @@ void run(fuzz::Input& in) {
   std::vector<std::int64_t> ids;
   std::vector<std::uint8_t> valid;
   std::vector<Detection<T>> dets;
-  std::vector<float> depth;
+  std::vector<Raw> depth;
   for (int f = 0; f < frames && !in.empty(); ++f) {
     const int W = in.range(1, 96), H = in.range(1, 96);
     PinholeCamera<T> cam;
@@ -138,7 +150,7 @@ void run(fuzz::Input& in) {
       const bool moved = in.flag();
       prev[i] = i < n && !moved ? kp[i] : Vec2<T>(in.scalar<T>(-5, W + 5), in.scalar<T>(-5, H + 5));
     }
-    CullingFrame<T, std::vector<Vec2<T>>> frame;
+    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, Raw> frame;
     frame.keypoints = &kp;
     frame.prev_keypoints = tracks ? &prev : nullptr;
     if (in.flag()) {
@@ -169,12 +181,14 @@ void run(fuzz::Input& in) {
     if (in.flag()) {
       depth.resize(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
       const int mode = in.range(0, 2);  // constant, two layers, per-pixel random
-      const float base = static_cast<float>(in.value(0, 8));
-      const float near = static_cast<float>(in.value(0, 8));
+      const Raw base = raw_depth<Raw>(in.value(0, 8));
+      const Raw near = raw_depth<Raw>(in.value(0, 8));
       for (std::size_t i = 0; i < depth.size(); ++i)
         depth[i] = mode == 0 ? base : mode == 1 ? ((i % static_cast<std::size_t>(W)) < static_cast<std::size_t>(W / 2) ? near : base)
-                                                 : static_cast<float>(in.value(0, 8));
+                                                 : raw_depth<Raw>(in.value(0, 8));
       frame.depth.data = depth.data();
+      if (!std::is_floating_point<Raw>::value) frame.depth.units_per_metre = 5000.f;  // TUM
+      if (in.u8() == 0) frame.depth.units_per_metre = static_cast<float>(in.value(-1, 10000));
       frame.depth.width = W;
       frame.depth.height = H;
       if (in.flag()) frame.depth.min_m = static_cast<float>(in.value(0, 1));
@@ -218,9 +232,9 @@ void run(fuzz::Input& in) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   fuzz::Input in(data, size);
   if (in.flag()) {
-    run<float>(in);
+    run<float, std::uint16_t>(in);  // raw sensor units
   } else {
-    run<double>(in);
+    run<double, float>(in);         // metres
   }
   return 0;
 }
