@@ -39,7 +39,7 @@ int main() {
   dyncull::PipelineState<float> state;  // lives as long as the tracker: carries boxes and track flags
   const auto options = dyncull::presets::recommended<float>();
   dyncull::CullingFrame<float, std::vector<cv::KeyPoint>, std::vector<cv::Point2f>, float> frame;
-  frame.keypoints = &keys;  frame.prev_keypoints = &prev_pts;  frame.track_valid = lk_status.data();
+  frame.keypoints = &keys;  frame.prev_keypoints = &prev_pts;  frame.track_valid = lk_status;
   frame.detections = &current.detections;  // pixel boxes from your detector (see detections.hpp for YOLO)
   frame.depth = dyncull::DepthView<float>{current.depth_m.data(), current.width, current.height};
   frame.camera = scene.camera().cast<float>();

@@ -50,7 +50,7 @@ void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options
   CullingFrame<float, std::vector<Vec2<float>>> frame;
   frame.keypoints = &d.scene.keypoints;
   frame.prev_keypoints = &d.scene.prev_keypoints;
-  frame.track_valid = d.scene.track_valid.data();
+  frame.track_valid = d.scene.track_valid;
   frame.detections = &d.dets;
   frame.depth = d.scene.depth_view();
   frame.camera = d.scene.camera;

@@ -48,7 +48,7 @@ CullingFrame<T, std::vector<Vec2<T>>> frame_of(const test::CullingScene<T>& s, c
   CullingFrame<T, std::vector<Vec2<T>>> frame;
   frame.keypoints = &s.keypoints;
   frame.prev_keypoints = &s.prev_keypoints;
-  frame.track_valid = s.track_valid.data();
+  frame.track_valid = s.track_valid;
   frame.detections = &dets;
   frame.depth = s.depth_view();
   frame.camera = s.camera;
@@ -498,7 +498,7 @@ TYPED_TEST(PipelineTest, MissingInputsSkipStagesWithReasons) {
   CullingFrame<T, std::vector<Vec2<T>>> bare;
   bare.keypoints = &s.keypoints;
   bare.prev_keypoints = &s.prev_keypoints;
-  bare.track_valid = s.track_valid.data();
+  bare.track_valid = s.track_valid;
   bare.detections = &none;
   bare.camera = s.camera;
   PipelineState<T> fresh;  // `state` would carry the last frame's boxes forward (box tracker)
@@ -949,7 +949,7 @@ TEST(PipelineReadme, FrontEndExampleCompilesAndRuns) {
   dyncull::CullingFrame<float, std::vector<KeyPoint>, std::vector<Point2f>, std::uint16_t> frame;
   frame.keypoints = &keys;                 // this frame's keypoints (cv::KeyPoint works as is)
   frame.prev_keypoints = &prev_pts;        // their LK positions in the reference frame (keyframe)
-  frame.track_valid = lk_status.data();    // LK status per keypoint
+  frame.track_valid = lk_status;    // LK status per keypoint
   frame.detections = &boxes;               // detector boxes (pixels, after NMS)
   frame.depth = dyncull::tum_depth_view(depth.data(), camera.width, camera.height);
   frame.camera = camera;

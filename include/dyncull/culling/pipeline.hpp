@@ -24,6 +24,7 @@
 #include "dyncull/culling/static_history.hpp"
 #include "dyncull/culling/subbox_memory.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
+#include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -165,6 +166,55 @@ struct PipelineOptions {
   bool survivor_guard = true;
   double min_survivor_fraction = 0.10;
   std::size_t min_survivors = 30;
+
+  static constexpr std::size_t kMaxReferenceKeyframes = 64;  ///< upper bound of max_reference_keyframes
+  static constexpr int kMaxEdgeEvidenceRadiusPx = 64;        ///< upper bound of edge_evidence_radius_px
+
+  /// InvalidInput naming the first field out of its range, nested fields as "depth_mask.histogram_bin_m":
+  /// every nested options struct that has a validate() passes it (whether its stage is on or not);
+  /// enums in range; max_reference_keyframes <= kMaxReferenceKeyframes; edge_evidence_radius_px in
+  /// [0, kMaxEdgeEvidenceRadiusPx]; edge_depth_step_ratio and overlap_high_level_margin_m finite and >= 0;
+  /// subbox_memory_frames and min_evidence_frames in [0, 65535]; min_survivor_fraction in [0, 1].
+  Status validate(std::string* reason = nullptr) const {
+    using detail::finite_in;
+    using detail::invalid_option;
+    using detail::validate_nested;
+    // Nested structs first, in stage order; the first failure's reason stands.
+    if (validate_nested(detections, "detections", reason) != Status::Ok ||
+        validate_nested(tracker, "tracker", reason) != Status::Ok ||
+        validate_nested(levels, "levels", reason) != Status::Ok ||
+        validate_nested(box_rule, "box_rule", reason) != Status::Ok ||
+        validate_nested(depth_mask, "depth_mask", reason) != Status::Ok ||
+        validate_nested(probability, "probability", reason) != Status::Ok ||
+        validate_nested(moving, "moving", reason) != Status::Ok ||
+        validate_nested(reprojection, "reprojection", reason) != Status::Ok ||
+        validate_nested(subbox, "subbox", reason) != Status::Ok ||
+        validate_nested(multiview, "multiview", reason) != Status::Ok ||
+        validate_nested(coherent_motion, "coherent_motion", reason) != Status::Ok ||
+        validate_nested(static_history, "static_history", reason) != Status::Ok)
+      return Status::InvalidInput;
+    if (static_cast<int>(probability_flow_model) > 2)
+      return invalid_option(reason, "probability_flow_model", "must be MeanFlow, Fundamental or Homography");
+    if (static_cast<int>(reprojection_evidence) > 1)
+      return invalid_option(reason, "reprojection_evidence", "must be Replace or Either");
+    if (static_cast<int>(candidates) > 2) return invalid_option(reason, "candidates", "must be Keep, Cull or Verify");
+    if (max_reference_keyframes > kMaxReferenceKeyframes)
+      return invalid_option(reason, "max_reference_keyframes", "must be at most 64");
+    if (!finite_in(overlap_high_level_margin_m, 0, 1e4))
+      return invalid_option(reason, "overlap_high_level_margin_m", "must be finite and in [0, 1e4] m");
+    if (subbox_memory_frames < 0 || subbox_memory_frames > 0xFFFF)
+      return invalid_option(reason, "subbox_memory_frames", "must be in [0, 65535]");
+    if (edge_evidence_radius_px < 0 || edge_evidence_radius_px > kMaxEdgeEvidenceRadiusPx)
+      return invalid_option(reason, "edge_evidence_radius_px", "must be in [0, 64]");
+    if (!finite_in(edge_depth_step_ratio, 0, 1e30))
+      return invalid_option(reason, "edge_depth_step_ratio", "must be finite and >= 0");
+    if (min_evidence_frames < 0 || min_evidence_frames > 0xFFFF)
+      return invalid_option(reason, "min_evidence_frames", "must be in [0, 65535]");
+    if (!finite_in(min_survivor_fraction, 0, 1))
+      return invalid_option(reason, "min_survivor_fraction", "must be in [0, 1]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Outcome of one stage in one frame.
@@ -245,9 +295,30 @@ struct PipelineState {
   BoxTrackerOptions<T> tracker_options_{};
 };
 
+/// Non-owning view of per-track flags with their count (data[i] != 0: valid). Built from a
+/// std::vector<std::uint8_t> (implicitly) or a pointer and a count: then given, and its count is checked
+/// against the keypoints' (an empty vector for keypoints is a mismatch, not "all valid"); default or
+/// nullptr: no flags.
+struct FlagView {
+  const std::uint8_t* data = nullptr;
+  std::size_t size = 0;
+  bool given = false;
+
+  FlagView() = default;
+  FlagView(std::nullptr_t) {}  // NOLINT(google-explicit-constructor): "no flags", as a null pointer was
+  FlagView(const std::uint8_t* flags, std::size_t count) : data(flags), size(count), given(true) {}
+  FlagView(const std::vector<std::uint8_t>& flags)  // NOLINT(google-explicit-constructor)
+      : data(flags.data()), size(flags.size()), given(true) {}
+  bool empty() const { return !given; }
+  /// Given, and readable for n entries.
+  bool holds(std::size_t n) const { return given && size == n && (data != nullptr || n == 0); }
+  std::uint8_t operator[](std::size_t i) const { return data[i]; }
+};
+
 /// One frame as the front end has it. Keypoints: the caller's container (cv::KeyPoint, Eigen, ...);
 /// prev_keypoints: previous-frame positions parallel to keypoints (any point container), with
-/// track_valid (nullptr = all valid); nothing is copied out of them except into scratch buffers.
+/// track_valid (not given = all valid; else one flag per keypoint, checked); nothing is copied out of them
+/// except into scratch buffers.
 /// points_3d: optional 3-D point of each track in one fixed frame (the map point, or the reference
 /// keyframe's back-projection in world or keyframe coordinates), parallel to keypoints, non-finite where
 /// there is none; used by the reprojection check.
@@ -255,7 +326,7 @@ template <class T, class Keypoints, class Prev = Keypoints, class Raw = float, c
 struct CullingFrame {
   const Keypoints* keypoints = nullptr;
   const Prev* prev_keypoints = nullptr;
-  const std::uint8_t* track_valid = nullptr;
+  FlagView track_valid{};
   const std::vector<std::int64_t>* track_ids = nullptr;  ///< for the probability's K term (optional)
   const Points3* points_3d = nullptr;                     ///< for the reprojection check (optional)
   const std::vector<Detection<T>>* detections = nullptr;  ///< pixel boxes after NMS
@@ -408,7 +479,9 @@ void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, 
 
 /// Runs the enabled strategies on one frame and returns the labels (a reference into `state`, valid
 /// until the next call). Never throws; bad or missing inputs skip the stages that need them, with a
-/// reason in the stage report.
+/// reason in the stage report. Options that fail PipelineOptions::validate, an invalid depth view
+/// (DepthView::validate) or a track_valid whose size is not the keypoints' give status InvalidInput with
+/// the reason and cull nothing: every keypoint is labelled Static and kept.
 template <class T, class Keypoints, class Prev, class Raw, class Points3>
 const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, Points3>& frame,
                                     const PipelineOptions<T>& options, PipelineState<T>* state) {
@@ -458,12 +531,40 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   r.num_features = n;
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
+  {
+    std::string why;
+    Status bad = Status::Ok;
+    if (options.validate(&why) != Status::Ok) {
+      bad = Status::InvalidInput;
+      why = "invalid options: " + why;
+    } else if (frame.depth.validate(&why) != Status::Ok) {
+      bad = Status::InvalidInput;
+    } else if (!frame.track_valid.empty() && !frame.track_valid.holds(n)) {
+      bad = Status::InvalidInput;
+      why = "track_valid has " + std::to_string(frame.track_valid.size) + " flags for " + std::to_string(n) +
+            " keypoints";
+    }
+    if (bad != Status::Ok) {
+      r.status = bad;
+      r.reason = why;
+      r.keep.assign(n, 1);
+      r.num_static = n;
+      r.num_dynamic = 0;
+      return r;
+    }
+  }
+  const std::uint8_t* const track_valid = frame.track_valid.empty() ? nullptr : frame.track_valid.data;
   s.sem_labels.assign(n, FeatureLabel::Static);
   s.sem_reasons.assign(n, CullReason::None);
   s.in_dyn_box.assign(n, 0);
   s.in_object.assign(n, 1);
   s.mv_dynamic.assign(n, 0);
   const bool have_tracks = frame.prev_keypoints && static_cast<std::size_t>(frame.prev_keypoints->size()) == n;
+  auto no_tracks = [&]() {  // the reason of a stage that needs tracks (built only when it is needed)
+    return frame.prev_keypoints ? "prev_keypoints has " + std::to_string(frame.prev_keypoints->size()) +
+                                      " positions for " + std::to_string(n) + " keypoints"
+                                : std::string("no previous-frame positions (tracks) given");
+  };
 
   // 1. Boxes: filter (padding, class thresholds), then carry missed ones forward.
   s.boxes.clear();
@@ -580,9 +681,9 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   const bool have_boxes = !s.dyn_boxes.empty();
   if (options.use_moving_consistency) {
     if (!have_tracks) {
-      r.moving_consistency.reason = "no previous-frame positions (tracks) given";
+      r.moving_consistency.reason = no_tracks();
     } else {
-      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &s.moving, frame.track_valid,
+      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &s.moving, track_valid,
                                have_boxes ? s.in_dyn_box.data() : nullptr);
       r.moving_consistency.status = s.moving.status;
       r.moving_consistency.reason = s.moving.reason;
@@ -594,7 +695,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     if (!frame.points_3d) {
       r.reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
     } else {
-      check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &s.reprojection, frame.track_valid,
+      check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &s.reprojection, track_valid,
                          have_boxes ? s.in_dyn_box.data() : nullptr, frame.depth);
       r.reprojection.status = s.reprojection.status;
       r.reprojection.reason = s.reprojection.reason;
@@ -639,12 +740,12 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   // 5. Dynamic probability for features in object masks (000 Algorithm 1).
   if (options.use_probability) {
     if (!have_tracks) {
-      r.probability.reason = "no previous-frame positions (tracks) given";
+      r.probability.reason = no_tracks();
     } else {
       s.prob_levels.assign(n, MotionLevel::Ignore);
       s.prob_prev.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        const bool valid = !frame.track_valid || frame.track_valid[i];
+        const bool valid = !track_valid || track_valid[i] != 0;
         s.prob_prev[i] = valid ? Vec2<T>(point_x<T>((*frame.prev_keypoints)[i]), point_y<T>((*frame.prev_keypoints)[i]))
                                : Vec2<T>(Constants<T>::nan(), Constants<T>::nan());
         if (s.in_dyn_box[i] && s.in_object[i] && i < rule_box_index->size() && (*rule_box_index)[i] >= 0)
@@ -773,7 +874,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
           roi.r1 = std::max(roi.r1, v + 1);
         }
       }
-      s.ref_index.resize(std::max<std::size_t>(1, options.max_reference_keyframes));
+      s.ref_index.resize(std::max<std::size_t>(1, std::min(options.max_reference_keyframes, s.keyframes.size())));
       const std::size_t k = s.keyframes.select_references(*frame.cam_from_world, options.max_reference_keyframes,
                                                           s.ref_index.data());
       if (s.multiview_mask.width != frame.depth.width || s.multiview_mask.height != frame.depth.height)
@@ -897,7 +998,10 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
     return c;
   };
   std::size_t survivors = count_static();
-  const std::size_t need = std::max(options.min_survivors, static_cast<std::size_t>(std::ceil(options.min_survivor_fraction * double(n))));
+  // The fraction is clamped to [0, 1] before the conversion (validate() rejects others; NaN counts as 0).
+  const double survivor_fraction = options.min_survivor_fraction >= 0 ? std::min(options.min_survivor_fraction, 1.0) : 0.0;
+  const std::size_t need =
+      std::max(options.min_survivors, static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));
   if (options.survivor_guard && survivors < need && n > 0) {
     std::size_t soft = 0;
     for (std::size_t i = 0; i < n; ++i) soft += r.labels[i] == FeatureLabel::Dynamic && detail::is_soft_cull(r.reasons[i]);

@@ -1,0 +1,297 @@
+// Bad input to cull_frame: options out of range (PipelineOptions::validate and its nested structs),
+// a track_valid of the wrong length, huge depths through the recommended preset, and random frames with
+// NaN / Inf / huge values: a non-Ok status with a reason, or defined labels and a parallel keep mask.
+#include "dyncull/core/random.hpp"
+#include "dyncull/culling/pipeline.hpp"
+#include "dyncull/culling/presets.hpp"
+
+#include "support/culling_scenes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+namespace {
+
+template <class T>
+class PipelineInputsTest : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(PipelineInputsTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
+
+template <class T>
+std::vector<Detection<T>> detections_of(const test::CullingScene<T>& s) {
+  std::vector<Detection<T>> out;
+  for (const auto& d : s.detections) out.push_back(Detection<T>{d.box.template cast<T>(), d.class_id, T(d.confidence)});
+  return out;
+}
+
+template <class T>
+CullingFrame<T, std::vector<Vec2<T>>> frame_of(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets) {
+  CullingFrame<T, std::vector<Vec2<T>>> frame;
+  frame.keypoints = &s.keypoints;
+  frame.prev_keypoints = &s.prev_keypoints;
+  frame.track_valid = s.track_valid;
+  frame.detections = &dets;
+  frame.depth = s.depth_view();
+  frame.camera = s.camera;
+  frame.cam_from_world = &s.cam_from_world;
+  return frame;
+}
+
+template <class T>
+void expect_nothing_culled(const PipelineResult<T>& r, std::size_t n, const char* field) {
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+  ASSERT_EQ(r.labels.size(), n);
+  ASSERT_EQ(r.keep.size(), n);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(r.keep[i], 1);
+  EXPECT_EQ(r.num_static, n);
+}
+
+TYPED_TEST(PipelineInputsTest, EveryPresetValidates) {
+  using T = TypeParam;
+  std::string why;
+  for (const PipelineOptions<T>& o : {presets::none<T>(), presets::dld_slam<T>(), presets::rtd_slam<T>(),
+                                      presets::zhu_2024<T>(), presets::dfd_slam<T>(), presets::zhang_2023<T>(),
+                                      presets::recommended<T>(), PipelineOptions<T>{}})
+    EXPECT_EQ(o.validate(&why), Status::Ok) << why;
+}
+
+TYPED_TEST(PipelineInputsTest, NestedReasonNamesTheStageAndTheField) {
+  using T = TypeParam;
+  std::string why;
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.depth_mask.histogram_bin_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
+  EXPECT_EQ(why, "depth_mask.histogram_bin_m must be positive and finite (at least 0.001 m)");
+  o = presets::recommended<T>();
+  o.moving.refit_iterations = 1000000;
+  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("moving.refit_iterations"), std::string::npos) << why;
+  o = presets::recommended<T>();
+  o.subbox.dilation_radius_px = INT_MAX;
+  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("subbox.dilation_radius_px"), std::string::npos) << why;
+}
+
+TYPED_TEST(PipelineInputsTest, HugeReferenceKeyframeCountIsInvalidInputNotAnException) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  PipelineOptions<T> o = presets::rtd_slam<T>();
+  PipelineState<T> state;
+  auto frame = frame_of(s, dets);
+  frame.is_keyframe = true;
+  cull_frame(frame, o, &state);  // stores a keyframe
+  ASSERT_FALSE(state.keyframes.empty());
+  o.max_reference_keyframes = std::numeric_limits<std::size_t>::max();
+  frame.is_keyframe = false;
+  const PipelineResult<T>* r = nullptr;
+  EXPECT_NO_THROW(r = &cull_frame(frame, o, &state));
+  ASSERT_NE(r, nullptr);
+  expect_nothing_culled(*r, s.size(), "max_reference_keyframes");
+  o.max_reference_keyframes = PipelineOptions<T>::kMaxReferenceKeyframes;
+  EXPECT_NO_THROW(r = &cull_frame(frame, o, &state));
+  EXPECT_TRUE(r->ok()) << r->reason;
+}
+
+TYPED_TEST(PipelineInputsTest, SurvivorFractionOutOfRangeIsInvalidInputEvenWithTheGuardOff) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  for (bool guard : {true, false})
+    for (double fraction : {-1.0, std::numeric_limits<double>::quiet_NaN(), 1e30}) {
+      PipelineOptions<T> o = presets::recommended<T>();
+      o.survivor_guard = guard;
+      o.min_survivor_fraction = fraction;
+      PipelineState<T> state;
+      expect_nothing_culled(cull_frame(frame_of(s, dets), o, &state), s.size(), "min_survivor_fraction");
+    }
+}
+
+TYPED_TEST(PipelineInputsTest, EdgeEvidenceRadiusIsBounded) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  for (int radius : {INT_MAX, 100000000, -1}) {
+    PipelineOptions<T> o = presets::recommended<T>();
+    o.edge_evidence_radius_px = radius;
+    PipelineState<T> state;
+    expect_nothing_culled(cull_frame(frame_of(s, dets), o, &state), s.size(), "edge_evidence_radius_px");
+  }
+}
+
+TYPED_TEST(PipelineInputsTest, TrackValidOfTheWrongLengthIsInvalidInput) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  const PipelineOptions<T> o = presets::recommended<T>();
+  PipelineState<T> state;
+  auto frame = frame_of(s, dets);
+  const std::vector<std::uint8_t> short_flags(s.size() / 2, 1);
+  frame.track_valid = short_flags;
+  expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "track_valid");
+  const std::vector<std::uint8_t> none;
+  frame.track_valid = none;  // given but empty: a mismatch too
+  expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "track_valid");
+  frame.track_valid = FlagView(nullptr, s.size());  // a count without flags
+  expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "track_valid");
+  // Flags of the right length, or none at all, run the pipeline.
+  frame.track_valid = s.track_valid;
+  EXPECT_TRUE(cull_frame(frame, o, &state).ok());
+  frame.track_valid = nullptr;
+  EXPECT_TRUE(cull_frame(frame, o, &state).ok());
+}
+
+TYPED_TEST(PipelineInputsTest, ShortPrevKeypointsSkipTheTrackStagesWithAReason) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  const std::vector<Vec2<T>> prev(s.prev_keypoints.begin(), s.prev_keypoints.begin() + 10);
+  auto frame = frame_of(s, dets);
+  frame.prev_keypoints = &prev;
+  frame.track_valid = nullptr;
+  PipelineState<T> state;
+  const PipelineResult<T>& r = cull_frame(frame, presets::recommended<T>(), &state);
+  EXPECT_TRUE(r.ok()) << r.reason;
+  EXPECT_FALSE(r.moving_consistency.ran());
+  EXPECT_NE(r.moving_consistency.reason.find("prev_keypoints has 10 positions"), std::string::npos)
+      << r.moving_consistency.reason;
+}
+
+TYPED_TEST(PipelineInputsTest, InvalidDepthViewIsInvalidInput) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  auto frame = frame_of(s, dets);
+  frame.depth.units_per_metre = -1.f;
+  PipelineState<T> state;
+  expect_nothing_culled(cull_frame(frame, presets::recommended<T>(), &state), s.size(), "units_per_metre");
+}
+
+TYPED_TEST(PipelineInputsTest, HugeFloatDepthThroughTheRecommendedPreset) {
+  using T = TypeParam;
+  auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  // Far surfaces at 1e20 m (finite floats; the view's max_m is 1e30): every box's histogram bins them.
+  for (std::size_t k = 0; k < s.depth.size(); k += 3) s.depth[k] = 1e20f;
+  PipelineState<T> state;
+  const PipelineResult<T>& r = cull_frame(frame_of(s, dets), presets::recommended<T>(), &state);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.labels.size(), s.size());
+  for (FeatureLabel l : r.labels) EXPECT_TRUE(l == FeatureLabel::Static || l == FeatureLabel::Dynamic);
+}
+
+/// A random value: mostly in [lo, hi), sometimes NaN, +-Inf, huge or negative.
+template <class T>
+T wild(Random& rng, double lo, double hi) {
+  switch (rng.index(14)) {
+    case 0: return std::numeric_limits<T>::quiet_NaN();
+    case 1: return std::numeric_limits<T>::infinity();
+    case 2: return -std::numeric_limits<T>::infinity();
+    case 3: return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
+    case 4: return T(rng.uniform(-1e10, 1e10));
+    default: return T(rng.uniform(lo, hi));
+  }
+}
+
+TYPED_TEST(PipelineInputsTest, PropertyRandomFramesGiveAStatusOrDefinedLabels) {
+  using T = TypeParam;
+  Random rng(77);
+  const PipelineOptions<T> bases[] = {presets::recommended<T>(), presets::dld_slam<T>(), presets::rtd_slam<T>(),
+                                      presets::dfd_slam<T>(), presets::zhang_2023<T>()};
+  const int w = 80, h = 60;
+  PinholeCamera<T> camera;
+  camera.width = w;
+  camera.height = h;
+  camera.fx = camera.fy = T(70);
+  camera.cx = T(39.5);
+  camera.cy = T(29.5);
+  std::size_t checked = 0, stages_ran = 0;  // frames whose labels were checked; stages that ran in them
+  for (int trial = 0; trial < 300; ++trial) {
+    PipelineOptions<T> o = bases[rng.index(5)];
+    o.moving.fundamental.ransac.max_iterations = 50;
+    o.reprojection.pnp.ransac.max_iterations = 50;
+    switch (rng.index(8)) {  // now and then one absurd option
+      case 0: o.min_survivor_fraction = wild<double>(rng, 0, 1); break;
+      case 1: o.depth_mask.histogram_max_m = wild<double>(rng, 0, 20); break;
+      case 2: o.subbox.dilation_radius_px = static_cast<int>(rng.index(4)) * (INT_MAX / 3); break;
+      case 3: o.max_reference_keyframes = rng.index(2) ? std::numeric_limits<std::size_t>::max() : rng.index(5); break;
+      case 4: o.multiview.search_radius_px = static_cast<int>(rng.index(3)) * (INT_MAX / 2); break;
+      default: break;
+    }
+    // A camera moving sideways past random 3-D points (the stages have real evidence to work on), with
+    // one value in ten replaced by a wild one, and boxes of a person, a chair or a TV (now and then wild).
+    Rigid3<T> pose;
+    pose.t = Vec3<T>(rng.index(10) == 0 ? wild<T>(rng, -0.1, 0.1) : T(-0.08), T(0), T(0));
+    const std::size_t n = rng.index(150);
+    std::vector<Vec2<T>> kp(n), prev(n);
+    std::vector<Vec3<T>> pts(n);
+    std::vector<std::uint8_t> valid(n);
+    std::vector<std::int64_t> ids(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      pts[i] = Vec3<T>(T(rng.uniform(-1, 1)), T(rng.uniform(-0.7, 0.7)), T(rng.uniform(1, 4)));
+      prev[i] = camera.project(pts[i]);
+      kp[i] = camera.project(pose.apply(pts[i]));
+      if (rng.index(10) == 0) kp[i] = Vec2<T>(wild<T>(rng, 0, w), wild<T>(rng, 0, h));
+      if (rng.index(10) == 0) prev[i] = Vec2<T>(wild<T>(rng, 0, w), wild<T>(rng, 0, h));
+      if (rng.index(10) == 0) pts[i] = Vec3<T>(wild<T>(rng, -1, 1), wild<T>(rng, -1, 1), wild<T>(rng, 0.5, 4));
+      valid[i] = static_cast<std::uint8_t>(rng.index(10) != 0);
+      ids[i] = static_cast<std::int64_t>(i);
+    }
+    std::vector<Detection<T>> dets(rng.index(4));
+    const int classes[] = {0, 0, 56, 62};
+    for (auto& d : dets) {
+      const bool odd = rng.index(6) == 0;
+      const T x0 = odd ? wild<T>(rng, -10, w) : T(rng.uniform(0, w / 2)), y0 = odd ? wild<T>(rng, -10, h) : T(rng.uniform(0, h / 2));
+      d.box = Box<T>{x0, y0, x0 + (odd ? wild<T>(rng, 0, w) : T(rng.uniform(5, w / 2))),
+                     y0 + (odd ? wild<T>(rng, 0, h) : T(rng.uniform(5, h / 2)))};
+      d.class_id = odd ? static_cast<int>(rng.index(90)) - 5 : classes[rng.index(4)];
+      d.confidence = odd ? wild<T>(rng, 0, 1) : T(0.9);
+    }
+    std::vector<float> depth(static_cast<std::size_t>(w * h));
+    for (float& z : depth) z = rng.index(20) == 0 ? wild<float>(rng, 0, 6) : float(rng.uniform(0.5, 5));
+    CullingFrame<T, std::vector<Vec2<T>>> frame;
+    frame.keypoints = &kp;
+    frame.prev_keypoints = &prev;
+    frame.track_valid = valid;
+    frame.track_ids = &ids;
+    frame.points_3d = rng.index(2) ? &pts : nullptr;
+    frame.detections = &dets;
+    frame.depth = DepthView<float>{depth.data(), w, h, 0, 1.f, 0.f, 1e30f};
+    frame.camera = camera;
+    frame.cam_from_world = &pose;
+    frame.evidence_frames = static_cast<int>(rng.index(4));
+    PipelineState<T> state;
+    for (int repeat = 0; repeat < 2; ++repeat) {
+      frame.is_keyframe = repeat == 0;  // the second frame has a keyframe for the multi-view check
+      const PipelineResult<T>* r = nullptr;
+      ASSERT_NO_THROW(r = &cull_frame(frame, o, &state)) << trial;
+      ASSERT_EQ(r->labels.size(), n) << trial;
+      ASSERT_EQ(r->keep.size(), n) << trial;
+      if (!r->ok()) {
+        EXPECT_FALSE(r->reason.empty()) << trial;
+        continue;
+      }
+      ++checked;
+      for (const StageReport* st : {&r->depth_mask, &r->moving_consistency, &r->reprojection, &r->subbox, &r->multiview})
+        stages_ran += st->ran();
+      for (std::size_t i = 0; i < n; ++i) {
+        EXPECT_TRUE(r->labels[i] == FeatureLabel::Static || r->labels[i] == FeatureLabel::Dynamic) << trial;
+        EXPECT_EQ(r->keep[i], r->labels[i] == FeatureLabel::Static ? 1 : 0) << trial;
+      }
+      EXPECT_EQ(r->num_static + r->num_dynamic, n) << trial;
+    }
+  }
+  EXPECT_GT(checked, 300u) << "frames that reached the label checks";
+  EXPECT_GT(stages_ran, 200u) << "geometric and depth stages that ran";
+}
+
+}  // namespace
+}  // namespace dyncull
