@@ -56,7 +56,9 @@ TEST(EvalArgs, BadArgumentsAreReported) {
 TEST(EvalArgs, NumbersAreReadTheSameInACommaDecimalLocale) {
   const std::string previous = std::setlocale(LC_NUMERIC, nullptr);
   bool switched = false;
-  for (const char* l : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8"}) switched = switched || std::setlocale(LC_NUMERIC, l);
+  for (const char* l : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8"}) {
+    switched = switched || std::setlocale(LC_NUMERIC, l) != nullptr;
+  }
   if (!switched) GTEST_SKIP() << "no comma-decimal locale installed";
   const auto ok = parse({"a", "b", "--delta", "0.5", "--offset", "-1.25"});
   const auto comma = parse({"a", "b", "--delta", "0,5"});

@@ -184,7 +184,9 @@ TYPED_TEST(IcpTest, PropertyTransformIsFiniteOrTheCallFails) {
     if (!clean) {
       for (auto* cloud : {&source, &target}) {
         for (auto& p : *cloud) {
-          if (rng.uniform() < 0.2) p = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3));
+          if (rng.uniform() < 0.2) {
+            p = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3));
+          }
         }
       }
     }

@@ -345,7 +345,9 @@ void pnp_property(std::uint64_t seed) {
     const bool half_clean = rng.uniform() < 0.5;
     for (std::size_t i = 0; i < s.world.size(); ++i) {
       if (half_clean && rng.uniform() < 0.8) continue;
-      if (rng.uniform() < 0.5) s.world[i] = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, 0, 8));
+      if (rng.uniform() < 0.5) {
+        s.world[i] = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, 0, 8));
+      }
       if (rng.uniform() < 0.5) s.pixels[i] = Vec2<T>(wild_value<T>(rng, 0, 640), wild_value<T>(rng, 0, 480));
     }
     if (rng.uniform() < 0.1) s.camera.fx = wild_value<T>(rng, 1, 1000);

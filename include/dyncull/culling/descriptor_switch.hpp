@@ -375,7 +375,8 @@ MatchResult match_l2(const FloatDescriptors<T>& query, const FloatDescriptors<T>
     out.reason = "match_l2: " + why;
     return out;
   }
-  if (query.rows > std::numeric_limits<std::uint32_t>::max() || train.rows > std::numeric_limits<std::uint32_t>::max()) {
+  if (query.rows > std::numeric_limits<std::uint32_t>::max() ||
+      train.rows > std::numeric_limits<std::uint32_t>::max()) {
     out.status = Status::InvalidInput;
     out.reason = "match_l2: more than 2^32 rows";
     return out;

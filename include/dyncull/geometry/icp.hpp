@@ -33,7 +33,8 @@ struct IcpOptions {
       if (reason) *reason = why;
       return Status::InvalidInput;
     };
-    if (max_iterations < 0 || max_iterations > kMaxIterations) return bad("IcpOptions: max_iterations must be in [0, 10000]");
+    if (max_iterations < 0 || max_iterations > kMaxIterations)
+      return bad("IcpOptions: max_iterations must be in [0, 10000]");
     if (!(max_correspondence_distance_m > T(0)) || !std::isfinite(max_correspondence_distance_m))
       return bad("IcpOptions: max_correspondence_distance_m must be finite and > 0");
     if (!(relative_fitness >= T(0)) || !std::isfinite(relative_fitness))

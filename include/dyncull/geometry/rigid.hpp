@@ -170,42 +170,54 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
     return result;
   }
   if (!result.ok() && result.status != Status::NonFinite && result.status != Status::Degenerate) return result;
-  // Overflowing (or underflowing) moments of finite data: align src / c and dst / c with c the largest
-  // magnitude (a power of two, so the scaling is exact). R and the scale are unchanged by a common
-  // factor; the translation scales by c. Weights are normalised the same way.
-  T c = T(0), wmax = T(0);
+  // Overflowing (or underflowing) moments of finite data: align src / 2^a and dst / 2^b, each scaled
+  // by its own largest magnitude (powers of two, so the scaling is exact). R does not depend on
+  // positive factors on src or dst; the scale becomes s' 2^b / 2^a, and t is rebuilt from the means
+  // in the original units. Weights are normalised the same way.
+  T cs = T(0), cd = T(0), wmax = T(0);
   for (Eigen::Index i = 0; i < n; ++i) {
-    c = std::max(c, std::max(src.col(i).cwiseAbs().maxCoeff(), dst.col(i).cwiseAbs().maxCoeff()));
+    cs = std::max(cs, src.col(i).cwiseAbs().maxCoeff());
+    cd = std::max(cd, dst.col(i).cwiseAbs().maxCoeff());
     if (weights != nullptr) wmax = std::max(wmax, weights[i]);
   }
-  if (!std::isfinite(c)) {  // NaN fails max, so test the data itself
-    result.status = Status::NonFinite;
-    result.reason = "umeyama: non-finite coordinates in src or dst";
-    return result;
-  }
-  if (!(c > T(0))) return result;  // all points at the origin: the first status (Degenerate) stands
-  for (Eigen::Index i = 0; i < n; ++i) {
+  for (Eigen::Index i = 0; i < n; ++i) {  // NaN fails max: test the data itself
     if (!src.col(i).allFinite() || !dst.col(i).allFinite()) {
       result.status = Status::NonFinite;
       result.reason = "umeyama: non-finite coordinates in src or dst";
       return result;
     }
   }
-  // Element-wise ldexp: 2^-exponent itself is not representable for the largest and smallest c.
-  int exponent = 0, w_exponent = 0;
-  std::frexp(c, &exponent);
-  if (weights != nullptr && wmax > T(0)) std::frexp(wmax, &w_exponent);
-  auto down = [exponent](T x) { return std::ldexp(x, -exponent); };
-  AlignmentAccumulator<T> scaled(src.col(0).unaryExpr(down), dst.col(0).unaryExpr(down));
+  if (!(cs > T(0)) || !(cd > T(0))) return result;  // all points at the origin: the first status stands
+  // Element-wise ldexp: 2^-exponent itself is not representable for the largest and smallest values.
+  int es = 0, ed = 0, ew = 0;
+  std::frexp(cs, &es);
+  std::frexp(cd, &ed);
+  if (weights != nullptr && wmax > T(0)) std::frexp(wmax, &ew);
+  auto down_s = [es](T x) { return std::ldexp(x, -es); };
+  auto down_d = [ed](T x) { return std::ldexp(x, -ed); };
+  AlignmentAccumulator<T> scaled(src.col(0).unaryExpr(down_s), dst.col(0).unaryExpr(down_d));
   for (Eigen::Index i = 0; i < n; ++i) {
-    const T w = weights != nullptr ? std::ldexp(weights[i], -w_exponent) : T(1);
-    scaled.add(src.col(i).unaryExpr(down), dst.col(i).unaryExpr(down), w);
+    const T w = weights != nullptr ? std::ldexp(weights[i], -ew) : T(1);
+    scaled.add(src.col(i).unaryExpr(down_s), dst.col(i).unaryExpr(down_d), w);
   }
-  AlignmentResult<T> second = scaled.solve(options);
+  AlignmentOptions rotation_only;
+  rotation_only.estimate_scale = false;
+  AlignmentResult<T> second = scaled.solve(rotation_only);
   if (!second.ok()) return second;
-  second.dst_from_src.t = second.dst_from_src.t.unaryExpr([exponent](T x) { return std::ldexp(x, exponent); });
-  if (!second.dst_from_src.t.allFinite() || !second.dst_from_src.R.allFinite() ||
-      !std::isfinite(second.dst_from_src.scale)) {
+  T scale = T(1);
+  if (options.estimate_scale) {
+    AlignmentOptions with_scale;
+    with_scale.estimate_scale = true;
+    const AlignmentResult<T> s = scaled.solve(with_scale);
+    if (!s.ok()) return s;
+    scale = std::ldexp(s.dst_from_src.scale, ed - es);
+  }
+  const T inv_w = T(1) / scaled.sum_w;
+  const Vec3<T> mean_s = (scaled.s0 + scaled.sum_s * inv_w).unaryExpr([es](T x) { return std::ldexp(x, es); });
+  const Vec3<T> mean_d = (scaled.d0 + scaled.sum_d * inv_w).unaryExpr([ed](T x) { return std::ldexp(x, ed); });
+  second.dst_from_src.scale = scale;
+  second.dst_from_src.t = mean_d - scale * (second.dst_from_src.R * mean_s);
+  if (!second.dst_from_src.t.allFinite() || !std::isfinite(scale)) {
     second.status = Status::InvalidInput;
     second.reason = "umeyama: the aligning translation is beyond the largest finite value (coordinates near the "
                     "floating-point limit)";
@@ -252,6 +264,13 @@ AlignmentResult<T> AlignmentAccumulator<T>::solve(const AlignmentOptions& option
   Vec3<T> S(T(1), T(1), T(1));
   if (U.determinant() * V.determinant() < T(0)) S(2) = T(-1);
   const Mat3<T> R = U * S.asDiagonal() * V.transpose();
+  // A cross-covariance of subnormal or wildly mixed magnitudes can defeat the SVD: never return a
+  // matrix that is not a rotation.
+  if (!((R.transpose() * R - Mat3<T>::Identity()).cwiseAbs().maxCoeff() < T(1e-3)) || !(R.determinant() > T(0))) {
+    result.status = Status::Degenerate;
+    result.reason = "umeyama: the cross-covariance is too ill-conditioned to determine a rotation";
+    return result;
+  }
   T scale = T(1);
   if (options.estimate_scale) {
     if (!(var_s > T(0))) {
