@@ -142,7 +142,7 @@ struct TwoViews {
 template <class T>
 class KeyframeMatcherTyped : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(KeyframeMatcherTyped, Scalars);
+TYPED_TEST_SUITE(KeyframeMatcherTyped, Scalars, );
 
 template <class T>
 void expect_unmatched(const KeyframeMatchResult<T>& r, std::size_t n) {

@@ -115,7 +115,7 @@ TEST(OpenCvFrame, MismatchedSizesCompactNothingAndNameTheArgument) {
 template <class T>
 class OpenCvFrameTyped : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(OpenCvFrameTyped, Scalars);
+TYPED_TEST_SUITE(OpenCvFrameTyped, Scalars, );
 
 TYPED_TEST(OpenCvFrameTyped, CameraFromKInBothMatrixTypes) {
   using T = TypeParam;
