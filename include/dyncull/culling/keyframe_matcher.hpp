@@ -1,9 +1,10 @@
 /// @file keyframe_matcher.hpp
 /// Correspondences of the current frame's binary-descriptor keypoints to a reference keyframe by guided
 /// matching: each keyframe point is predicted in the current image through the predicted pose and its
-/// depth, u = pi(R X + t) (Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-D "track local map" search by
-/// projection), then matched by Hamming distance (Rublee et al. 2011, ORB) among the current keypoints
-/// within a radius, with the nearest / second-nearest ratio test (Lowe 2004) and a mutual check.
+/// depth, u = pi(R X + t) (Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-B, the guided search of the
+/// previous frame's points), then matched by Hamming distance (Rublee et al. 2011, ORB) among the
+/// current keypoints within a radius, with the nearest / second-nearest ratio test (Lowe 2004) and a
+/// mutual check.
 ///
 /// API:
 ///   KeyframeMatchWorkspace<float> ws;  KeyframeMatchResult<float> r;   // reused every frame
@@ -54,8 +55,8 @@ struct DescriptorRows {
 
 struct KeyframeMatchOptions {
   /// Search radius (px) around a keyframe point's prediction through the pose and its depth: the pose
-  /// prediction's error plus keypoint noise. ORB-SLAM searches 15 px (its th = 15 at the finest level
-  /// when the motion model is uncertain). In (0, 4096].
+  /// prediction's error plus keypoint noise. ORB-SLAM2's search from the previous frame uses 15 px at
+  /// the finest pyramid level for monocular and RGB-D input. In (0, 4096].
   double radius_px = 15.0;
   /// Search radius (px) when the prediction has no depth (rotation only, or the same pixel when no pose
   /// is given): the whole inter-frame parallax must fit in it. In (0, 4096].
@@ -345,7 +346,8 @@ void kfm_fill(std::vector<V>& v, std::size_t n, const V& value) {
 template <class T, class KfKeypoints, class KfPoints, class CurKeypoints>
 void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_points, DescriptorRows kf_desc,
                        const CurKeypoints& cur_keypoints, DescriptorRows cur_desc, const PinholeCamera<T>& camera,
-                       const typename detail::kfm_identity<Rigid3<T>>::type* cam_from_keyframe, const KeyframeMatchOptions& options,
+                       const typename detail::kfm_identity<Rigid3<T>>::type* cam_from_keyframe,
+                       const KeyframeMatchOptions& options,
                        KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* out) {
   static_assert(std::is_floating_point<T>::value, "dyncull::match_to_keyframe: T is float or double");
   static_assert(is_point_container_v<KfKeypoints> && is_point_container_v<CurKeypoints>,
@@ -375,7 +377,8 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
                                                          "principal point and a positive image size");
   if (kf_points.size() != 0 && kf_points.size() != n_kf)
     return fail(Status::InvalidInput, "kf_points has " + std::to_string(kf_points.size()) + " points for " +
-                                          std::to_string(n_kf) + " keyframe keypoints (give one per keypoint, or none)");
+                                          std::to_string(n_kf) +
+                                          " keyframe keypoints (give one per keypoint, or none)");
   if (!detail::kfm_rows_ok(kf_desc, n_kf, "kf_desc", &why)) return fail(Status::InvalidInput, why);
   if (!detail::kfm_rows_ok(cur_desc, n, "cur_desc", &why)) return fail(Status::InvalidInput, why);
   if (kf_desc.row_bytes != cur_desc.row_bytes)
@@ -383,8 +386,10 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
                                           " bytes, cur_desc rows " + std::to_string(cur_desc.row_bytes));
   if (static_cast<std::size_t>(options.max_hamming) > 8 * kf_desc.row_bytes)
     return fail(Status::InvalidInput, "KeyframeMatchOptions: max_hamming " + std::to_string(options.max_hamming) +
-                                          " exceeds the descriptor's " + std::to_string(8 * kf_desc.row_bytes) + " bits");
-  if (n > std::numeric_limits<std::uint32_t>::max() - 1 || n_kf > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+                                          " exceeds the descriptor's " + std::to_string(8 * kf_desc.row_bytes) +
+                                          " bits");
+  if (n > std::numeric_limits<std::uint32_t>::max() - 1 ||
+      n_kf > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     return fail(Status::InvalidInput, "more keypoints than the matcher indexes (2^31)");
   if (cam_from_keyframe != nullptr && !cam_from_keyframe->all_finite())
     return fail(Status::NonFinite, "cam_from_keyframe has a NaN or Inf entry");
@@ -443,7 +448,8 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
       continue;
     }
     const int c = detail::kfm_cell(ws.cur_x[i], x0, cell, cols), q = detail::kfm_cell(ws.cur_y[i], y0, cell, rows);
-    const std::uint32_t id = static_cast<std::uint32_t>(q) * static_cast<std::uint32_t>(cols) + static_cast<std::uint32_t>(c);
+    const std::uint32_t id =
+        static_cast<std::uint32_t>(q) * static_cast<std::uint32_t>(cols) + static_cast<std::uint32_t>(c);
     ws.cell_of[i] = id;
     ++ws.cell_start[id + 1];
   }
@@ -586,7 +592,8 @@ template <class T, class KfKeypoints, class KfPoints, class CurKeypoints>
 KeyframeMatchResult<T> match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_points,
                                          DescriptorRows kf_desc, const CurKeypoints& cur_keypoints,
                                          DescriptorRows cur_desc, const PinholeCamera<T>& camera,
-                                         const typename detail::kfm_identity<Rigid3<T>>::type* cam_from_keyframe, const KeyframeMatchOptions& options = {}) {
+                                         const typename detail::kfm_identity<Rigid3<T>>::type* cam_from_keyframe,
+                                         const KeyframeMatchOptions& options = {}) {
   KeyframeMatchWorkspace<T> ws;
   KeyframeMatchResult<T> r;
   match_to_keyframe(kf_keypoints, kf_points, kf_desc, cur_keypoints, cur_desc, camera, cam_from_keyframe, options, ws,

@@ -210,7 +210,8 @@ template <class P> void kp_set_position(cv::Point_<P>& q, const cv::Point2f& p) 
 /// (out then holds a copy of the input), Ok otherwise.
 template <class KP>
 Status undistort_keypoints(const std::vector<KP>& keypoints, const cv::Mat& K, const cv::Mat& distortion,
-                           std::vector<KP>* out, std::string* reason = nullptr, UndistortWorkspace* workspace = nullptr) {
+                           std::vector<KP>* out, std::string* reason = nullptr,
+                           UndistortWorkspace* workspace = nullptr) {
   static_assert(std::is_same<KP, cv::KeyPoint>::value || std::is_same<KP, cv::Point2f>::value ||
                     std::is_same<KP, cv::Point2d>::value,
                 "undistort_keypoints: cv::KeyPoint, cv::Point2f or cv::Point2d");
