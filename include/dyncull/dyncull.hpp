@@ -49,8 +49,10 @@
 
 #include "dyncull/sim/actors.hpp"
 #include "dyncull/sim/depth_noise.hpp"
+#include "dyncull/sim/families.hpp"
 #include "dyncull/sim/primitives.hpp"
 #include "dyncull/sim/scene.hpp"
+#include "dyncull/sim/scene_keys.hpp"
 #include "dyncull/sim/texture.hpp"
 #include "dyncull/sim/trajectory.hpp"
 #include "dyncull/sim/truth.hpp"
