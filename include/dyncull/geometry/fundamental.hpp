@@ -617,6 +617,11 @@ FundamentalResult<T> fundamental_8point(const C1& points1, const C2& points2) {
                "points, or a planar scene / pure rotation without noise)";
     return r;
   }
+  if (!F.allFinite()) {  // wild but finite coordinates can still defeat the solver
+    r.status = Status::Degenerate;
+    r.reason = "the 8-point solve produced a non-finite F (coordinates too large or too small)";
+    return r;
+  }
   r.F = F;
   for (std::size_t i = 0; i < est.num_data(); ++i) r.inlier_mask[est.index(i)] = 1;
   r.num_inliers = est.num_data();
@@ -694,6 +699,11 @@ FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& po
   r.iterations = rr.iterations;
   r.score = rr.score;
   if (rr.inlier_mask.size() != est.num_data()) return r;  // failed before any model
+  if (r.ok() && !rr.model.allFinite()) {  // wild but finite coordinates can still defeat the solver
+    r.status = Status::Degenerate;
+    r.reason = "RANSAC produced a non-finite F (coordinates too large or too small)";
+    return r;
+  }
   r.F = rr.model;
   std::vector<std::uint32_t> inliers;
   inliers.reserve(rr.num_inliers);

@@ -618,6 +618,18 @@ bool check_pnp_inputs(const Points3& world, const Points2& pixels, const Pinhole
   return true;
 }
 
+/// An Ok result must carry a finite pose: closed forms on wild but finite data (huge or subnormal
+/// coordinates) can still produce NaN. Degenerate then, with an empty mask.
+template <class T>
+void require_finite_pose(const char* who, std::size_t n_total, PnpResult<T>* res) {
+  if (!res->ok() || res->cam_from_world.all_finite()) return;
+  res->status = Status::Degenerate;
+  res->reason = std::string(who) + ": the solver produced a non-finite pose (coordinates too large or too small)";
+  res->inlier_mask.assign(n_total, 0);
+  res->num_inliers = 0;
+  res->rmse_px = 0;
+}
+
 /// Relabels `res` at its pose: inlier mask (caller order), count and inlier RMSE.
 template <class T>
 void label_pnp(const PnpData<T>& d, std::size_t n_total, double max_residual, PnpResult<T>* res) {
@@ -748,6 +760,7 @@ PnpResult<T> solve_pnp_dlt(const Points3& world, const Points2& pixels, const Pi
   detail::PnpData<T> d;
   detail::load_pnp_data(world, pixels, camera, &d);
   res.status = detail::pnp_dlt_data(d, &res.cam_from_world, &res.reason);
+  detail::require_finite_pose("solve_pnp_dlt", static_cast<std::size_t>(world.size()), &res);
   if (res.ok()) detail::label_pnp(d, static_cast<std::size_t>(world.size()), PnpOptions<T>{}.ransac.max_residual, &res);
   return res;
 }
@@ -811,7 +824,8 @@ PnpResult<T> solve_pnp(const Points3& world, const Points2& pixels, const Pinhol
     const auto r = detail::refine_pose_data<T>(d, nullptr, d.size(), res.cam_from_world, options.refinement);
     if (r.ok()) res.cam_from_world = r.cam_from_world;
   }
-  detail::label_pnp(d, n_total, options.ransac.max_residual, &res);
+  detail::require_finite_pose("solve_pnp", n_total, &res);
+  if (res.ok()) detail::label_pnp(d, n_total, options.ransac.max_residual, &res);
   return res;
 }
 
@@ -853,6 +867,8 @@ PnpResult<T> solve_pnp_ransac(const Points3& world, const Points2& pixels, const
     const auto r = detail::refine_pose_data(d, idx.data(), idx.size(), rr.model, options.refinement);
     if (r.ok()) res.cam_from_world = r.cam_from_world;
   }
+  detail::require_finite_pose("solve_pnp_ransac", n_total, &res);
+  if (!res.ok()) return res;
   detail::label_pnp(d, n_total, options.ransac.max_residual, &res);
   if (res.num_inliers < 4) {
     res.status = Status::Degenerate;
