@@ -318,6 +318,8 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
 
   if (!args.tum.empty()) {
+    if (args.families_set || !args.scene.empty())
+      std::printf("--family / --scene set the synthetic scene: ignored with --tum.\n");
     vo::TumSource source;
     std::string error;
     if (!source.open(args.tum, args.detections, vo::tum_camera_for(args.tum), &error)) {
