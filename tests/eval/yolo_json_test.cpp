@@ -219,7 +219,7 @@ std::string data_dir() {
 
 TEST(YoloJsonReal, ReadsEveryFrameOfTheFourRealStreams) {
   const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   const std::pair<const char*, std::size_t> streams[] = {
       {"fr3_walking_xyz", 859}, {"fr3_walking_static", 743}, {"fr3_sitting_static", 707}, {"fr3_sitting_xyz", 1261}};
   for (const auto& [name, frames] : streams) {
@@ -253,7 +253,7 @@ bool any_overlap(const std::vector<Detection<float>>& dets, const Box<float>& bo
 // lost it for longer).
 TEST(YoloJsonReal, BoxTrackerBridgesOneFramePersonDropoutsOnWalkingXyz) {
   const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   const auto seq = read_yolo_json_sequence<float>(root + "/tum/fr3_walking_xyz/yolov8n");
   ASSERT_TRUE(seq.ok()) << seq.reason;
   const int w = 640, h = 480;
