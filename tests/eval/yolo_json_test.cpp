@@ -126,6 +126,21 @@ TYPED_TEST(YoloJsonTest, ReasonGivesLineAndColumnOfTheFault) {
   EXPECT_NE(f.reason.find("a.json: byte 35 (line 3, column 17)"), std::string::npos) << f.reason;
 }
 
+TYPED_TEST(YoloJsonTest, BadEscapeOfAControlByteIsShownNotCopied) {
+  // A NUL or control byte after a backslash is named by its code: reasons stay printable text.
+  for (char c : {'\0', '\x01', '\n', '\x7f', '\xff'}) {
+    std::string text = "{\" \\";
+    text += c;
+    text += "\": 1}";
+    const YoloJsonFrame<TypeParam> f = parse_yolo_json<TypeParam>(text, "esc.json");
+    EXPECT_EQ(f.status, Status::ParseError);
+    EXPECT_NE(f.reason.find("bad escape"), std::string::npos) << f.reason;
+    for (char r : f.reason) EXPECT_TRUE(r >= 0x20 && r < 0x7f) << static_cast<int>(static_cast<unsigned char>(r));
+  }
+  const YoloJsonFrame<TypeParam> q = parse_yolo_json<TypeParam>("{\"\\q\": 1}", "esc.json");
+  EXPECT_NE(q.reason.find("bad escape \\'q'"), std::string::npos) << q.reason;
+}
+
 TEST(YoloJson, FloatRangeIsCheckedOnlyForFloat) {
   const std::string text = R"({"frame_id": 0, "timestamp": 1, "detections": [{"class_id": 0, "confidence": 1e39, "bbox": [1, 2, 3, 4]}]})";
   const auto f = parse_yolo_json<float>(text, "f.json");
