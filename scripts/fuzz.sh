@@ -6,6 +6,8 @@
 # corpus or turn it into a regression test once fixed).
 #   scripts/fuzz.sh [seconds per target]     (default 60; also DYNCULL_FUZZ_SECONDS)
 #   DYNCULL_FUZZ_TARGETS="tum yolo"          run only these targets
+#   DYNCULL_FUZZ_SEED=N                      libFuzzer's -seed (default: a random seed each run; .ci/run fixes
+#                                            it so that a failure in CI reproduces with the same command)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-${DYNCULL_FUZZ_SECONDS:-60}}
@@ -33,7 +35,9 @@ for t in $targets; do
   mkdir -p "$work"
   log="$build/$t.log"
   status=0
-  "$build/tests/fuzz/${t}_fuzz" "$work" "$root/tests/fuzz/corpus/$t" -max_total_time="$seconds" -timeout=10 \
+  seed_arg=()
+  if [[ -n "${DYNCULL_FUZZ_SEED:-}" ]]; then seed_arg=(-seed="$DYNCULL_FUZZ_SEED"); fi
+  "$build/tests/fuzz/${t}_fuzz" "$work" "$root/tests/fuzz/corpus/$t" ${seed_arg[@]+"${seed_arg[@]}"} -max_total_time="$seconds" -timeout=10 \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/crashes/$t-" >"$log" 2>&1 || status=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   line="fuzz: $t: ${execs:-?} executions in ${seconds} s"
