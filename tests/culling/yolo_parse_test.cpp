@@ -4,7 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <clocale>
+#include "support/locale.hpp"
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -19,27 +20,7 @@ class YoloParseTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(YoloParseTest, Scalars, );
 
-// Sets a locale whose decimal separator is a comma for the test's scope; GTEST_SKIP when none is installed.
-class CommaDecimalLocale {
- public:
-  CommaDecimalLocale() {
-    const char* saved = std::setlocale(LC_ALL, nullptr);
-    saved_ = saved ? saved : "C";
-    for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "de_DE", "fr_FR.UTF-8", "nl_NL.UTF-8"}) {
-      if (std::setlocale(LC_ALL, name) && std::localeconv()->decimal_point[0] == ',') {
-        active_ = true;
-        return;
-      }
-    }
-    std::setlocale(LC_ALL, saved_.c_str());
-  }
-  ~CommaDecimalLocale() { std::setlocale(LC_ALL, saved_.c_str()); }
-  bool active() const { return active_; }
-
- private:
-  std::string saved_;
-  bool active_ = false;
-};
+using dyncull::test::CommaDecimalLocale;
 
 TYPED_TEST(YoloParseTest, PointDecimalsParseAndCommaDecimalsFailUnderACommaLocale) {
   using T = TypeParam;

@@ -4,8 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include "support/locale.hpp"
+
 #include <algorithm>
-#include <clocale>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -113,28 +114,7 @@ TYPED_TEST(TrajectoryIoTest, WriteReadRoundTripIsLossless) {
   }
 }
 
-// Sets a locale whose decimal separator is a comma for the test's scope (the C library's strtod then
-// reads "0,5" and rejects "0.5"); GTEST_SKIP when none is installed.
-class CommaDecimalLocale {
- public:
-  CommaDecimalLocale() {
-    const char* saved = std::setlocale(LC_ALL, nullptr);
-    saved_ = saved ? saved : "C";
-    for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "de_DE", "fr_FR.UTF-8", "nl_NL.UTF-8"}) {
-      if (std::setlocale(LC_ALL, name) && std::localeconv()->decimal_point[0] == ',') {
-        active_ = true;
-        return;
-      }
-    }
-    std::setlocale(LC_ALL, saved_.c_str());
-  }
-  ~CommaDecimalLocale() { std::setlocale(LC_ALL, saved_.c_str()); }
-  bool active() const { return active_; }
-
- private:
-  std::string saved_;
-  bool active_ = false;
-};
+using dyncull::test::CommaDecimalLocale;
 
 TYPED_TEST(TrajectoryIoTest, ParsingIgnoresTheCLocale) {
   using T = TypeParam;
