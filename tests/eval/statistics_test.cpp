@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/adversarial.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -115,16 +117,10 @@ TEST(ImprovementRate, ReproducesPaperTable) {
   EXPECT_TRUE(std::isnan(improvement_rate(1.0, std::nan(""))));
 }
 
-// A value for property tests: mostly ordinary, sometimes NaN, +-Inf, huge or tiny.
+// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
 T wild_value(dyncull::Random& rng, double lo, double hi) {
-  const double u = rng.uniform();
-  if (u < 0.03) return std::numeric_limits<T>::quiet_NaN();
-  if (u < 0.05) return std::numeric_limits<T>::infinity();
-  if (u < 0.07) return -std::numeric_limits<T>::infinity();
-  if (u < 0.10) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
-  if (u < 0.12) return std::numeric_limits<T>::denorm_min();
-  return T(rng.uniform(lo, hi));
+  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kStatisticsMix);
 }
 
 TYPED_TEST(StatisticsTest, PropertyStatisticsAreFiniteOrTheCallFails) {

@@ -2,6 +2,7 @@
 // correspondence distance, association vs a brute-force oracle, Open3D-style statistics, bad input.
 #include "dyncull/geometry/icp.hpp"
 
+#include "support/adversarial.hpp"
 #include "support/pose_data.hpp"
 
 #include <gtest/gtest.h>
@@ -160,15 +161,10 @@ TEST(IcpOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
   check(bad, "relative_rmse");
 }
 
+// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
 T wild_value(Random& rng, double lo, double hi) {
-  const double u = rng.uniform();
-  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
-  if (u < 0.03) return std::numeric_limits<T>::infinity();
-  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
-  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
-  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
-  return T(rng.uniform(lo, hi));
+  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
 }
 
 // For any clouds, start and options: a non-Ok status with a reason, or a finite transform and statistics.

@@ -2,6 +2,7 @@
 // PnP-RANSAC with 0.5 px noise and 30 % outliers, degenerate inputs, and OpenCV cross-checks.
 #include "dyncull/geometry/pnp.hpp"
 
+#include "support/adversarial.hpp"
 #include "support/pose_data.hpp"
 
 #include <gtest/gtest.h>
@@ -323,15 +324,10 @@ TEST(PnpOptionsValidate, NamesTheFieldIncludingNestedOptions) {
   check(bad, "ransac.max_residual");
 }
 
+// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
 T wild_value(Random& rng, double lo, double hi) {
-  const double u = rng.uniform();
-  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
-  if (u < 0.03) return std::numeric_limits<T>::infinity();
-  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
-  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
-  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
-  return T(rng.uniform(lo, hi));
+  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
 }
 
 // For any correspondences, camera and options: a non-Ok status with a reason, or a finite pose with a

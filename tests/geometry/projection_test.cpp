@@ -2,6 +2,7 @@
 // would be caught), depth image to cloud with mask/stride/missing depth, voxel grid vs an oracle.
 #include "dyncull/geometry/projection.hpp"
 
+#include "support/adversarial.hpp"
 #include "support/pose_data.hpp"
 
 #include <gtest/gtest.h>
@@ -179,17 +180,10 @@ TYPED_TEST(ProjectionTest, DepthToPointsNeverReturnsNonFinitePoints) {
   EXPECT_EQ(cloud.points.size() + cloud.num_missing, 48u);
 }
 
-// A value for property tests: mostly ordinary, sometimes NaN, +-Inf, huge, tiny or zero.
+// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
 T wild(Random& rng, double lo, double hi) {
-  const double u = rng.uniform();
-  if (u < 0.03) return std::numeric_limits<T>::quiet_NaN();
-  if (u < 0.05) return std::numeric_limits<T>::infinity();
-  if (u < 0.07) return -std::numeric_limits<T>::infinity();
-  if (u < 0.10) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
-  if (u < 0.12) return std::numeric_limits<T>::denorm_min();
-  if (u < 0.14) return T(0);
-  return T(rng.uniform(lo, hi));
+  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kProjectionMix);
 }
 
 TYPED_TEST(ProjectionTest, PropertyOutputsAreFiniteOrFlagged) {

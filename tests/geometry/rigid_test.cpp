@@ -2,6 +2,7 @@
 // weights, the reflection case, and failure statuses on degenerate or non-finite input.
 #include "dyncull/geometry/rigid.hpp"
 
+#include "support/adversarial.hpp"
 #include "support/pose_data.hpp"
 
 #include <Eigen/Geometry>
@@ -198,15 +199,10 @@ TEST(UmeyamaVsEigen, MatchesEigenUmeyamaTo1e12) {
   }
 }
 
+// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
 T wild_value(Random& rng, double lo, double hi) {
-  const double u = rng.uniform();
-  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
-  if (u < 0.03) return std::numeric_limits<T>::infinity();
-  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
-  if (u < 0.07) return std::numeric_limits<T>::denorm_min() * T(rng.uniform(-100, 100));
-  if (u < 0.09) return T(rng.uniform(lo, hi) * 1e30);
-  return T(rng.uniform(lo, hi));
+  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kAlignmentMix);
 }
 
 // For any input: a non-Ok status with a reason, or a finite proper rotation, scale and translation.

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/adversarial.hpp"
+
 #include <string>
 
 #ifdef DYNCULL_HAS_CERES
@@ -384,15 +386,10 @@ TEST(RotationCentreOptionsValidate, NamesTheFieldIncludingNestedBfgs) {
   check(bad, "bfgs.max_iterations");
 }
 
+// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
 T wild_value(dyncull::Random& rng, double lo, double hi) {
-  const double u = rng.uniform();
-  if (u < 0.02) return std::numeric_limits<T>::quiet_NaN();
-  if (u < 0.03) return std::numeric_limits<T>::infinity();
-  if (u < 0.05) return std::numeric_limits<T>::max() * T(rng.uniform(-1, 1));
-  if (u < 0.06) return std::numeric_limits<T>::denorm_min();
-  if (u < 0.08) return T(rng.uniform(lo, hi) * 1e20);
-  return T(rng.uniform(lo, hi));
+  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
 }
 
 // For any flow and options (both solvers, every loss): a non-Ok status with a reason, or a finite
