@@ -40,6 +40,7 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
         s.untracked_boxes.push_back(s.boxes[b]);
     }
     s.boxes.resize(kept);
+    tracker->set_options(options.tracker);
     BoxTrackerResult<T> t = tracker->update(s.boxes, W, H);
     r->tracker.status = t.status;
     r->tracker.reason = t.reason;
