@@ -92,6 +92,7 @@ void usage(const char* argv0) {
       "                      and written (family_summary.md, family_summary.csv)\n"
       "  --scene K=V[,K=V]   scene keys set on top of each family (keys below), e.g.\n"
       "                      --scene actors.walking_speed_mps=0.9,miss_rate=0.2,trajectory.xyz_amplitude_m=0.2:0.1:0.2\n"
+      "                      (motion, seed and num_frames are set per run by --sequences, --seeds, --frames)\n"
       "  --suite             every family x static,xyz,rpy,halfsphere x seeds 1,2,3 at %d frames (unless\n"
       "                      --family / --sequences / --seeds / --frames say otherwise); prints the summary only\n"
       "  --jobs N            sequences run in parallel on N threads (default 1)\n"

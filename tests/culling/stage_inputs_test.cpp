@@ -365,6 +365,18 @@ TEST(DepthMaskInputs, NegativeUnitsPerMetreIsInvalidInput) {
   EXPECT_EQ(info.status, Status::InvalidInput);
 }
 
+TEST(DepthMaskInputs, RangeWithoutARawValueIsInvalidInput) {
+  // uint16 at 5000 units per metre reaches 13.1 m: a valid range from 20 m (or from 1e30 m) holds no raw value.
+  const std::vector<std::uint16_t> raw(64, 60000);
+  for (float min_m : {20.f, 1e30f}) {
+    const auto view = tum_depth_view(raw.data(), 8, 8, min_m, 1e30f);
+    const DepthMaskResult r = depth_mask(view, std::vector<Box<float>>{Box<float>{0.f, 0.f, 7.f, 7.f}},
+                                         std::vector<Vec2<float>>{Vec2<float>(3.f, 3.f)}, DepthMaskOptions{});
+    EXPECT_EQ(r.status, Status::InvalidInput) << min_m;
+    EXPECT_NE(r.reason.find("min_m"), std::string::npos) << r.reason;
+  }
+}
+
 template <class Raw>
 void depth_mask_property(std::uint64_t seed) {
   Random rng(seed);

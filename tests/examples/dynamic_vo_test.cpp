@@ -517,6 +517,8 @@ TEST(DynamicVo, AblationStrategiesEachUndoOneThingOfTheRecommendedPreset) {
     EXPECT_FALSE(s.recommended) << s.name;
     EXPECT_TRUE(s.culls) << s.name;
     EXPECT_FALSE(s.needs_truth()) << s.name;
+    std::string reason;
+    EXPECT_EQ(s.pipeline.validate(&reason), Status::Ok) << s.name << ": " << reason << " (the pipeline would refuse it)";
     const std::string fields = ablated_fields(s);
     EXPECT_NE(fields, ablated_fields(*preset)) << s.name << " changes nothing";
     EXPECT_TRUE(changed.insert(fields).second) << s.name << " repeats another switch";

@@ -221,7 +221,8 @@ RawRange<Raw> valid_raw_range(const DepthView<Raw>& v) {
   const double upm = static_cast<double>(v.units_per_metre);
   if (std::is_integral<Raw>::value) {
     const double top = static_cast<double>(std::numeric_limits<Raw>::max());
-    double lo = std::max(1.0, std::ceil(static_cast<double>(v.min_m) * upm));
+    // lo is capped at top + 1 (then no raw value is valid) before any conversion to Raw.
+    double lo = std::min(top + 1, std::max(1.0, std::ceil(static_cast<double>(v.min_m) * upm)));
     double hi = std::min(top, std::floor(static_cast<double>(v.max_m) * upm));
     // Float rounding in to_metres: nudge the integer bounds until they agree with it.
     while (lo > 1 && v.to_metres(static_cast<Raw>(lo - 1)) > 0.f) lo -= 1;
@@ -895,6 +896,14 @@ bool depth_mask_inputs_valid(const DepthView<Raw>& depth, const DepthMaskOptions
   if (options.validate(&why) != Status::Ok) {
     *status = Status::InvalidInput;
     *reason = "invalid options: " + why;
+    return false;
+  }
+  // The integer raw paths need a non-empty valid range (a uint16 view with min_m above 13.1 m at 5000
+  // units per metre has none).
+  const RawRange<Raw> range = valid_raw_range(depth);
+  if (!(range.lo <= range.hi)) {
+    *status = Status::InvalidInput;
+    *reason = "depth min_m and max_m leave no raw depth value valid";
     return false;
   }
   return true;

@@ -173,8 +173,8 @@ struct MatchResult {
   std::size_t rejected_distance = 0;     ///< nearest neighbour farther than max_distance
   std::size_t rejected_ratio = 0;        ///< failed the ratio test
   std::size_t rejected_cross_check = 0;  ///< not mutual nearest neighbours
-  /// Queries with no finite distance to any train row (NaN / Inf in the query, or in every train row):
-  /// a non-finite descriptor never matches.
+  /// Queries with no finite distance to any train row (NaN / Inf in the query or in every train row,
+  /// or values so large that the squared distances overflow): a non-finite distance never matches.
   std::size_t rejected_non_finite = 0;
   bool ok() const { return status == Status::Ok; }
 };

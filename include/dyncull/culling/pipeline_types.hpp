@@ -268,7 +268,7 @@ struct FlagView {
   bool given = false;
 
   FlagView() = default;
-  FlagView(std::nullptr_t) {}  // NOLINT(google-explicit-constructor): "no flags", as a null pointer was
+  FlagView(std::nullptr_t) {}  // NOLINT(google-explicit-constructor): nullptr means "no flags"
   FlagView(const std::uint8_t* flags, std::size_t count) : data(flags), size(count), given(true) {}
   FlagView(const std::vector<std::uint8_t>& flags)  // NOLINT(google-explicit-constructor)
       : data(flags.data()), size(flags.size()), given(true) {}

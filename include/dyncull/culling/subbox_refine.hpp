@@ -251,7 +251,9 @@ void subbox_label_features(const Points& points, const FeatureLabel* geometric, 
 /// extra_dynamic_cells: optional per box grid*grid flags (box-major, as SubBoxResult::cells) of cells that
 /// are dynamic besides this frame's vote (remembered from earlier frames, subbox_memory.hpp); they take no
 /// part in merging or in the whole-box count and act only on the features with extra_eligible[i] != 0
-/// (nullptr: on all), inside the object mask as the voted cells.
+/// (nullptr: on all), inside the object mask as the voted cells. The raw pointers carry no length: the
+/// per-feature ones must hold points.size() entries, extra_dynamic_cells boxes.size() * grid * grid.
+/// Options failing SubBoxOptions::validate give InvalidInput (every feature Static).
 template <class T, class Points, class Boxes>
 void refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
@@ -357,6 +359,7 @@ SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geomet
 /// earlier frame): per box grid*grid states, box-major, 0 = static with evidence, 1 = dynamic, 2 =
 /// unknown; unknown cells act as dynamic (inside the object mask, as voted ones), so a box without a
 /// remembered vote falls back to the box rule. The counts in `out` stay zero: nothing was voted.
+/// `states` must hold boxes.size() * grid * grid entries (a raw pointer: its length cannot be checked).
 template <class T, class Points, class Boxes>
 void apply_subbox_states(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
                          const std::uint8_t* states, const SubBoxOptions<T>& options, SubBoxResult<T>* out,

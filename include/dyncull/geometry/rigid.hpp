@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 namespace dyncull {
 
@@ -88,17 +89,85 @@ struct AlignmentAccumulator {
   AlignmentResult<T> solve(const AlignmentOptions& options = {}) const;
 };
 
+namespace detail {
+/// umeyama()'s second pass, out of line (only reached when the first pass's moments overflowed).
+template <class DA, class DB>
+__attribute__((noinline, cold)) AlignmentResult<typename DA::Scalar> umeyama_rescaled(
+    const Eigen::MatrixBase<DA>& src, const Eigen::MatrixBase<DB>& dst, const AlignmentOptions& options,
+    const typename DA::Scalar* weights, AlignmentResult<typename DA::Scalar> result) {
+  using T = typename DA::Scalar;
+  const Eigen::Index n = src.cols();
+  // Overflowing moments of finite data: align src / 2^a and dst / 2^b, each scaled
+  // by its own largest magnitude (powers of two, so the scaling is exact). R does not depend on
+  // positive factors on src or dst; the scale becomes s' 2^b / 2^a, and t is rebuilt from the means
+  // in the original units. Weights are normalised the same way.
+  T cs = T(0), cd = T(0), wmax = T(0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    cs = std::max(cs, src.col(i).cwiseAbs().maxCoeff());
+    cd = std::max(cd, dst.col(i).cwiseAbs().maxCoeff());
+    if (weights != nullptr) wmax = std::max(wmax, weights[i]);
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {  // NaN fails max: test the data itself
+    if (!src.col(i).allFinite() || !dst.col(i).allFinite()) {
+      result.status = Status::NonFinite;
+      result.reason = "umeyama: non-finite coordinates in src or dst";
+      return result;
+    }
+  }
+  if (!(cs > T(0)) || !(cd > T(0))) {
+    result.status = Status::Degenerate;
+    result.reason = "umeyama: every source or every destination point is at the origin";
+    return result;
+  }
+  // Element-wise ldexp: 2^-exponent itself is not representable for the largest and smallest values.
+  int es = 0, ed = 0, ew = 0;
+  std::frexp(cs, &es);
+  std::frexp(cd, &ed);
+  if (weights != nullptr && wmax > T(0)) std::frexp(wmax, &ew);
+  auto down_s = [es](T x) { return std::ldexp(x, -es); };
+  auto down_d = [ed](T x) { return std::ldexp(x, -ed); };
+  AlignmentAccumulator<T> scaled(src.col(0).unaryExpr(down_s), dst.col(0).unaryExpr(down_d));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const T w = weights != nullptr ? std::ldexp(weights[i], -ew) : T(1);
+    scaled.add(src.col(i).unaryExpr(down_s), dst.col(i).unaryExpr(down_d), w);
+  }
+  AlignmentOptions rotation_only;
+  rotation_only.estimate_scale = false;
+  AlignmentResult<T> second = scaled.solve(rotation_only);
+  if (!second.ok()) return second;
+  T scale = T(1);
+  if (options.estimate_scale) {
+    AlignmentOptions with_scale;
+    with_scale.estimate_scale = true;
+    const AlignmentResult<T> s = scaled.solve(with_scale);
+    if (!s.ok()) return s;
+    scale = std::ldexp(s.dst_from_src.scale, ed - es);
+  }
+  const T inv_w = T(1) / scaled.sum_w;
+  const Vec3<T> mean_s = (scaled.s0 + scaled.sum_s * inv_w).unaryExpr([es](T x) { return std::ldexp(x, es); });
+  const Vec3<T> mean_d = (scaled.d0 + scaled.sum_d * inv_w).unaryExpr([ed](T x) { return std::ldexp(x, ed); });
+  second.dst_from_src.scale = scale;
+  second.dst_from_src.t = mean_d - scale * (second.dst_from_src.R * mean_s);
+  if (!second.dst_from_src.t.allFinite() || !std::isfinite(scale)) {
+    second.status = Status::InvalidInput;
+    second.reason = "umeyama: the aligning translation is beyond the largest finite value (coordinates near the "
+                    "floating-point limit)";
+  }
+  return second;
+}
+}  // namespace detail
+
 /// Least-squares dst_from_src minimising sum_i w_i |dst_i - (s R src_i + t)|^2.
 /// src and dst are 3xN (any Eigen expression, column i corresponds); weights (optional) points to N
 /// non-negative finite weights. Fails with TooFewPoints below 3 points, Degenerate when the
 /// cross-covariance has rank < 2 (collinear or coincident points), NonFinite on NaN/Inf input.
-/// Finite coordinates near the floating-point limits (squares that overflow or underflow) are aligned
-/// after scaling by the largest magnitude; InvalidInput when the fitted translation itself is not
-/// representable. Every output of an Ok result is finite.
+/// Finite coordinates whose squares overflow are aligned after scaling by the largest magnitude
+/// (coordinates so small that they underflow give Degenerate); InvalidInput when the fitted
+/// transform itself is not representable. Every output of an Ok result is finite.
 /// Call it qualified, `dyncull::umeyama(src, dst)`: with two Eigen arguments an unqualified call also
 /// finds Eigen::umeyama by argument-dependent lookup and is ambiguous.
 /// Cost: one pass over the data (3x3 cross-covariance, centred on the first point so far-from-origin
-/// trajectories do not cancel) plus one 3x3 SVD; a second, scaled pass only when the first fails.
+/// trajectories do not cancel) plus one 3x3 SVD; a second, scaled pass only when the moments overflow.
 template <class DA, class DB>
 AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, const Eigen::MatrixBase<DB>& dst,
                                              const AlignmentOptions& options = {},
@@ -164,65 +233,13 @@ AlignmentResult<typename DA::Scalar> umeyama(const Eigen::MatrixBase<DA>& src, c
       acc.add(src.col(i), dst.col(i), w);
     }
   }
-  result = acc.solve(options);
-  if (result.ok() && result.dst_from_src.R.allFinite() && result.dst_from_src.t.allFinite() &&
-      std::isfinite(result.dst_from_src.scale)) {
-    return result;
+  // Moments that overflowed (finite data near the floating-point limit, or NaN / Inf: the fallback
+  // tells them apart) go to the rescaled pass.
+  if (!acc.sum_ds.allFinite() || !acc.sum_s.allFinite() || !acc.sum_d.allFinite() || !std::isfinite(acc.sum_ss) ||
+      !std::isfinite(acc.sum_w)) {
+    return detail::umeyama_rescaled(src, dst, options, weights, std::move(result));
   }
-  if (!result.ok() && result.status != Status::NonFinite && result.status != Status::Degenerate) return result;
-  // Overflowing (or underflowing) moments of finite data: align src / 2^a and dst / 2^b, each scaled
-  // by its own largest magnitude (powers of two, so the scaling is exact). R does not depend on
-  // positive factors on src or dst; the scale becomes s' 2^b / 2^a, and t is rebuilt from the means
-  // in the original units. Weights are normalised the same way.
-  T cs = T(0), cd = T(0), wmax = T(0);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    cs = std::max(cs, src.col(i).cwiseAbs().maxCoeff());
-    cd = std::max(cd, dst.col(i).cwiseAbs().maxCoeff());
-    if (weights != nullptr) wmax = std::max(wmax, weights[i]);
-  }
-  for (Eigen::Index i = 0; i < n; ++i) {  // NaN fails max: test the data itself
-    if (!src.col(i).allFinite() || !dst.col(i).allFinite()) {
-      result.status = Status::NonFinite;
-      result.reason = "umeyama: non-finite coordinates in src or dst";
-      return result;
-    }
-  }
-  if (!(cs > T(0)) || !(cd > T(0))) return result;  // all points at the origin: the first status stands
-  // Element-wise ldexp: 2^-exponent itself is not representable for the largest and smallest values.
-  int es = 0, ed = 0, ew = 0;
-  std::frexp(cs, &es);
-  std::frexp(cd, &ed);
-  if (weights != nullptr && wmax > T(0)) std::frexp(wmax, &ew);
-  auto down_s = [es](T x) { return std::ldexp(x, -es); };
-  auto down_d = [ed](T x) { return std::ldexp(x, -ed); };
-  AlignmentAccumulator<T> scaled(src.col(0).unaryExpr(down_s), dst.col(0).unaryExpr(down_d));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const T w = weights != nullptr ? std::ldexp(weights[i], -ew) : T(1);
-    scaled.add(src.col(i).unaryExpr(down_s), dst.col(i).unaryExpr(down_d), w);
-  }
-  AlignmentOptions rotation_only;
-  rotation_only.estimate_scale = false;
-  AlignmentResult<T> second = scaled.solve(rotation_only);
-  if (!second.ok()) return second;
-  T scale = T(1);
-  if (options.estimate_scale) {
-    AlignmentOptions with_scale;
-    with_scale.estimate_scale = true;
-    const AlignmentResult<T> s = scaled.solve(with_scale);
-    if (!s.ok()) return s;
-    scale = std::ldexp(s.dst_from_src.scale, ed - es);
-  }
-  const T inv_w = T(1) / scaled.sum_w;
-  const Vec3<T> mean_s = (scaled.s0 + scaled.sum_s * inv_w).unaryExpr([es](T x) { return std::ldexp(x, es); });
-  const Vec3<T> mean_d = (scaled.d0 + scaled.sum_d * inv_w).unaryExpr([ed](T x) { return std::ldexp(x, ed); });
-  second.dst_from_src.scale = scale;
-  second.dst_from_src.t = mean_d - scale * (second.dst_from_src.R * mean_s);
-  if (!second.dst_from_src.t.allFinite() || !std::isfinite(scale)) {
-    second.status = Status::InvalidInput;
-    second.reason = "umeyama: the aligning translation is beyond the largest finite value (coordinates near the "
-                    "floating-point limit)";
-  }
-  return second;
+  return acc.solve(options);
 }
 
 template <class T>
@@ -284,6 +301,11 @@ AlignmentResult<T> AlignmentAccumulator<T>::solve(const AlignmentOptions& option
   result.dst_from_src.R = R;
   // t maps the shifted frames back: d = s R (x - s0) + d0 + (mu_d - s R mu_s).
   result.dst_from_src.t = d0 + mean_d - scale * (R * (s0 + mean_s));
+  if (!result.dst_from_src.t.allFinite() || !std::isfinite(scale)) {
+    result.status = Status::InvalidInput;
+    result.reason = "umeyama: the aligning transform is beyond the largest finite value (coordinates near the "
+                    "floating-point limit)";
+  }
   return result;
 }
 
