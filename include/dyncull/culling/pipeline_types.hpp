@@ -304,15 +304,16 @@ struct CullingFrame {
 
 namespace detail {
 inline bool is_soft_cull(CullReason r) {
-  return r == CullReason::Epipolar || r == CullReason::MultiView || r == CullReason::SubBox ||
-         r == CullReason::MediumLevelBox || r == CullReason::TrackedBox;
+  return r == CullReason::Epipolar || r == CullReason::Reprojection || r == CullReason::MultiView ||
+         r == CullReason::SubBox || r == CullReason::CoherentMotion || r == CullReason::MediumLevelBox ||
+         r == CullReason::TrackedBox;
 }
 
 /// Culls for the region a feature lies in (its box, tracked box or sub-box), not for its own evidence: the
 /// ones a track's static history may overrule (PipelineOptions::static_history).
 inline bool is_regional_cull(CullReason r) {
-  return r == CullReason::SubBox || r == CullReason::HighLevelBox || r == CullReason::TrackedBox ||
-         r == CullReason::MediumLevelBox;
+  return r == CullReason::SubBox || r == CullReason::CoherentMotion || r == CullReason::HighLevelBox ||
+         r == CullReason::TrackedBox || r == CullReason::MediumLevelBox;
 }
 
 template <class T, class Keypoints>

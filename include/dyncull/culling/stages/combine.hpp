@@ -45,19 +45,20 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
         if (geo_flagged) why = CullReason::SubBox;
       } else if (vote == CullReason::SubBox && (!sheltered || geo_dyn)) {
         lab = FeatureLabel::Dynamic;
-        why = CullReason::SubBox;
+        why = geo_dyn && w.evidence_source(i) == CullReason::CoherentMotion ? CullReason::CoherentMotion
+                                                                             : CullReason::SubBox;
         geo_flagged = true;
       } else if (w.semantic.in_dyn_box[i] && sem_reasons[i] != CullReason::Probability) {
         lab = FeatureLabel::Static;  // refined: in a static sub-box of its box
         why = CullReason::None;
       } else if (geo_dyn && options.cull_geometric_outside_boxes && lab == FeatureLabel::Static && !sheltered) {
         lab = FeatureLabel::Dynamic;
-        why = CullReason::Epipolar;
+        why = w.evidence_source(i);
       }
     } else if (geo_dyn && lab != FeatureLabel::Dynamic &&
                (lab == FeatureLabel::Candidate || (options.cull_geometric_outside_boxes && !sheltered))) {
       lab = FeatureLabel::Dynamic;
-      why = CullReason::Epipolar;
+      why = w.evidence_source(i);
     }
     if (mv_ok && w.multiview.dynamic[i]) {
       geo_flagged = true;

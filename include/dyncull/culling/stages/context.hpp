@@ -56,6 +56,7 @@ struct GeometricEvidence {
   MovingConsistencyResult<T> moving;
   ReprojectionCheckResult<T> reprojection;
   std::vector<FeatureLabel> labels;
+  std::vector<CullReason> source;  ///< per feature, the check whose label stands: Epipolar or Reprojection
   bool ok = false;                 ///< labels valid this frame
   bool fit_outside_boxes = true;   ///< every check in the labels fitted its model outside the boxes
 };
@@ -104,6 +105,11 @@ struct PipelineWork {
   }
   /// The geometric evidence the vote and the combination read (with the coherent cells' flags).
   const FeatureLabel* evidence() const { return votes.coherent_ran ? votes.evidence.data() : geometric.labels.data(); }
+  /// The stage whose flag made feature i geometric-dynamic (evidence()[i] == Dynamic).
+  CullReason evidence_source(std::size_t i) const {
+    return votes.coherent_ran && geometric.labels[i] != FeatureLabel::Dynamic ? CullReason::CoherentMotion
+                                                                             : geometric.source[i];
+  }
 };
 
 template <class T>
@@ -114,7 +120,7 @@ PipelineWork<T>& work_of(PipelineState<T>* state);
 /// pipeline allocates nothing after warm-up); read a frame's outcome from `result`.
 template <class T>
 struct PipelineState {
-  BoxTracker<T> tracker;
+  BoxTracker<T> tracker;             ///< given PipelineOptions::tracker each frame
   TrackStateStore track_states;      ///< K of 000 eq. 3, keyed by the caller's track ids
   SubBoxMemory subbox_memory;        ///< PipelineOptions::subbox_memory_frames
   StaticHistory static_history;      ///< PipelineOptions::static_history
@@ -125,7 +131,7 @@ struct PipelineState {
 
   explicit PipelineState(std::size_t keyframe_capacity = 20) : keyframes(keyframe_capacity) {}
   void reset() {
-    tracker = BoxTracker<T>(tracker_options_);
+    tracker = BoxTracker<T>();
     track_states.clear();
     subbox_memory.clear();
     static_history.clear();
@@ -138,7 +144,6 @@ struct PipelineState {
 
  private:
   friend detail::PipelineWork<T>& detail::work_of<T>(PipelineState<T>* state);
-  BoxTrackerOptions<T> tracker_options_{};
   detail::PipelineWork<T> work_;
 };
 

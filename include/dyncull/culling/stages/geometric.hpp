@@ -49,7 +49,10 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
       r->moving_consistency.num_dynamic = g.moving.num_dynamic;
     }
   }
-  if (r->moving_consistency.ran()) g.labels.assign(g.moving.labels.begin(), g.moving.labels.end());
+  if (r->moving_consistency.ran()) {
+    g.labels.assign(g.moving.labels.begin(), g.moving.labels.end());
+    g.source.assign(n, CullReason::Epipolar);
+  }
   if (options.use_reprojection) {
     if (!frame.points_3d) {
       r->reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
@@ -63,14 +66,16 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
     if (r->reprojection.ran()) {
       if (!r->moving_consistency.ran()) {
         g.labels.assign(g.reprojection.labels.begin(), g.reprojection.labels.end());
+        g.source.assign(n, CullReason::Reprojection);
       } else {
         for (std::size_t i = 0; i < n; ++i) {
           const FeatureLabel rl = g.reprojection.labels[i];
           FeatureLabel& gl = g.labels[i];
-          if (options.reprojection_evidence == PipelineOptions<T>::Evidence::Replace) {
-            if (rl != FeatureLabel::Candidate) gl = rl;
-          } else if (rl == FeatureLabel::Dynamic || gl == FeatureLabel::Candidate) {
-            gl = rl == FeatureLabel::Candidate ? gl : rl;
+          const bool replace = options.reprojection_evidence == PipelineOptions<T>::Evidence::Replace ||
+                               rl == FeatureLabel::Dynamic || gl == FeatureLabel::Candidate;
+          if (replace && rl != FeatureLabel::Candidate) {
+            gl = rl;
+            g.source[i] = CullReason::Reprojection;
           }
         }
       }
