@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace {
@@ -71,6 +72,35 @@ TYPED_TEST(CeresPoseTest, MaskAndBadInput) {
   EXPECT_EQ(dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, nan_pose).status, Status::NonFinite);
   std::vector<Vec2<T>> fewer(s.pixels.begin(), s.pixels.begin() + 10);
   EXPECT_EQ(dyncull::refine_pose_ceres(s.world, fewer, s.camera, s.cam_from_world).status, Status::InvalidInput);
+}
+
+TYPED_TEST(CeresPoseTest, InvalidOptionsAreRefusedWithTheFieldNamed) {
+  using T = TypeParam;
+  const auto s = make_pnp_scene<T>(303, 50, 0.5, 0.0);
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  const auto refused = [&](const PoseRefinementOptions<T>& o, const char* field) {
+    const auto r = dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, s.cam_from_world, o);
+    EXPECT_EQ(r.status, Status::InvalidInput) << field;
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+    // The same options are refused the same way by the core refinement.
+    EXPECT_EQ(dyncull::refine_pose(s.world, s.pixels, s.camera, s.cam_from_world, o).status, Status::InvalidInput);
+  };
+  PoseRefinementOptions<T> o;
+  o.max_iterations = 1000000;  // unbounded time
+  refused(o, "max_iterations");
+  o = {};
+  o.step_tolerance = nan;
+  refused(o, "step_tolerance");
+  o = {};
+  o.cost_tolerance = T(-1);
+  refused(o, "cost_tolerance");
+  o = {};
+  o.huber = true;
+  o.huber_threshold_px = std::numeric_limits<T>::infinity();
+  refused(o, "huber_threshold_px");
+  o = {};
+  o.initial_damping = nan;
+  refused(o, "initial_damping");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <initializer_list>
 #include <vector>
 
@@ -204,6 +205,41 @@ TYPED_TEST(MovingConsistencyTest, AnyPointContainerAndDeterministic) {
   check_moving_consistency(prev, cur, o, &reuse, s.track_valid.data());
   check_moving_consistency(prev, cur, o, &reuse, s.track_valid.data());
   EXPECT_EQ(reuse.labels, a.labels);
+}
+
+
+// Whatever F the fit ends with, a result is either not Ok with every track a Candidate and nothing
+// counted, or Ok with every evaluated track labelled and counted: tracks scaled far beyond any image
+// (where F's entries underflow) and far below one.
+TYPED_TEST(MovingConsistencyTest, NonOkResultLabelsNothingAndOkResultCountsEveryLabel) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>(SceneConfig{});
+  for (double scale : {1e-30, 1e-3, 1.0, 1e12, 1e24, 1e30, 1e200}) {
+    std::vector<Vec2<T>> prev(s.size()), cur(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      prev[i] = (s.prev_keypoints[i].template cast<double>() * scale).template cast<T>();
+      cur[i] = (s.keypoints[i].template cast<double>() * scale).template cast<T>();
+    }
+    const auto r = check_moving_consistency(prev, cur, MovingConsistencyOptions<T>{}, s.track_valid.data());
+    std::size_t dynamic = 0, static_ = 0;
+    for (std::size_t i = 0; i < r.labels.size(); ++i) {
+      dynamic += r.labels[i] == FeatureLabel::Dynamic;
+      static_ += r.labels[i] == FeatureLabel::Static;
+      if (r.labels[i] != FeatureLabel::Candidate) {
+        EXPECT_FALSE(std::isnan(r.distance_px[i])) << scale;
+      }
+    }
+    if (!r.ok()) {
+      EXPECT_FALSE(r.reason.empty()) << scale;
+      EXPECT_EQ(dynamic + static_, 0u) << scale << ": " << r.reason;
+      EXPECT_EQ(r.num_dynamic + r.num_static, 0u) << scale;
+    } else {
+      EXPECT_TRUE(r.F.allFinite()) << scale;
+      EXPECT_GT(r.F.cwiseAbs().maxCoeff(), T(0)) << scale;
+      EXPECT_EQ(r.num_dynamic, dynamic) << scale;
+      EXPECT_EQ(r.num_static, static_) << scale;
+    }
+  }
 }
 
 }  // namespace

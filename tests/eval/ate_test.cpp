@@ -158,6 +158,12 @@ TEST(Ate, OptionsValidateNamesTheField) {
   b.association.offset_s = -HUGE_VAL;
   EXPECT_EQ(b.validate(&why), Status::InvalidInput);
   EXPECT_NE(why.find("association.offset_s"), std::string::npos) << why;
+  // The window's upper bound is the association's own.
+  AteOptions wide;
+  wide.association.max_difference_s = 1e9;
+  EXPECT_EQ(wide.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("AteOptions: association.max_difference_s"), std::string::npos) << why;
+  EXPECT_EQ(evaluate_ate(gt, gt, wide).status, Status::InvalidInput);
 }
 
 TYPED_TEST(AteTest, LargeFiniteCoordinatesGiveAFiniteError) {

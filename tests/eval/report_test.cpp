@@ -88,7 +88,7 @@ TEST(EvalRun, MalformedFileGivesFileAndLine) {
 
 TEST(EvalRun, RealDataPrintsTheTumScriptsLines) {
   const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   const std::string dir = std::string(root) + "/tum/fr3_sitting_static";
   if (!std::ifstream(dir + "/groundtruth.txt")) GTEST_SKIP() << dir << "/groundtruth.txt is missing";
   const std::string gt = dir + "/groundtruth.txt";

@@ -419,4 +419,35 @@ TEST(Associate, NoOverlapEmptyAndBadOptionsAreStatuses) {
   EXPECT_EQ(associate(std::vector<double>{1.0}, std::vector<double>{1.0}, bad).status, Status::InvalidInput);
 }
 
+
+TEST(Associate, OptionsValidateNamesTheField) {
+  std::string why;
+  EXPECT_EQ(AssociationOptions{}.validate(&why), Status::Ok);
+  EXPECT_TRUE(why.empty());
+  const std::vector<double> a{1.0, 2.0, 3.0}, b{1.001, 2.001, 3.001};
+  for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL, 1e9}) {
+    AssociationOptions o;
+    o.max_difference_s = bad;
+    EXPECT_EQ(o.validate(&why), Status::InvalidInput) << bad;
+    EXPECT_NE(why.find("max_difference_s"), std::string::npos) << why;
+    // A window of seconds or more pairs unrelated poses and makes every pair a candidate.
+    const AssociationResult r = associate(a, b, o);
+    EXPECT_EQ(r.status, Status::InvalidInput) << bad;
+    EXPECT_NE(r.reason.find("max_difference_s"), std::string::npos) << r.reason;
+    EXPECT_EQ(r.size(), 0u);
+  }
+  for (double bad : {std::nan(""), -HUGE_VAL}) {
+    AssociationOptions o;
+    o.offset_s = bad;
+    EXPECT_EQ(o.validate(&why), Status::InvalidInput);
+    const AssociationResult r = associate(a, b, o);
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_NE(r.reason.find("offset_s"), std::string::npos) << r.reason;
+    EXPECT_EQ(r.reason.find("max_difference_s"), std::string::npos) << r.reason;
+  }
+  AssociationOptions widest;
+  widest.max_difference_s = AssociationOptions::kMaxDifferenceS;
+  EXPECT_EQ(associate(a, b, widest).size(), 3u);
+}
+
 }  // namespace

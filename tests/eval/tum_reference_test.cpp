@@ -25,7 +25,7 @@ struct TumData {
 bool load_data(TumData* out, std::string* why) {
   const char* root = std::getenv("DYNCULL_DATA_DIR");
   if (root == nullptr || *root == '\0') {
-    *why = "DYNCULL_DATA_DIR is not set; point it at /work/shared/data to run the TUM oracle test";
+    *why = "DYNCULL_DATA_DIR is not set; point it at the shared data directory, e.g. ../shared/data to run the TUM oracle test";
     return false;
   }
   out->dir = std::string(root) + "/tum/fr3_sitting_static";

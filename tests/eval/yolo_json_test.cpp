@@ -126,6 +126,21 @@ TYPED_TEST(YoloJsonTest, ReasonGivesLineAndColumnOfTheFault) {
   EXPECT_NE(f.reason.find("a.json: byte 35 (line 3, column 17)"), std::string::npos) << f.reason;
 }
 
+TYPED_TEST(YoloJsonTest, BadEscapeOfAControlByteIsShownNotCopied) {
+  // A NUL or control byte after a backslash is named by its code: reasons stay printable text.
+  for (char c : {'\0', '\x01', '\n', '\x7f', '\xff'}) {
+    std::string text = "{\" \\";
+    text += c;
+    text += "\": 1}";
+    const YoloJsonFrame<TypeParam> f = parse_yolo_json<TypeParam>(text, "esc.json");
+    EXPECT_EQ(f.status, Status::ParseError);
+    EXPECT_NE(f.reason.find("bad escape"), std::string::npos) << f.reason;
+    for (char r : f.reason) EXPECT_TRUE(r >= 0x20 && r < 0x7f) << static_cast<int>(static_cast<unsigned char>(r));
+  }
+  const YoloJsonFrame<TypeParam> q = parse_yolo_json<TypeParam>("{\"\\q\": 1}", "esc.json");
+  EXPECT_NE(q.reason.find("bad escape \\'q'"), std::string::npos) << q.reason;
+}
+
 TEST(YoloJson, FloatRangeIsCheckedOnlyForFloat) {
   const std::string text = R"({"frame_id": 0, "timestamp": 1, "detections": [{"class_id": 0, "confidence": 1e39, "bbox": [1, 2, 3, 4]}]})";
   const auto f = parse_yolo_json<float>(text, "f.json");
@@ -219,7 +234,7 @@ std::string data_dir() {
 
 TEST(YoloJsonReal, ReadsEveryFrameOfTheFourRealStreams) {
   const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   const std::pair<const char*, std::size_t> streams[] = {
       {"fr3_walking_xyz", 859}, {"fr3_walking_static", 743}, {"fr3_sitting_static", 707}, {"fr3_sitting_xyz", 1261}};
   for (const auto& [name, frames] : streams) {
@@ -253,7 +268,7 @@ bool any_overlap(const std::vector<Detection<float>>& dets, const Box<float>& bo
 // lost it for longer).
 TEST(YoloJsonReal, BoxTrackerBridgesOneFramePersonDropoutsOnWalkingXyz) {
   const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   const auto seq = read_yolo_json_sequence<float>(root + "/tum/fr3_walking_xyz/yolov8n");
   ASSERT_TRUE(seq.ok()) << seq.reason;
   const int w = 640, h = 480;

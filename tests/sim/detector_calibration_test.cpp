@@ -141,7 +141,7 @@ Frames real_detections(const std::string& root, const char* sequence) {
 
 TEST(SimDetectorCalibration, CalibratedModelMatchesTheRealYoloStreams) {
   const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   const StreamStats real_sitting = stream_stats(real_detections(root, "fr3_sitting_static"), 640, 480);
   print("real sitting_static", real_sitting);
   double real_dropout_max = 0;

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <clocale>
 #include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -187,6 +189,48 @@ TEST(SceneKeys, BadKeysAndValuesAreRejectedWithTheExpectedTypeAndRange) {
   EXPECT_NE(reason.find("'bogus'"), std::string::npos) << reason;
   EXPECT_EQ(set_scene_key(nullptr, "seed", "1", &reason), Status::InvalidInput);
   EXPECT_EQ(apply_scene_assignments(nullptr, "seed=1", &reason), Status::InvalidInput);
+}
+
+// Numbers follow Python's grammar, as every number dyncull reads: float() for real keys, int() for
+// integer keys (digits with single underscores, no fraction or exponent), in any C locale.
+TEST(SceneKeys, NumbersFollowThePythonGrammarInAnyLocale) {
+  const char* const previous = std::setlocale(LC_ALL, nullptr);
+  const std::string saved = previous ? previous : "C";
+  const bool comma_locale = std::setlocale(LC_ALL, "de_DE.UTF-8") != nullptr;
+  SceneOptions o;
+  std::string reason;
+  EXPECT_EQ(set_scene_key(&o, "fps", "2_5", &reason), Status::Ok) << reason;
+  EXPECT_EQ(o.fps, 25.0);
+  EXPECT_EQ(set_scene_key(&o, "miss_rate", ".25", &reason), Status::Ok) << reason;
+  EXPECT_EQ(o.miss_rate, 0.25);
+  EXPECT_EQ(set_scene_key(&o, "width", "1_024", &reason), Status::Ok) << reason;
+  EXPECT_EQ(o.width, 1024);
+  EXPECT_EQ(set_scene_key(&o, "width", "+320", &reason), Status::Ok) << reason;
+  EXPECT_EQ(o.width, 320);
+  EXPECT_EQ(set_scene_key(&o, "seed", "18_446_744_073_709_551_615", &reason), Status::Ok) << reason;
+  EXPECT_EQ(o.seed, 18446744073709551615ull);
+  EXPECT_EQ(set_scene_key(&o, "trajectory.eye_m", "1_0:-2.5e0:.5", &reason), Status::Ok) << reason;
+  EXPECT_EQ(o.trajectory.eye_m.x(), 10.0);
+  const SceneOptions before = o;
+  for (const auto& kv : std::vector<std::pair<const char*, const char*>>{{"miss_rate", "0,5"},
+                                                                         {"fps", "2__5"},
+                                                                         {"fps", "_25"},
+                                                                         {"fps", "0x10"},
+                                                                         {"width", "1e3"},
+                                                                         {"width", "640.0"},
+                                                                         {"width", "1_"},
+                                                                         {"seed", "+-1"},
+                                                                         {"seed", "1.0"}}) {
+    EXPECT_EQ(set_scene_key(&o, kv.first, kv.second, &reason), Status::InvalidInput) << kv.first << "=" << kv.second;
+  }
+  EXPECT_EQ(scene_difference(o, before), "");
+  // The value is quoted in the reason with control bytes escaped, and cut when long.
+  EXPECT_EQ(set_scene_key(&o, "miss_rate", std::string("0.2\n", 4), &reason), Status::InvalidInput);
+  EXPECT_NE(reason.find("'0.2\\x0a'"), std::string::npos) << reason;
+  EXPECT_EQ(set_scene_key(&o, "miss_rate", std::string(5000, '1'), &reason), Status::InvalidInput);
+  EXPECT_LT(reason.size(), 300u) << reason.size();
+  std::setlocale(LC_ALL, saved.c_str());
+  if (!comma_locale) GTEST_SKIP() << "de_DE.UTF-8 not installed: checked in the C locale only";
 }
 
 // After the keys, SceneOptions::validate() has the last word (here on options that were invalid before).

@@ -211,7 +211,7 @@ Rigid3<double> interpolate(const eval::Trajectory<double>& rec, double stamp) {
 
 TEST(SimTrajectory, RecordedMotionFollowsTheRealTumGroundTruth) {
   const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at /work/shared/data)";
+  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
   for (const char* name : {"fr3_walking_xyz", "fr3_walking_static", "fr3_walking_rpy", "fr3_walking_halfsphere",
                            "fr3_sitting_static", "fr3_sitting_xyz"}) {
     const auto read = eval::read_tum_trajectory<double>(std::string(root) + "/tum/" + name + "/groundtruth.txt");

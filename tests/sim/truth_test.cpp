@@ -2,6 +2,8 @@
 // double Eigen vectors, structs with x/y), and defined results outside the image.
 #include "dyncull/sim/truth.hpp"
 
+#include "dyncull/core/pixel.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -91,6 +93,43 @@ TEST(SimTruth, AgreesWithARenderedFrame) {
     }
   }
   EXPECT_GT(moving_count, 0u);
+}
+
+
+TEST(SimTruth, CoordinatesBeyondTheIntRangeOrNonFiniteAreOutside) {
+  const FrameData f = tiny_frame();
+  const double inf = std::numeric_limits<double>::infinity();
+  // 2^32 + 2 and 2^64 + 2 wrap to pixel 2 in a 32- or 64-bit integer; 1e300 overflows every integer.
+  for (double big : {4294967298.0, 18446744073709551618.0, 9.3e18, -9.3e18, 1e300, -1e300, inf, -inf,
+                     std::numeric_limits<double>::quiet_NaN()}) {
+    EXPECT_FALSE(truth_at(f, big, 1.0).inside) << big;
+    EXPECT_FALSE(truth_at(f, 2.0, big).inside) << big;
+  }
+  // Rounding half away from zero, the same rule as pixel_of: -0.5 is pixel -1, 3.5 is pixel 4.
+  EXPECT_FALSE(truth_at(f, -0.5, 1.0).inside);
+  EXPECT_TRUE(truth_at(f, -0.49, 1.0).inside);
+  EXPECT_FALSE(truth_at(f, 3.5, 1.0).inside);
+  EXPECT_FALSE(truth_at(f, 1.0, 2.5).inside);
+  for (double x = -1.5; x <= 4.5; x += 0.25)
+    for (double y = -1.5; y <= 3.5; y += 0.25) {
+      int u = -1, v = -1;
+      const bool in = dyncull::pixel_of(x, y, f.width, f.height, &u, &v);
+      const PointTruth t = truth_at(f, x, y);
+      ASSERT_EQ(t.inside, in) << x << ", " << y;
+      if (in) {
+        EXPECT_EQ(t.instance, f.instance[static_cast<std::size_t>(v * f.width + u)]);
+      }
+    }
+}
+
+TEST(SimTruth, FrameWithShortBuffersOrBadSizeReadsNothing) {
+  FrameData f = tiny_frame();
+  f.depth_m.resize(5);  // shorter than width * height: pixels past it are not read
+  EXPECT_TRUE(truth_at(f, 0.0, 1.0).inside);
+  EXPECT_FALSE(truth_at(f, 2.0, 2.0).inside);
+  FrameData g = tiny_frame();
+  g.width = -4;
+  EXPECT_FALSE(truth_at(g, 0.0, 0.0).inside);
 }
 
 }  // namespace

@@ -51,6 +51,8 @@ struct ReprojectionResidual {
 /// (0.5 sum rho(|r|^2), Huber of options.huber_threshold_px when options.huber) over the finite
 /// correspondences in front of the initial camera (mask: optional, non-zero = use). Double
 /// internally; options.max_iterations, step_tolerance and cost_tolerance map to Ceres' limits.
+/// InvalidInput for sizes that differ, an invalid camera or options that fail options.validate()
+/// (the same checks as refine_pose()).
 template <class T, class Points3, class Points2>
 PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
                                           const Rigid3<T>& initial_cam_from_world,
@@ -61,11 +63,17 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   static_assert(is_point_container_v<Points2>, "refine_pose_ceres: pixels must be a container of 2-D points");
   PoseRefinementResult<T> res;
   res.cam_from_world = initial_cam_from_world;
-  if (static_cast<std::size_t>(world.size()) != static_cast<std::size_t>(pixels.size()) || !camera.valid() ||
-      options.max_iterations < 0 || (options.huber && !(options.huber_threshold_px > T(0)))) {
-    res.status = Status::InvalidInput;
-    res.reason = "refine_pose_ceres: size mismatch, invalid camera or invalid options";
+  if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) {
+    res.reason = "refine_pose_ceres: " + res.reason;
     return res;
+  }
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) {
+      res.status = Status::InvalidInput;
+      res.reason = "refine_pose_ceres: " + why;
+      return res;
+    }
   }
   if (!initial_cam_from_world.all_finite()) {
     res.status = Status::NonFinite;

@@ -183,7 +183,9 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
   const std::vector<Vec2<T>>& fit_prev = subset ? r.scratch_fit_prev : r.scratch_prev;
   const std::vector<Vec2<T>>& fit_cur = subset ? r.scratch_fit_cur : r.scratch_cur;
   for (int it = 0; it < options.refit_iterations; ++it) {
-    epipolar_distances(r.F, fit_prev, fit_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine);
+    if (epipolar_distances(r.F, fit_prev, fit_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine) !=
+        Status::Ok)
+      break;  // the final pass below reports it
     r.scratch_refit_prev.clear();
     r.scratch_refit_cur.clear();
     for (std::size_t k = 0; k < fit_prev.size(); ++k) {
@@ -196,7 +198,14 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
     if (!polished.ok()) break;
     r.F = polished.F;
   }
-  epipolar_distances(r.F, r.scratch_prev, r.scratch_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine);
+  const Status ds =
+      epipolar_distances(r.F, r.scratch_prev, r.scratch_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine);
+  if (ds != Status::Ok) {
+    // F = 0 (Degenerate) or non-finite (NonFinite): no epipolar line, so no track has evidence.
+    r.status = ds;
+    r.reason = std::string("epipolar distances not usable (") + to_string(ds) + "): F is zero or not finite";
+    return;
+  }
   const T t_out = options.max_epipolar_distance_px, t_in = options.max_epipolar_distance_in_boxes_px;
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t i = r.scratch_index[k];

@@ -26,15 +26,16 @@ struct AteOptions {
   /// fixed factor given by the user; a fitted scale gives the lower bound of the error over scales.
   bool estimate_scale = false;
 
-  /// Ok, or InvalidInput with a reason naming the field (the association window's own checks).
+  /// Ok, or InvalidInput with a reason naming the field (association.* as nested).
   Status validate(std::string* reason = nullptr) const {
-    auto bad = [&](const char* why) {
-      if (reason) *reason = why;
+    std::string why;
+    if (association.validate(&why) != Status::Ok) {
+      if (reason) {
+        const std::size_t colon = why.find(": ");
+        *reason = "AteOptions: association." + (colon == std::string::npos ? why : why.substr(colon + 2));
+      }
       return Status::InvalidInput;
-    };
-    if (!(association.max_difference_s > 0.0) || !std::isfinite(association.max_difference_s))
-      return bad("AteOptions: association.max_difference_s must be positive and finite");
-    if (!std::isfinite(association.offset_s)) return bad("AteOptions: association.offset_s must be finite");
+    }
     if (reason) reason->clear();
     return Status::Ok;
   }

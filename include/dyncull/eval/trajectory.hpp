@@ -82,6 +82,23 @@ struct WriteResult {
 struct AssociationOptions {
   double max_difference_s = 0.02;  ///< pairs need |t_first - (t_second + offset)| < this (strict, as TUM)
   double offset_s = 0.0;           ///< added to the second list's stamps
+
+  /// Upper bound of max_difference_s: a wider window pairs poses seconds apart, and makes the
+  /// candidate list (every pair inside the window) grow with the product of the two lengths.
+  static constexpr double kMaxDifferenceS = 10.0;
+
+  /// Ok, or InvalidInput with a reason naming the field.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (!(max_difference_s > 0.0) || !(max_difference_s <= kMaxDifferenceS))
+      return bad("AssociationOptions: max_difference_s must be in (0, 10] seconds");
+    if (!std::isfinite(offset_s)) return bad("AssociationOptions: offset_s must be finite");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Matched index pairs into the two input stamp arrays, sorted by the first stamp (associate.py's
@@ -132,7 +149,7 @@ WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& t
 /// associate.py: every (a, b) with |a - (b + offset)| < max_difference is a candidate; candidates are
 /// sorted by (difference, a, b) and taken greedily so each stamp is used once. Equal stamps within one
 /// list count as one stamp, the later entry winning (Python dict semantics). Non-finite stamps are
-/// ignored. TooFewPoints when nothing associates; InvalidInput for a non-positive max difference.
+/// ignored. TooFewPoints when nothing associates; InvalidInput when options.validate() fails.
 /// Cost: O((n + m) log(n + m) + k log k) for k candidates (TUM's script is O(n m)).
 inline AssociationResult associate(const double* first, std::size_t num_first, const double* second,
                                    std::size_t num_second, const AssociationOptions& options = {});
@@ -401,11 +418,13 @@ WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& t
 inline AssociationResult associate(const double* first, std::size_t num_first, const double* second,
                                    std::size_t num_second, const AssociationOptions& options) {
   AssociationResult result;
-  if (!(options.max_difference_s > 0.0) || !std::isfinite(options.max_difference_s) ||
-      !std::isfinite(options.offset_s)) {
-    result.status = Status::InvalidInput;
-    result.reason = "associate: max_difference_s must be positive and finite, offset_s finite";
-    return result;
+  {
+    std::string why;
+    if (options.validate(&why) != Status::Ok) {
+      result.status = Status::InvalidInput;
+      result.reason = "associate: " + why;
+      return result;
+    }
   }
   std::vector<std::uint32_t> a;
   std::vector<std::uint32_t> b;

@@ -198,7 +198,7 @@ class YoloJsonParser {
           decoded = v < 0x80 ? static_cast<char>(v) : '?';
           break;
         }
-        default: pos_ -= 1; return fail("bad escape \\" + std::string(1, e) + " in a string");
+        default: pos_ -= 1; return fail("bad escape \\" + shown(e) + " in a string");  // e may be any byte
       }
       if (out) out->push_back(decoded);
     }

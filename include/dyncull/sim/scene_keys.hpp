@@ -5,10 +5,12 @@
 #pragma once
 
 #include "dyncull/core/status.hpp"
+#include "dyncull/core/text.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/sim/scene.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -16,6 +18,7 @@
 #include <locale>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace dyncull::sim {
@@ -97,33 +100,37 @@ inline std::string format_number(double v) {
     o.imbue(std::locale::classic());
     o.precision(precision);
     o << v;
-    std::istringstream back(o.str());
-    back.imbue(std::locale::classic());
     double r = 0;
-    back >> r;
-    if (r == v || precision == 17) return o.str();
+    if ((text::parse_python_float(o.str(), &r) == text::NumberStatus::Ok && r == v) || precision == 17) return o.str();
   }
   return {};
 }
 
-/// Whole-string parse in the classic locale; false on trailing text, empty text or overflow.
-template <class N>
-bool parse_whole(const std::string& text, N* out) {
-  if (text.empty() || std::isspace(static_cast<unsigned char>(text.front()))) return false;
-  std::istringstream in(text);
-  in.imbue(std::locale::classic());
-  N v{};
-  in >> v;
-  if (in.fail()) return false;
-  in.peek();
-  if (!in.eof()) return false;
+/// A finite number as Python's float() reads it (core/text.hpp), in any locale.
+inline bool parse_double(const std::string& token, double* out) {
+  double v = 0;
+  if (text::parse_python_float(token, &v) != text::NumberStatus::Ok || !std::isfinite(v)) return false;
   *out = v;
   return true;
 }
 
-inline bool parse_double(const std::string& text, double* out) {
-  double v = 0;
-  if (!parse_whole(text, &v) || !std::isfinite(v)) return false;
+/// An integer as Python's int() reads it: the float() grammar restricted to a sign and digits with
+/// single underscores (no fraction, exponent, inf or nan), read exactly into N by std::from_chars.
+template <class N>
+bool parse_integer(const std::string& token, N* out) {
+  double ignored = 0;
+  if (text::parse_python_float(token, &ignored) != text::NumberStatus::Ok) return false;  // grammar and length
+  std::string digits;
+  digits.reserve(token.size());
+  for (std::size_t k = 0; k < token.size(); ++k) {
+    const char c = token[k];
+    if (c >= '0' && c <= '9') digits += c;
+    else if (c == '-' && k == 0) digits += c;
+    else if (!(c == '+' && k == 0) && c != '_') return false;
+  }
+  N v{};
+  const std::from_chars_result r = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+  if (r.ec != std::errc() || r.ptr != digits.data() + digits.size()) return false;  // out of N's range
   *out = v;
   return true;
 }
@@ -170,7 +177,7 @@ const F& read_field(FieldRef<F> ref, const SceneOptions& o) {
 }
 
 inline bool fail(const SceneKey& k, const std::string& value, std::string* reason) {
-  if (reason) *reason = "scene key '" + k.name + "': expected " + k.expected() + ", got '" + value + "'";
+  if (reason) *reason = "scene key '" + k.name + "': expected " + k.expected() + ", got " + text::quote_token(value);
   return false;
 }
 
@@ -191,7 +198,7 @@ inline SceneKey int_key(const char* name, FieldRef<int> ref, int lo, int hi, con
   SceneKey k{name, SceneKeyType::Int, static_cast<double>(lo), static_cast<double>(hi), false, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     long long v = 0;
-    if (!parse_whole(text, &v) || !in_range(static_cast<double>(v), k)) return fail(k, text, reason);
+    if (!parse_integer(text, &v) || !in_range(static_cast<double>(v), k)) return fail(k, text, reason);
     ref(o) = static_cast<int>(v);
     return true;
   };
@@ -203,9 +210,7 @@ inline SceneKey uint64_key(const char* name, FieldRef<std::uint64_t> ref, const 
   SceneKey k{name, SceneKeyType::UInt64, 0, 18446744073709551615.0, false, help, {}, {}, {}};
   k.set = [k, ref](SceneOptions& o, const std::string& text, std::string* reason) {
     unsigned long long v = 0;
-    // The stream would read "-1" as 2^64 - 1.
-    if (text.empty() || text.front() == '-' || text.front() == '+' || !parse_whole(text, &v))
-      return fail(k, text, reason);
+    if (!parse_integer(text, &v)) return fail(k, text, reason);  // unsigned: "-1" is refused, never 2^64 - 1
     ref(o) = static_cast<std::uint64_t>(v);
     return true;
   };

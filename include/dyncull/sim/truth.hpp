@@ -3,6 +3,7 @@
 /// whether the surface moves in the world and which instance it belongs to, for scoring culling.
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/sim/scene.hpp"
 
@@ -21,12 +22,13 @@ struct PointTruth {
   float depth_m = 0.f;         ///< the frame's depth at the pixel (0 = no measurement)
 };
 
-/// Truth at sub-pixel (x, y): the pixel whose centre is nearest, i.e. (round(x), round(y)).
+/// Truth at sub-pixel (x, y): the pixel whose centre is nearest, i.e. (round(x), round(y)) as pixel_of.
 inline PointTruth truth_at(const FrameData& frame, double x, double y) {
   PointTruth t;
-  if (!std::isfinite(x) || !std::isfinite(y)) return t;
-  const long u = std::lround(x), v = std::lround(y);
-  if (u < 0 || v < 0 || u >= frame.width || v >= frame.height) return t;
+  int u = 0, v = 0;
+  // Range-checked in floating point before any conversion: a coordinate beyond the integer range
+  // never wraps back into the image.
+  if (!pixel_of(x, y, frame.width, frame.height, &u, &v)) return t;
   const auto i = static_cast<std::size_t>(v) * static_cast<std::size_t>(frame.width) + static_cast<std::size_t>(u);
   if (i >= frame.instance.size() || i >= frame.moving.size() || i >= frame.depth_m.size()) return t;
   t.inside = true;
