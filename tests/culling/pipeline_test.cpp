@@ -123,6 +123,30 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   }
 }
 
+// A geometric cull names the check whose label stood: Reprojection where the 3-D points were given
+// (Replace), Epipolar without them.
+TYPED_TEST(PipelineTest, GeometricCullsNameTheCheckThatFlaggedThem) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  auto frame = frame_of(s, dets);
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.use_subbox = false;
+  o.cull_geometric_outside_boxes = true;
+  o.survivor_guard = false;
+  frame.points_3d = &s.prev_points_world;
+  PipelineState<T> with_points;
+  const PipelineResult<T> r = cull_frame(frame, o, &with_points);
+  ASSERT_TRUE(r.reprojection.ran()) << r.reprojection.reason;
+  EXPECT_GT(std::count(r.reasons.begin(), r.reasons.end(), CullReason::Reprojection), 0);
+  frame.points_3d = nullptr;
+  PipelineState<T> without_points;
+  const PipelineResult<T>& e = cull_frame(frame, o, &without_points);
+  EXPECT_GT(std::count(e.reasons.begin(), e.reasons.end(), CullReason::Epipolar), 0);
+  EXPECT_EQ(std::count(e.reasons.begin(), e.reasons.end(), CullReason::Reprojection), 0);
+}
+
 // With each track's 3-D point given, the recommended preset's geometric evidence is the reprojection
 // residual (the epipolar labels are replaced where a point exists). Without points, or with points of the
 // wrong size, the stage says why and the epipolar labels stand, exactly as without the option.
@@ -230,6 +254,8 @@ TYPED_TEST(PipelineTest, CoherentMotionFlagsASwayTheResidualsMiss) {
   PipelineState<T> state;
   const PipelineResult<T>& r = cull_frame(frame, o, &state);
   ASSERT_TRUE(r.coherent_motion.ran()) << r.coherent_motion.reason;
+  // The culls the coherent cells decided say so (not the sub-box vote's reason).
+  EXPECT_GT(std::count(r.reasons.begin(), r.reasons.end(), CullReason::CoherentMotion), 0);
   EXPECT_GT(r.coherent_motion.num_dynamic, 0u);
   EXPECT_GT(state.internals().votes.coherent.num_cells_flagged, 0u);
   EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.8);  // measured 1.0 (12 cells flagged)
