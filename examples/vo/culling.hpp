@@ -159,28 +159,27 @@ class Culler {
     return frame.moving.at<std::uint8_t>(v, u) != 0 ? 1 : 0;
   }
 
-  /// Reads the pipeline's per-stage scratch of this frame (PipelineState): which stage left a kept track
+  /// Reads the per-feature trace of this frame (PipelineResult::trace): which stage left a kept track
   /// static. Diagnostic only (dynamic_vo --diagnose).
   void explain_kept(const PipelineResult<float>& r) {
     const std::size_t n = r.labels.size();
     kept_why_.assign(n, KeptWhy::NotExplained);
-    const PipelineState<float>& s = state_;
-    const bool masks = r.depth_mask.ran() && s.in_object.size() == n;
-    const bool geo = (r.moving_consistency.ran() || r.reprojection.ran()) && s.moving.labels.size() == n;
+    if (r.trace.size() != n) return;
     for (std::size_t i = 0; i < n; ++i) {
       if (!r.keep[i] || r.reasons[i] != CullReason::None) continue;
+      const FeatureTrace& t = r.trace[i];
       KeptWhy& why = kept_why_[i];
-      if (i < s.history_kept.size() && s.history_kept[i]) {
+      if (t.history_kept) {
         why = KeptWhy::StaticHistory;
-      } else if (i >= s.in_dyn_box.size() || !s.in_dyn_box[i]) {
+      } else if (!t.in_dynamic_box) {
         why = KeptWhy::OutsideBoxes;
-      } else if (masks && !s.in_object[i]) {
+      } else if (!t.in_object) {
         why = KeptWhy::OutsideObjectBand;
-      } else if (s.sem_labels.size() == n && s.sem_labels[i] == FeatureLabel::Candidate) {
+      } else if (t.semantic == FeatureLabel::Candidate) {
         why = KeptWhy::CandidateNotFlagged;
-      } else if (!geo || s.moving.labels[i] == FeatureLabel::Candidate) {
+      } else if (t.geometric == FeatureLabel::Candidate) {
         why = KeptWhy::NoGeometricEvidence;
-      } else if (s.moving.labels[i] == FeatureLabel::Dynamic) {
+      } else if (t.geometric == FeatureLabel::Dynamic) {
         why = KeptWhy::FlaggedInStaticSubBox;
       } else {
         why = KeptWhy::NotFlagged;

@@ -113,7 +113,7 @@ constexpr const char* to_string(KeptWhy w) noexcept {
 /// feature's reason is None; `kept_why` (optional) then says at which stage it stayed static.
 struct LabelBreakdown {
   /// Every sim instance id (sim::SceneInstance), then "other".
-  static constexpr int kInstances = sim::SceneInstance::kCount + 1, kReasons = 12, kKeptWhy = 8;
+  static constexpr int kInstances = sim::SceneInstance::kCount + 1, kReasons = 14, kKeptWhy = 8;
   static constexpr int kCells = kReasons + kKeptWhy;  ///< reasons, then None split by KeptWhy
   std::array<std::size_t, kInstances * 2 * 2 * kCells> counts{};
 

@@ -123,6 +123,30 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   }
 }
 
+// A geometric cull names the check whose label stood: Reprojection where the 3-D points were given
+// (Replace), Epipolar without them.
+TYPED_TEST(PipelineTest, GeometricCullsNameTheCheckThatFlaggedThem) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  auto frame = frame_of(s, dets);
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.use_subbox = false;
+  o.cull_geometric_outside_boxes = true;
+  o.survivor_guard = false;
+  frame.points_3d = &s.prev_points_world;
+  PipelineState<T> with_points;
+  const PipelineResult<T> r = cull_frame(frame, o, &with_points);
+  ASSERT_TRUE(r.reprojection.ran()) << r.reprojection.reason;
+  EXPECT_GT(std::count(r.reasons.begin(), r.reasons.end(), CullReason::Reprojection), 0);
+  frame.points_3d = nullptr;
+  PipelineState<T> without_points;
+  const PipelineResult<T>& e = cull_frame(frame, o, &without_points);
+  EXPECT_GT(std::count(e.reasons.begin(), e.reasons.end(), CullReason::Epipolar), 0);
+  EXPECT_EQ(std::count(e.reasons.begin(), e.reasons.end(), CullReason::Reprojection), 0);
+}
+
 // With each track's 3-D point given, the recommended preset's geometric evidence is the reprojection
 // residual (the epipolar labels are replaced where a point exists). Without points, or with points of the
 // wrong size, the stage says why and the epipolar labels stand, exactly as without the option.
@@ -146,11 +170,11 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   EXPECT_TRUE(r.subbox.ran()) << r.subbox.reason;
   EXPECT_GT(r.reprojection.num_dynamic, 0u);
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (state.reprojection.labels[i] == FeatureLabel::Candidate) continue;
+    if (state.internals().geometric.reprojection.labels[i] == FeatureLabel::Candidate) continue;
     // Replace: the geometric label is the reprojection one, unless the depth-edge rule demoted a flag.
-    const FeatureLabel g = state.moving.labels[i];
-    EXPECT_TRUE(g == state.reprojection.labels[i] ||
-                (g == FeatureLabel::Candidate && state.reprojection.labels[i] == FeatureLabel::Dynamic))
+    const FeatureLabel g = state.internals().geometric.labels[i];
+    EXPECT_TRUE(g == state.internals().geometric.reprojection.labels[i] ||
+                (g == FeatureLabel::Candidate && state.internals().geometric.reprojection.labels[i] == FeatureLabel::Dynamic))
         << i;
   }
   EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
@@ -162,14 +186,14 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   // The frame's depth reaches the check (the preset's depth residual): measured where the track's pixel has
   // depth, and nowhere without a depth image.
   std::size_t with_depth = 0;
-  for (std::size_t i = 0; i < s.size(); ++i) with_depth += std::isfinite(double(state.reprojection.depth_residual_m[i]));
+  for (std::size_t i = 0; i < s.size(); ++i) with_depth += std::isfinite(double(state.internals().geometric.reprojection.depth_residual_m[i]));
   EXPECT_GT(with_depth, s.size() / 2);
   auto no_depth_frame = frame;
   no_depth_frame.depth = {};
   PipelineState<T> state_no_depth;
   cull_frame(no_depth_frame, o, &state_no_depth);
   ASSERT_TRUE(state_no_depth.result.reprojection.ran()) << state_no_depth.result.reprojection.reason;
-  for (std::size_t i = 0; i < s.size(); ++i) EXPECT_TRUE(std::isnan(double(state_no_depth.reprojection.depth_residual_m[i])));
+  for (std::size_t i = 0; i < s.size(); ++i) EXPECT_TRUE(std::isnan(double(state_no_depth.internals().geometric.reprojection.depth_residual_m[i])));
 
   // Either: a track is geometric-dynamic when either check flags it, so never fewer flags than Replace.
   PipelineOptions<T> either = o;
@@ -179,8 +203,8 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   ASSERT_TRUE(re.reprojection.ran());
   std::size_t flags_replace = 0, flags_either = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    flags_replace += state.moving.labels[i] == FeatureLabel::Dynamic;
-    flags_either += state_either.moving.labels[i] == FeatureLabel::Dynamic;
+    flags_replace += state.internals().geometric.labels[i] == FeatureLabel::Dynamic;
+    flags_either += state_either.internals().geometric.labels[i] == FeatureLabel::Dynamic;
   }
   EXPECT_GE(flags_either, flags_replace);
 
@@ -230,8 +254,10 @@ TYPED_TEST(PipelineTest, CoherentMotionFlagsASwayTheResidualsMiss) {
   PipelineState<T> state;
   const PipelineResult<T>& r = cull_frame(frame, o, &state);
   ASSERT_TRUE(r.coherent_motion.ran()) << r.coherent_motion.reason;
+  // The culls the coherent cells decided say so (not the sub-box vote's reason).
+  EXPECT_GT(std::count(r.reasons.begin(), r.reasons.end(), CullReason::CoherentMotion), 0);
   EXPECT_GT(r.coherent_motion.num_dynamic, 0u);
-  EXPECT_GT(state.coherent_motion.num_cells_flagged, 0u);
+  EXPECT_GT(state.internals().votes.coherent.num_cells_flagged, 0u);
   EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.8);  // measured 1.0 (12 cells flagged)
   EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2);  // measured 0.07, as without the stage
   EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
@@ -286,10 +312,10 @@ TYPED_TEST(PipelineTest, StaticHistoryKeepsTracksProvenStillInACulledRegion) {
     leg_label.push_back(r.labels[leg]);
     EXPECT_NE(r.static_history.reason.find(std::to_string(r.history_kept)), std::string::npos) << r.static_history.reason;
     for (std::size_t i = 0; i < s.size(); ++i) {
-      if (!state.history_kept[i]) continue;
+      if (!state.internals().history_kept[i]) continue;
       EXPECT_EQ(r.labels[i], FeatureLabel::Static);
-      EXPECT_GE(state.still_frames[i], 6);
-      EXPECT_NE(state.reprojection.labels[i], FeatureLabel::Dynamic);
+      EXPECT_GE(state.internals().still_frames[i], 6);
+      EXPECT_NE(state.internals().geometric.reprojection.labels[i], FeatureLabel::Dynamic);
     }
   }
   for (int k = 0; k < 5; ++k) {
@@ -406,7 +432,7 @@ TYPED_TEST(PipelineTest, CandidatesAreCulledOnTheirOwnEvidenceOnly) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] != SceneKind::Chair || r.labels[i] != FeatureLabel::Dynamic) continue;
     if (r.reasons[i] == CullReason::SubBox) {
-      EXPECT_EQ(state.moving.labels[i], FeatureLabel::Dynamic) << "chair feature " << i << " culled without its own flag";
+      EXPECT_EQ(state.internals().evidence()[i], FeatureLabel::Dynamic) << "chair feature " << i << " culled without its own flag";
     } else {
       EXPECT_EQ(r.reasons[i], CullReason::MultiView) << "chair feature " << i;
     }
@@ -623,7 +649,7 @@ TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
   EXPECT_EQ(rates(on, 2), 0.0);
   for (std::size_t i = 0; i < kp.size(); ++i) {
     if (kind[i] != 1) continue;
-    EXPECT_EQ(on_state.object_box_bits[i], 2u) << "chair feature " << i << " keeps only the chair's mask bit";
+    EXPECT_EQ(on_state.internals().semantic.object_box_bits[i], 2u) << "chair feature " << i << " keeps only the chair's mask bit";
   }
 }
 
@@ -660,7 +686,7 @@ TYPED_TEST(PipelineTest, HighLevelMarginGivesNearTiesToThePerson) {
     const PipelineResult<T>& r = cull_frame(frame, o, &state);
     EXPECT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
     std::size_t chair = 0;
-    for (std::size_t i = 0; i < on_chair; ++i) chair += state.object_box_bits[i] == 2u;
+    for (std::size_t i = 0; i < on_chair; ++i) chair += state.internals().semantic.object_box_bits[i] == 2u;
     return double(chair) / double(on_chair);
   };
   EXPECT_EQ(chair_share(2.4f, 0.0), 1.0) << "nearest d_c: the chair";
@@ -773,7 +799,40 @@ TYPED_TEST(PipelineTest, TrackerCarriesMoversNotLowLevelBoxes) {
   EXPECT_EQ(second.labels[0], FeatureLabel::Dynamic) << "the carried person box culls; no carried TV box shelters";
   EXPECT_EQ(second.labels[1], FeatureLabel::Dynamic);
   EXPECT_EQ(second.labels[2], FeatureLabel::Static);
-  EXPECT_EQ(state.boxes.size(), 1u) << "only the person's box is carried";
+  EXPECT_EQ(state.internals().regions.boxes.size(), 1u) << "only the person's box is carried";
+}
+
+// PipelineOptions::tracker reaches the box tracker: with max_missed_frames 0 a missed person box is not
+// carried (its features stay static), with 2 it is carried for two frames.
+TYPED_TEST(PipelineTest, TrackerOptionsDecideHowLongAMissedBoxIsCarried) {
+  using T = TypeParam;
+  PinholeCamera<T> camera;
+  camera.width = 320;
+  camera.height = 240;
+  const Detection<T> person{Box<T>{T(100), T(30), T(200), T(230)}, 0, T(0.9)};
+  std::vector<Vec2<T>> kp = {Vec2<T>(T(150), T(90))};
+  for (int u = 10; u < 310; u += 10) kp.emplace_back(T(u), T(10));  // wall: keeps the survivor guard quiet
+  CullingFrame<T, std::vector<Vec2<T>>> frame;
+  frame.keypoints = &kp;
+  frame.camera = camera;
+  std::vector<Detection<T>> seen = {person}, missed;
+  std::vector<FeatureLabel> person_label;
+  for (int max_missed : {0, 2}) {
+    PipelineOptions<T> o = presets::none<T>();
+    o.use_detection_filter = false;
+    o.use_box_rule = true;
+    o.use_box_tracker = true;
+    o.tracker.max_missed_frames = max_missed;
+    PipelineState<T> state;
+    frame.detections = &seen;
+    ASSERT_EQ(cull_frame(frame, o, &state).labels[0], FeatureLabel::Dynamic);
+    frame.detections = &missed;
+    const PipelineResult<T>& r = cull_frame(frame, o, &state);
+    ASSERT_TRUE(r.tracker.ran()) << r.tracker.reason;
+    person_label.push_back(r.labels[0]);
+  }
+  EXPECT_EQ(person_label[0], FeatureLabel::Static) << "max_missed_frames 0: the missed box is dropped";
+  EXPECT_EQ(person_label[1], FeatureLabel::Dynamic) << "max_missed_frames 2: the missed box is carried";
 }
 
 // edge_evidence_radius_px: epipolar flags of features near a depth step stop counting as evidence
@@ -788,7 +847,7 @@ TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
   o.edge_evidence_radius_px = 0;
   PipelineState<T> off_state;
   run(s, dets, o, &off_state, config);
-  const std::vector<FeatureLabel> off_geo = off_state.moving.labels;
+  const std::vector<FeatureLabel> off_geo = off_state.internals().geometric.labels;
   o.edge_evidence_radius_px = 8;
   PipelineState<T> on_state;
   const auto& on = run(s, dets, o, &on_state, config);
@@ -796,16 +855,16 @@ TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
   const DepthView<float> depth = s.depth_view();
   std::size_t discounted = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (off_geo[i] == on_state.moving.labels[i]) continue;
+    if (off_geo[i] == on_state.internals().geometric.labels[i]) continue;
     ++discounted;
     EXPECT_EQ(off_geo[i], FeatureLabel::Dynamic) << i;
-    EXPECT_EQ(on_state.moving.labels[i], FeatureLabel::Candidate) << i;
+    EXPECT_EQ(on_state.internals().geometric.labels[i], FeatureLabel::Candidate) << i;
     const int u = static_cast<int>(std::lround(double(s.keypoints[i].x())));
     const int v = static_cast<int>(std::lround(double(s.keypoints[i].y())));
     EXPECT_TRUE(depth_step_near(depth, u, v, 8, 0.05)) << i;
   }
   EXPECT_GT(discounted, 0u) << "premise: some flagged features lie on depth edges (silhouettes)";
-  EXPECT_EQ(on_state.moving.num_dynamic, off_state.moving.num_dynamic);  // the stage's own count is untouched
+  EXPECT_EQ(on_state.internals().geometric.moving.num_dynamic, off_state.internals().geometric.moving.num_dynamic);  // the stage's own count is untouched
   EXPECT_EQ(on.moving_consistency.num_dynamic + discounted, off_state.result.moving_consistency.num_dynamic);
   EXPECT_GT(dynamic_rate(s, on, SceneKind::WalkingPerson), 0.95);
   EXPECT_LT(dynamic_rate(s, on, SceneKind::Room), 0.03);
@@ -908,13 +967,13 @@ TYPED_TEST(PipelineTest, StateBuffersAreReusedAcrossFrames) {
   PipelineState<T> state;
   const auto first = run(s, dets, presets::recommended<T>(), &state, config).labels;
   const auto* labels_data = state.result.labels.data();
-  const auto* moving_data = state.moving.scratch_prev.data();
-  const auto* mask_data = state.multiview_mask.pixels.data();
+  const auto* moving_data = state.internals().geometric.moving.scratch_prev.data();
+  const auto* mask_data = state.internals().multiview.mask.pixels.data();
   const auto second = run(s, dets, presets::recommended<T>(), &state, config).labels;
   EXPECT_EQ(first, second);
   EXPECT_EQ(labels_data, state.result.labels.data());
-  EXPECT_EQ(moving_data, state.moving.scratch_prev.data());
-  EXPECT_EQ(mask_data, state.multiview_mask.pixels.data());
+  EXPECT_EQ(moving_data, state.internals().geometric.moving.scratch_prev.data());
+  EXPECT_EQ(mask_data, state.internals().multiview.mask.pixels.data());
 }
 
 // The README example: a front end with cv::KeyPoint-like keypoints, cv::Point2f-like LK positions and a

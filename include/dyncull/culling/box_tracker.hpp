@@ -77,6 +77,8 @@ template <class T>
 class BoxTracker {
  public:
   explicit BoxTracker(const BoxTrackerOptions<T>& options = {}) : options_(options) {}
+  /// Options of the next update() (the tracks are kept).
+  void set_options(const BoxTrackerOptions<T>& options) { options_ = options; }
 
   /// Feeds one frame's detections (already filtered, pixel boxes). Invalid boxes are ignored
   /// (counted in `reason`); a bad image size or options failing BoxTrackerOptions::validate fail

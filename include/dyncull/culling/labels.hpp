@@ -23,6 +23,8 @@ enum class CullReason : std::uint8_t {
   MultiView,          ///< multi-view depth/angle check (geometric stage)
   SurvivorGuardUndo,  ///< culling undone because too few static features would remain
   TrackedBox,         ///< inside a box carried forward by the box tracker (detector miss)
+  Reprojection,       ///< RGB-D reprojection residual above threshold (reprojection_check.hpp)
+  CoherentMotion,     ///< its cell's residuals moved together (coherent_motion.hpp), culled by the sub-box vote
   InvalidInput,       ///< non-finite coordinates: never trusted as static
 };
 
@@ -48,6 +50,8 @@ constexpr const char* to_string(CullReason reason) noexcept {
     case CullReason::MultiView: return "multi-view";
     case CullReason::SurvivorGuardUndo: return "survivor guard undo";
     case CullReason::TrackedBox: return "tracked box";
+    case CullReason::Reprojection: return "reprojection";
+    case CullReason::CoherentMotion: return "coherent motion";
     case CullReason::InvalidInput: return "invalid input";
   }
   return "unknown";

@@ -1,0 +1,105 @@
+/// @file geometric.hpp
+/// Stage 4 of the culling pipeline: per-feature geometric evidence from the tracks, the epipolar
+/// distance to an F fitted outside the boxes (DFD-SLAM 2024 eq. 1-3; SG-SLAM 2023) and/or the RGB-D
+/// reprojection residual, combined, with flags on occlusion edges discounted.
+#pragma once
+
+#include "dyncull/culling/stages/context.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <string>
+
+namespace dyncull {
+namespace detail {
+
+/// The tracks of a frame: previous positions parallel to the keypoints, or why there are none.
+template <class Frame>
+bool have_tracks(const Frame& frame, std::size_t n) {
+  return frame.prev_keypoints && static_cast<std::size_t>(frame.prev_keypoints->size()) == n;
+}
+template <class Frame>
+std::string no_tracks_reason(const Frame& frame, std::size_t n) {
+  return frame.prev_keypoints ? "prev_keypoints has " + std::to_string(frame.prev_keypoints->size()) +
+                                    " positions for " + std::to_string(n) + " keypoints"
+                              : std::string("no previous-frame positions (tracks) given");
+}
+template <class Frame>
+const std::uint8_t* track_valid_of(const Frame& frame) {
+  return frame.track_valid.empty() ? nullptr : frame.track_valid.data;
+}
+
+/// Geometric evidence of this frame (out->labels, valid when out->ok); reports into
+/// r.moving_consistency and r.reprojection.
+template <class T, class Frame>
+void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& options, const BoxRegions<T>& regions,
+                               const SemanticEvidence<T>& semantic, GeometricEvidence<T>* out, PipelineResult<T>* r) {
+  const auto& kp = *frame.keypoints;
+  const std::size_t n = r->num_features;
+  GeometricEvidence<T>& g = *out;
+  const std::uint8_t* const track_valid = track_valid_of(frame);
+  const std::uint8_t* const in_boxes = regions.dyn_boxes.empty() ? nullptr : semantic.in_dyn_box.data();
+  if (options.use_moving_consistency) {
+    if (!have_tracks(frame, n)) {
+      r->moving_consistency.reason = no_tracks_reason(frame, n);
+    } else {
+      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &g.moving, track_valid, in_boxes);
+      r->moving_consistency.status = g.moving.status;
+      r->moving_consistency.reason = g.moving.reason;
+      r->moving_consistency.num_dynamic = g.moving.num_dynamic;
+    }
+  }
+  if (r->moving_consistency.ran()) {
+    g.labels.assign(g.moving.labels.begin(), g.moving.labels.end());
+    g.source.assign(n, CullReason::Epipolar);
+  }
+  if (options.use_reprojection) {
+    if (!frame.points_3d) {
+      r->reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
+    } else {
+      check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &g.reprojection, track_valid,
+                         in_boxes, frame.depth);
+      r->reprojection.status = g.reprojection.status;
+      r->reprojection.reason = g.reprojection.reason;
+      r->reprojection.num_dynamic = g.reprojection.num_dynamic;
+    }
+    if (r->reprojection.ran()) {
+      if (!r->moving_consistency.ran()) {
+        g.labels.assign(g.reprojection.labels.begin(), g.reprojection.labels.end());
+        g.source.assign(n, CullReason::Reprojection);
+      } else {
+        for (std::size_t i = 0; i < n; ++i) {
+          const FeatureLabel rl = g.reprojection.labels[i];
+          FeatureLabel& gl = g.labels[i];
+          const bool replace = options.reprojection_evidence == PipelineOptions<T>::Evidence::Replace ||
+                               rl == FeatureLabel::Dynamic || gl == FeatureLabel::Candidate;
+          if (replace && rl != FeatureLabel::Candidate) {
+            gl = rl;
+            g.source[i] = CullReason::Reprojection;
+          }
+        }
+      }
+    }
+  }
+  g.ok = r->moving_consistency.ran() || r->reprojection.ran();
+  g.fit_outside_boxes = (!r->moving_consistency.ran() || g.moving.fitted_outside_boxes) &&
+                        (!r->reprojection.ran() || g.reprojection.fitted_outside_boxes);
+  // An LK window straddling an occlusion edge follows the contour, not a 3-D point: not evidence.
+  if (g.ok && options.edge_evidence_radius_px > 0 && !frame.depth.empty()) {
+    std::size_t discounted = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      int u = 0, v = 0;
+      if (g.labels[i] != FeatureLabel::Dynamic ||
+          !keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
+        continue;
+      if (depth_step_near(frame.depth, u, v, options.edge_evidence_radius_px, options.edge_depth_step_ratio)) {
+        g.labels[i] = FeatureLabel::Candidate;
+        ++discounted;
+      }
+    }
+    r->moving_consistency.num_dynamic -= std::min(r->moving_consistency.num_dynamic, discounted);
+  }
+}
+
+}  // namespace detail
+}  // namespace dyncull

@@ -1,0 +1,82 @@
+/// @file inputs.hpp
+/// Start of a culling frame: the stage reports reset and enabled from the options, and the frame's inputs
+/// checked against the input contract of docs/design.md (nothing is culled on invalid input).
+#pragma once
+
+#include "dyncull/culling/stages/context.hpp"
+
+#include <string>
+
+namespace dyncull {
+namespace detail {
+
+/// Resets r for a new frame; every stage report enabled as its option says.
+template <class T>
+void begin_frame(const PipelineOptions<T>& options, PipelineResult<T>* r) {
+  r->status = Status::Ok;
+  r->reason.clear();
+  r->guard = GuardAction::None;
+  r->guard_restored = 0;
+  r->history_kept = 0;
+  r->unsheltered = 0;
+  for (StageReport* st : {&r->detections, &r->tracker, &r->box_rule, &r->depth_mask, &r->probability,
+                          &r->moving_consistency, &r->reprojection, &r->coherent_motion, &r->subbox, &r->multiview,
+                          &r->static_history}) {
+    st->status = Status::Skipped;
+    st->reason.clear();
+    st->num_dynamic = 0;
+  }
+  r->detections.enabled = options.use_detection_filter;
+  r->tracker.enabled = options.use_box_tracker;
+  r->box_rule.enabled = options.use_box_rule;
+  r->depth_mask.enabled = options.use_depth_mask;
+  r->probability.enabled = options.use_probability;
+  r->moving_consistency.enabled = options.use_moving_consistency;
+  r->reprojection.enabled = options.use_reprojection;
+  r->coherent_motion.enabled = options.use_coherent_motion;
+  if (options.use_coherent_motion)
+    r->coherent_motion.reason = "runs with the sub-box refinement, on the reprojection check's residuals";
+  r->subbox.enabled = options.use_subbox;
+  r->multiview.enabled = options.use_multiview;
+  r->static_history.enabled = options.static_history.min_frames > 0;
+}
+
+/// False (r filled: InvalidInput, every keypoint Static and kept) when the frame cannot be culled: no
+/// keypoints, invalid options, an invalid depth view or a track_valid of the wrong length.
+template <class T, class Frame>
+bool accept_inputs(const Frame& frame, const PipelineOptions<T>& options, PipelineResult<T>* r) {
+  if (!frame.keypoints) {
+    r->status = Status::InvalidInput;
+    r->reason = "no keypoints given";
+    r->labels.clear();
+    r->reasons.clear();
+    r->keep.clear();
+    r->trace.clear();
+    r->num_features = r->num_static = r->num_dynamic = 0;
+    return false;
+  }
+  const std::size_t n = static_cast<std::size_t>(frame.keypoints->size());
+  r->num_features = n;
+  r->labels.assign(n, FeatureLabel::Static);
+  r->reasons.assign(n, CullReason::None);
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
+    why = "invalid options: " + why;
+  } else if (frame.depth.validate(&why) != Status::Ok) {
+  } else if (!frame.track_valid.empty() && !frame.track_valid.holds(n)) {
+    why = "track_valid has " + std::to_string(frame.track_valid.size) + " flags for " + std::to_string(n) +
+          " keypoints";
+  } else {
+    return true;
+  }
+  r->status = Status::InvalidInput;
+  r->reason = why;
+  r->keep.assign(n, 1);
+  r->trace.assign(n, FeatureTrace{});
+  r->num_static = n;
+  r->num_dynamic = 0;
+  return false;
+}
+
+}  // namespace detail
+}  // namespace dyncull

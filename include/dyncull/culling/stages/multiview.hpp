@@ -1,0 +1,91 @@
+/// @file multiview.hpp
+/// Stage 7 of the culling pipeline: the multi-view depth and parallax check of RTD-SLAM 2024 §III.A
+/// (after DynaSLAM, Bescos et al. 2018) against stored keyframes, grown into a mask over the depth image.
+#pragma once
+
+#include "dyncull/culling/stages/context.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+namespace dyncull {
+namespace detail {
+
+/// out->dynamic: per feature, in a region the check found moving (valid when out->ok); reports into r.multiview.
+template <class T, class Frame>
+void check_against_keyframes(const Frame& frame, const PipelineOptions<T>& options,
+                             const std::vector<FeatureLabel>& semantic_labels, const KeyframeRing<T>& keyframes,
+                             MultiViewFlags<T>* out, PipelineResult<T>* r) {
+  MultiViewFlags<T>& m = *out;
+  const std::size_t n = r->num_features;
+  m.dynamic.assign(n, 0);
+  m.ok = false;
+  if (!options.use_multiview) return;
+  const auto& kp = *frame.keypoints;
+  if (!frame.cam_from_world || !frame.cam_from_world->all_finite()) {
+    r->multiview.reason = "no current pose (tracking not initialised or lost)";
+    return;
+  }
+  if (keyframes.empty()) {
+    r->multiview.reason = "no keyframe stored yet";
+    return;
+  }
+  if (frame.depth.empty()) {
+    r->multiview.reason = "no depth image";
+    return;
+  }
+  if (!options.multiview_overrides_static &&
+      std::none_of(semantic_labels.begin(), semantic_labels.end(),
+                   [](FeatureLabel l) { return l == FeatureLabel::Candidate; })) {
+    r->multiview.reason = "no candidate features to verify (multiview_overrides_static is off)";
+    return;
+  }
+  // Growth only where labels are still open: all the image, or around the candidates.
+  PixelRect roi{0, 0, frame.depth.width, frame.depth.height};
+  if (!options.multiview_overrides_static) {
+    roi = PixelRect{frame.depth.width, frame.depth.height, 0, 0};
+    for (std::size_t i = 0; i < n; ++i) {
+      int u = 0, v = 0;
+      if (semantic_labels[i] != FeatureLabel::Candidate ||
+          !keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
+        continue;
+      roi.c0 = std::min(roi.c0, u);
+      roi.r0 = std::min(roi.r0, v);
+      roi.c1 = std::max(roi.c1, u + 1);
+      roi.r1 = std::max(roi.r1, v + 1);
+    }
+  }
+  m.ref_index.resize(std::max<std::size_t>(1, std::min(options.max_reference_keyframes, keyframes.size())));
+  const std::size_t k =
+      keyframes.select_references(*frame.cam_from_world, options.max_reference_keyframes, m.ref_index.data());
+  if (m.mask.width != frame.depth.width || m.mask.height != frame.depth.height)
+    m.mask.reset(frame.depth.width, frame.depth.height, 0);
+  else
+    std::fill(m.mask.pixels.begin(), m.mask.pixels.end(), std::uint8_t(0));
+  std::size_t checked = 0;
+  for (std::size_t j = 0; j < k; ++j) {
+    const MultiViewKeyframe<T>& kf = keyframes[m.ref_index[j]];
+    check_multiview(kf.points, kf.depth_m, kf.cam_from_world, *frame.cam_from_world, frame.depth, frame.camera,
+                    options.multiview, &m.check);
+    if (m.check.num_checked == 0) continue;
+    ++checked;
+    grow_multiview_regions(m.check, frame.depth, options.multiview, &m.mask, &m.flood_stack, &roi);
+  }
+  if (checked == 0) {
+    r->multiview.status = Status::TooFewPoints;
+    r->multiview.reason = "no keyframe point could be compared";
+    return;
+  }
+  r->multiview.status = Status::Ok;
+  for (std::size_t i = 0; i < n; ++i) {
+    int u = 0, v = 0;
+    if (keypoint_in_image<T>(kp, i, m.mask.width, m.mask.height, &u, &v))
+      m.dynamic[i] = m.mask.pixels[static_cast<std::size_t>(v) * m.mask.width + u] != 0;
+    r->multiview.num_dynamic += m.dynamic[i];
+  }
+  m.ok = r->multiview.ran();
+}
+
+}  // namespace detail
+}  // namespace dyncull

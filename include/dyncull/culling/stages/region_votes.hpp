@@ -1,0 +1,109 @@
+/// @file region_votes.hpp
+/// Stage 6 of the culling pipeline: region votes over the dynamic-class boxes, the sub-box refinement
+/// (DFD-SLAM 2024 Algorithm 1) on the geometric evidence, with cell-level coherent motion before the
+/// vote, the sub-box memory of a tracked box, and the box rule deciding on too short a baseline.
+#pragma once
+
+#include "dyncull/culling/stages/context.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace dyncull {
+namespace detail {
+
+/// out->subbox: this frame's sub-box labels (valid when out->ok); out->evidence: the geometric labels with
+/// the coherent cells' features flagged (when out->coherent_ran). Reports into r.coherent_motion, r.subbox.
+template <class T, class Frame>
+void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::uint64_t frame_index,
+                  const BoxRegions<T>& regions, const SemanticEvidence<T>& semantic,
+                  const std::vector<FeatureLabel>& semantic_labels, const GeometricEvidence<T>& geometric,
+                  SubBoxMemory* memory_store, RegionVotes<T>* out, PipelineResult<T>* r) {
+  RegionVotes<T>& v = *out;
+  v.ok = false;
+  v.coherent_ran = false;
+  if (!options.use_subbox) return;
+  const auto& kp = *frame.keypoints;
+  const std::size_t n = r->num_features;
+  const bool masks = semantic.masks;
+  const std::uint8_t* const in_object = masks ? semantic.in_object.data() : nullptr;
+  const std::uint32_t* const box_bits = masks ? semantic.object_box_bits.data() : nullptr;
+  if (!geometric.ok) {
+    r->subbox.reason = "needs geometric labels (moving consistency or reprojection), unavailable this frame";
+  } else if (regions.dyn_boxes.empty()) {
+    r->subbox.reason = "no dynamic-class boxes";
+  } else if (options.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
+             frame.evidence_frames < options.min_evidence_frames) {
+    const std::size_t recalled =
+        options.short_baseline_keeps_last_vote && options.use_box_tracker && r->tracker.ran()
+            ? memory_store->recall_states(regions.dyn_box_track_id, options.subbox.grid, frame_index,
+                                          options.min_evidence_frames, &v.remembered_cells)
+            : 0;
+    if (recalled > 0) {
+      apply_subbox_states(kp, geometric.labels.data(), regions.dyn_boxes, v.remembered_cells.data(), options.subbox,
+                          &v.subbox, in_object, box_bits);
+      r->subbox.status = v.subbox.status;
+      r->subbox.num_dynamic = v.subbox.num_dynamic;
+    }
+    r->subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
+                       " frame(s) too short for static evidence (min_evidence_frames): " +
+                       (recalled > 0 ? "the last vote of " + std::to_string(recalled) +
+                                           " tracked box(es) kept, the box rule elsewhere"
+                                     : std::string("the box rule decides"));
+  } else if (options.subbox_requires_fit_outside_boxes && !geometric.fit_outside_boxes &&
+             std::any_of(semantic.in_dyn_box.begin(), semantic.in_dyn_box.end(),
+                         [](std::uint8_t f) { return f != 0; })) {
+    r->subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
+                       "its evidence inside the boxes is not trusted";
+  } else {
+    const FeatureLabel* evidence = geometric.labels.data();
+    if (options.use_coherent_motion) {
+      if (!r->reprojection.ran() || geometric.reprojection.residual_vec.size() != n) {
+        r->coherent_motion.reason = "needs the reprojection check's residuals (use_reprojection, points_3d)";
+      } else {
+        CoherentMotionOptions<T> co = options.coherent_motion;
+        co.grid = options.subbox.grid;  // the cells the vote will count
+        // High-level objects only: a candidate (a chair) stays verified on its own evidence.
+        v.coherent_eligible.resize(n);
+        for (std::size_t i = 0; i < n; ++i) v.coherent_eligible[i] = semantic_labels[i] == FeatureLabel::Dynamic;
+        v.evidence.assign(geometric.labels.begin(), geometric.labels.end());
+        v.coherent_ran = true;
+        evidence = v.evidence.data();
+        flag_coherent_cells(kp, geometric.reprojection.residual_vec.data(), regions.dyn_boxes,
+                            geometric.reprojection.inlier_noise_px, co, v.evidence.data(), &v.coherent, in_object,
+                            box_bits, v.coherent_eligible.data());
+        r->coherent_motion.status = v.coherent.status;
+        r->coherent_motion.reason = v.coherent.reason;
+        r->coherent_motion.num_dynamic = v.coherent.num_flagged;
+      }
+    }
+    const bool memory = options.subbox_memory_frames > 0 && options.use_box_tracker && r->tracker.ran() &&
+                        frame.track_ids && frame.track_ids->size() == n;
+    if (memory) {
+      memory_store->recall(regions.dyn_box_track_id, options.subbox.grid, frame_index, options.subbox_memory_frames,
+                           &v.remembered_cells);
+      memory_store->update_tracks(*frame.track_ids, evidence, frame_index, options.subbox_memory_frames,
+                                  &v.memory_eligible);
+    }
+    refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits,
+                    memory ? v.remembered_cells.data() : nullptr, memory ? v.memory_eligible.data() : nullptr);
+    if (memory && v.subbox.ok())
+      memory_store->remember(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
+                             options.subbox_memory_frames);
+    if (options.short_baseline_keeps_last_vote && options.min_evidence_frames > 0 && options.use_box_tracker &&
+        r->tracker.ran() && v.subbox.ok())
+      memory_store->remember_states(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
+                                    options.min_evidence_frames);
+    r->subbox.status = v.subbox.status;
+    r->subbox.reason = v.subbox.reason;
+    r->subbox.num_dynamic = v.subbox.num_dynamic;
+    if (options.subbox_memory_frames > 0 && !memory && v.subbox.ok())
+      r->subbox.reason = "sub-box memory off this frame: it needs the box tracker and CullingFrame::track_ids";
+  }
+  v.ok = r->subbox.ran();
+}
+
+}  // namespace detail
+}  // namespace dyncull

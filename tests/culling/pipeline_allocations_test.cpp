@@ -1,0 +1,102 @@
+// Counts the heap allocations cull_frame makes per frame after warm-up, for the recommended preset and
+// each paper's, on a synthetic sequence (a counting global operator new in this executable only).
+// g++ cannot see that every operator new of this file is malloc and pairs it with a sized delete.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+
+#include "dyncull/culling/pipeline.hpp"
+#include "dyncull/culling/presets.hpp"
+
+#include "support/culling_scenes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+namespace {
+std::atomic<std::size_t> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return ::operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace dyncull {
+namespace {
+
+struct Frame {
+  test::CullingScene<float> scene;
+  std::vector<Detection<float>> detections;
+  std::vector<std::int64_t> ids;
+};
+
+/// Allocations of each frame after `warmup` frames of the same sequence replayed (same sizes each round).
+std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& options, const std::vector<Frame>& seq,
+                                               int warmup_rounds) {
+  PipelineState<float> state;
+  std::vector<std::size_t> counts;
+  for (int round = 0; round <= warmup_rounds; ++round) {
+    for (std::size_t k = 0; k < seq.size(); ++k) {
+      const Frame& f = seq[k];
+      CullingFrame<float, std::vector<Vec2<float>>> frame;
+      frame.keypoints = &f.scene.keypoints;
+      frame.prev_keypoints = &f.scene.prev_keypoints;
+      frame.track_valid = f.scene.track_valid;
+      frame.track_ids = &f.ids;
+      frame.points_3d = &f.scene.prev_points_world;
+      frame.detections = &f.detections;
+      frame.depth = f.scene.depth_view();
+      frame.camera = f.scene.camera;
+      frame.cam_from_world = &f.scene.cam_from_world;
+      frame.is_keyframe = k == 0;
+      frame.evidence_frames = 2;
+      const std::size_t before = g_allocations.load();
+      cull_frame(frame, options, &state);
+      if (round == warmup_rounds) counts.push_back(g_allocations.load() - before);
+    }
+  }
+  return counts;
+}
+
+TEST(PipelineAllocations, CountedPerFrameAfterWarmUp) {
+  std::vector<Frame> seq;
+  for (int k = 0; k < 3; ++k) {
+    test::SceneConfig config;
+    config.seed = 300 + static_cast<std::uint64_t>(k);
+    Frame f;
+    f.scene = test::make_culling_scene<float>(config);
+    for (const auto& d : f.scene.detections) f.detections.push_back(d);
+    for (std::size_t i = 0; i < f.scene.size(); ++i) f.ids.push_back(static_cast<std::int64_t>(i));
+    seq.push_back(std::move(f));
+  }
+  struct Named {
+    const char* name;
+    PipelineOptions<float> options;
+  };
+  const Named all[] = {{"recommended", presets::recommended<float>()}, {"dld_slam", presets::dld_slam<float>()},
+                       {"rtd_slam", presets::rtd_slam<float>()},       {"zhu_2024", presets::zhu_2024<float>()},
+                       {"dfd_slam", presets::dfd_slam<float>()},       {"zhang_2023", presets::zhang_2023<float>()}};
+  for (const Named& p : all) {
+    const std::vector<std::size_t> counts = allocations_per_frame(p.options, seq, 3);
+    std::size_t most = 0;
+    for (std::size_t c : counts) most = std::max(most, c);
+    std::printf("%-12s allocations per frame after warm-up: at most %zu\n", p.name, most);
+    RecordProperty(p.name, static_cast<int>(most));
+  }
+}
+
+}  // namespace
+}  // namespace dyncull
