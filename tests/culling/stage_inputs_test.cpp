@@ -68,6 +68,22 @@ int maybe_wild_int(Random& rng, int normal) {
   }
 }
 
+/// A box with a wild corner in [x_lo, x_hi] x [y_lo, y_hi] and wild extents up to w_hi, h_hi (may be
+/// inverted, empty or non-finite).
+template <class T>
+Box<T> wild_box(Random& rng, double x_lo, double x_hi, double y_lo, double y_hi, double w_hi, double h_hi) {
+  const T x0 = wild<T>(rng, x_lo, x_hi), y0 = wild<T>(rng, y_lo, y_hi);
+  return Box<T>{x0, y0, x0 + wild<T>(rng, 0, w_hi), y0 + wild<T>(rng, 0, h_hi)};
+}
+
+/// The options fail validate() with InvalidInput and a reason that names the field.
+template <class Options>
+void expect_names_field(const Options& o, const char* field) {
+  std::string why;
+  EXPECT_EQ(o.validate(&why), Status::InvalidInput) << field;
+  EXPECT_NE(why.find(field), std::string::npos) << why;
+}
+
 // ---- multi-view check ----
 
 TYPED_TEST(StageInputsTest, MultiViewRejectsFewerDepthsThanPoints) {
@@ -97,12 +113,10 @@ TYPED_TEST(StageInputsTest, MultiViewOptionsNameTheBadField) {
   MultiViewOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
   o.search_radius_px = INT_MAX;
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("search_radius_px"), std::string::npos) << why;
+  expect_names_field(o, "search_radius_px");
   o = MultiViewOptions<T>{};
   o.max_parallax_deg = std::numeric_limits<T>::quiet_NaN();
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("max_parallax_deg"), std::string::npos) << why;
+  expect_names_field(o, "max_parallax_deg");
 }
 
 TYPED_TEST(StageInputsTest, MultiViewPropertyStatusOrFiniteOutputs) {
@@ -210,12 +224,10 @@ TYPED_TEST(StageInputsTest, SubBoxOptionsNameTheBadField) {
   SubBoxOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
   o.dilation_radius_px = INT_MAX;
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("dilation_radius_px"), std::string::npos) << why;
+  expect_names_field(o, "dilation_radius_px");
   o = SubBoxOptions<T>{};
   o.sigma1 = std::numeric_limits<T>::quiet_NaN();
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("sigma1"), std::string::npos) << why;
+  expect_names_field(o, "sigma1");
   std::vector<Vec2<T>> points(3, Vec2<T>(T(1), T(1)));
   std::vector<FeatureLabel> labels(3, FeatureLabel::Dynamic);
   const auto r = refine_subboxes(points, labels.data(), std::vector<Box<T>>{}, o);
@@ -267,10 +279,7 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
       geo[i] = static_cast<FeatureLabel>(rng.index(3));
     }
     std::vector<Box<T>> boxes(nb);
-    for (auto& b : boxes) {
-      const T x0 = wild<T>(rng, -20, 100), y0 = wild<T>(rng, -20, 80);
-      b = Box<T>{x0, y0, x0 + wild<T>(rng, 0, 60), y0 + wild<T>(rng, 0, 60)};
-    }
+    for (auto& b : boxes) b = wild_box<T>(rng, -20, 100, -20, 80, 60, 60);
     SubBoxOptions<T> o;
     o.grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
     o.sigma1 = maybe_wild(rng, T(0.5));
@@ -337,8 +346,7 @@ TEST(DepthMaskInputs, OptionsNameTheBadField) {
   DepthMaskOptions o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
   o.histogram_max_m = 1e12;
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("histogram_max_m"), std::string::npos) << why;
+  expect_names_field(o, "histogram_max_m");
   o = DepthMaskOptions{};
   o.histogram_bin_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
@@ -396,10 +404,7 @@ void depth_mask_property(std::uint64_t seed) {
     if (rng.index(6) == 0) view.max_m = wild<float>(rng, 0, 10);
     const std::size_t nb = rng.index(4), n = rng.index(40);
     std::vector<Box<double>> boxes(nb);
-    for (auto& b : boxes) {
-      const double x0 = wild<double>(rng, -10, w), y0 = wild<double>(rng, -10, h);
-      b = Box<double>{x0, y0, x0 + wild<double>(rng, 0, w), y0 + wild<double>(rng, 0, h)};
-    }
+    for (auto& b : boxes) b = wild_box<double>(rng, -10, w, -10, h, w, h);
     std::vector<Vec2<double>> points(n);
     for (auto& p : points) p = Vec2<double>(wild<double>(rng, 0, w), wild<double>(rng, 0, h));
     DepthMaskOptions o;
@@ -454,8 +459,7 @@ TYPED_TEST(StageInputsTest, MovingConsistencyBoundsRefitIterations) {
   MovingConsistencyOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
   o.refit_iterations = 1000000;
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("refit_iterations"), std::string::npos) << why;
+  expect_names_field(o, "refit_iterations");
   std::vector<Vec2<T>> a(40), b(40);
   Random rng(3);
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -558,12 +562,10 @@ TYPED_TEST(StageInputsTest, ReprojectionOptionsNameTheBadField) {
   ReprojectionCheckOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
   o.min_noise_px = -std::numeric_limits<T>::infinity();
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("min_noise_px"), std::string::npos) << why;
+  expect_names_field(o, "min_noise_px");
   o = ReprojectionCheckOptions<T>{};
   o.pnp.ransac.max_iterations = 0;
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("pnp"), std::string::npos) << why;
+  expect_names_field(o, "pnp");
 }
 
 // ---- coherent motion, dynamic probability, static history, sub-box memory ----
@@ -582,10 +584,7 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
       labels[i] = static_cast<FeatureLabel>(rng.index(3));
     }
     std::vector<Box<T>> boxes(nb);
-    for (auto& b : boxes) {
-      const T x0 = wild<T>(rng, -10, 90), y0 = wild<T>(rng, -10, 90);
-      b = Box<T>{x0, y0, x0 + wild<T>(rng, 0, 80), y0 + wild<T>(rng, 0, 80)};
-    }
+    for (auto& b : boxes) b = wild_box<T>(rng, -10, 90, -10, 90, 80, 80);
     CoherentMotionOptions<T> o;
     o.grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
     o.min_points = rng.index(6);
@@ -650,12 +649,10 @@ TYPED_TEST(StageInputsTest, StaticHistoryOptionsNameTheBadField) {
   StaticHistoryOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
   o.min_frames = 70000;
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("min_frames"), std::string::npos) << why;
+  expect_names_field(o, "min_frames");
   o = StaticHistoryOptions<T>{};
   o.max_residual_px = std::numeric_limits<T>::quiet_NaN();
-  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("max_residual_px"), std::string::npos) << why;
+  expect_names_field(o, "max_residual_px");
 }
 
 TEST(SubBoxMemoryInputs, GridOutsideItsRangeRecallsNothing) {
