@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Regenerates docs/results.md: the scene-family suite (scripts/demo.sh: every preset against no culling and
+# the oracle) and the ablation table of the recommended preset (scripts/ablation.sh), with the machine, the
+# compiler, the commit and the commands that produced them.
+#   scripts/results.sh [--out DIR] [--page FILE]      runs both (about 15 + 30 minutes on two free cores)
+#   scripts/results.sh --suite DIR --ablation DIR      only the page, from earlier runs' output directories
+# DIR defaults to ./results_out, FILE to docs/results.md. Each run directory gets a run_info.txt (machine,
+# compiler, commit, command, wall time) that the page quotes.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+out=results_out
+page="$root/docs/results.md"
+suite=""
+ablation=""
+while (($#)); do
+  case "$1" in
+    --out) out=$2; shift 2 ;;
+    --page) page=$2; shift 2 ;;
+    --suite) suite=$2; shift 2 ;;
+    --ablation) ablation=$2; shift 2 ;;
+    *) echo "results.sh: unknown argument '$1' (see the comment at the top of $0)" >&2; exit 2 ;;
+  esac
+done
+
+# Runs one command, then records what ran it where: the page cites this file, not the memory of a person.
+run_recorded() {
+  local dir=$1 shown=$2; shift 2
+  mkdir -p "$dir"
+  local start end
+  start=$(date +%s)
+  "$@"
+  end=$(date +%s)
+  local build="${DYNCULL_DEMO_BUILD:-$root/build/demo}"
+  local compiler
+  compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt" 2>/dev/null || true)
+  {
+    echo "machine: $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores"
+    echo "compiler: $("${compiler:-c++}" --version | head -1), CMAKE_BUILD_TYPE=Release"
+    echo "commit: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet HEAD -- include examples || echo ' (with local changes)')"
+    echo "command: $shown"
+    echo "wall time: $((end - start)) s"
+  } >"$dir/run_info.txt"
+}
+
+if [[ -z "$suite" ]]; then
+  suite="$out/suite"
+  run_recorded "$suite" "scripts/demo.sh --suite --jobs ${DYNCULL_JOBS:-$(nproc)}" "$root/scripts/demo.sh" --suite --jobs "${DYNCULL_JOBS:-$(nproc)}" --out "$suite"
+fi
+if [[ -z "$ablation" ]]; then
+  ablation="$out/ablation"
+  run_recorded "$ablation" "scripts/ablation.sh" "$root/scripts/ablation.sh" --out "$ablation"
+fi
+for f in "$suite/family_summary.md" "$suite/family_summary.csv" "$ablation/ablation.md"; do
+  [[ -f "$f" ]] || { echo "results.sh: $f is missing (run without --suite / --ablation to produce it)" >&2; exit 1; }
+done
+
+# What the families and the ablation rows are, as the binary that ran them describes them.
+vo="${DYNCULL_DEMO_BUILD:-$root/build/demo}/examples/dynamic_vo"
+if [[ -x "$vo" ]]; then
+  "$vo" --help | awk '/^scene families/ { on = 1; next } on && /^$/ { on = 0 } on' >"$suite/families.txt"
+  "$vo" --list | awk '$1 ~ /^recommended-no_/' | sed 's/ *(ablation).*//' >"$ablation/strategies.txt"
+fi
+
+python3 "$root/scripts/results_page.py" "$suite" "$ablation" >"$page"
+echo "results.sh: wrote $page"
