@@ -3,7 +3,7 @@
 # Idempotent: installs only what is missing, so CI and repeated runs cost a few seconds.
 set -euo pipefail
 
-packages=(g++ clang cmake make pkg-config libeigen3-dev libopencv-dev libceres-dev
+packages=(g++ clang cmake make pkg-config libeigen3-dev libopencv-dev libceres-dev doxygen graphviz
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev locales)
 # Open3D is an optional benchmark peer (ICP); set DYNCULL_WITH_OPEN3D=1 to install it.
 if [[ "${DYNCULL_WITH_OPEN3D:-0}" == 1 ]]; then packages+=(libopen3d-dev); fi

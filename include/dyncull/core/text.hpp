@@ -129,7 +129,7 @@ inline NumberStatus parse_python_float(std::string_view token, double* out) {
 }
 
 /// A bad token for a reason: at most `max_chars` characters between single quotes, bytes outside
-/// printable ASCII (and the quote and backslash) as \xHH, then "... (N bytes)" when cut.
+/// printable ASCII (and the quote and backslash) as `\xHH`, then "... (N bytes)" when cut.
 inline std::string quote_token(std::string_view token, std::size_t max_chars = kQuotedTokenChars) {
   static const char* const kHex = "0123456789abcdef";
   std::string out = "'";

@@ -384,7 +384,7 @@ class RansacRunner {
 ///   using Model = ...; using Scalar = float|double;
 ///   static constexpr int kSampleSize; static constexpr int kMaxModels;
 ///   std::size_t num_data() const;
-///   int minimal_solve(const std::uint32_t* sample, Model* models) const;   // returns #models written
+///   int minimal_solve(const std::uint32_t* sample, Model* models) const;   // returns the number of models written
 ///   void residuals_sq(const Model& m, Scalar* out) const;                   // all data, contiguous
 ///   bool refit(const std::uint32_t* inliers, std::size_t n, Model* model) const;
 ///   optional: bool is_sample_good(const std::uint32_t* sample) const;
