@@ -104,7 +104,7 @@ void BM_Pipeline_RecommendedWithPointsAndMemory(benchmark::State& state) {
 }
 BENCHMARK(BM_Pipeline_RecommendedWithPointsAndMemory)->Unit(benchmark::kMicrosecond);
 
-// The multi-view check (left out of the recommended preset since session 5) verifying the candidates.
+// The multi-view check (left out of the recommended preset: it only verifies candidates there) on top.
 void BM_Pipeline_RecommendedPlusMultiView(benchmark::State& state) {
   PipelineOptions<float> o = presets::recommended<float>();
   o.use_multiview = true;

@@ -33,11 +33,8 @@ struct FrontEndOptions {
   int min_feature_distance_px = 10;   ///< new corners keep this far from tracked ones ...
   /// ... and, at a keyframe, from the tracks the culling removed in that frame: otherwise the budget
   /// freed by dropping them is spent on new corners on the same mover, which the culling then sees with
-  /// a one-frame baseline only (a keyframe resets every track's reference). Measured on the sim,
-  /// `dynamic_vo` seeds 1-12, four sequences: recommended preset summed ATE static / xyz / rpy /
-  /// halfsphere 12.2 / 27.7 / 30.0 / 30.8 -> 10.0 / 17.2 / 29.1 / 30.2 cm, oracle 5.2 / 14.5 / 19.4 /
-  /// 24.6 -> 4.8 / 13.0 / 15.7 / 19.1 cm; label recall up to 0.06 lower (docs/results.md, session 10).
-  /// No effect without culling.
+  /// a one-frame baseline only (a keyframe resets every track's reference). Lowers the ATE with culling
+  /// (figures in docs/results.md); no effect without culling.
   bool detect_away_from_culled = true;
   int border_px = 12;                 ///< no features this close to the edge (Kinect depth band, LK window)
   float min_depth_m = 0.4f;           ///< TUM sensor's reliable range
@@ -45,12 +42,9 @@ struct FrontEndOptions {
   float max_depth_step_ratio = 0.05f; ///< reject corners near depth edges: a step above this fraction ...
   /// ... within this radius (sampled every 2 px beyond 2; 1 = the 3x3 neighbourhood). A corner whose LK
   /// window straddles an occlusion edge tracks the contour (a T-junction), not a 3-D point, and the
-  /// epipolar check flags it although its surface is static. Measured on the sim (dynamic_vo --seeds
-  /// 1,2,3, the recommended preset of commit d189c7e, xyz / rpy / halfsphere): label precision 0.68 /
-  /// 0.92 / 0.66 at 1, 0.79 / 0.95 / 0.73 at 6, 0.85 / 0.97 / 0.80 at 8, 0.93 / 0.98 / 0.85 at 10, recall
-  /// 0.71-0.81 throughout; but with fewer corners the VO itself gets weaker (no-culling and oracle ATE
-  /// up on static and rpy, docs/results.md), so the default stays 1, and the preset now discounts flags
-  /// on depth edges instead (PipelineOptions::edge_evidence_radius_px).
+  /// epipolar check flags it although its surface is static. A larger radius raises label precision but
+  /// leaves fewer corners and a weaker VO, so the default is 1 and the culling discounts flags on depth
+  /// edges instead (PipelineOptions::edge_evidence_radius_px).
   int depth_edge_radius_px = 1;
   int lk_window_px = 21;              ///< LK window and pyramid depth (PRIOR_ART: 21 px, 3-5 levels)
   int lk_levels = 3;
@@ -62,11 +56,8 @@ struct FrontEndOptions {
   /// ... and beyond it against the keyframe image warped by the predicted rotation since the keyframe
   /// (the homography K R K^-1 of a point at infinity; what is left, parallax and the prediction's error, is
   /// a shift LK handles). Without it the tracks of a turning camera (rpy: up to 0.8 deg a frame) are not
-  /// refined from 5 deg on and their LK error adds up again. Measured on the sim, `dynamic_vo --sequences
-  /// rpy --seeds 1-6`, oracle culling: median ATE 2.64 -> 1.31 cm (better on 5 of 6 seeds), recommended
-  /// preset 4.22 -> 2.41 cm; static, xyz and halfsphere hardly ever turn 5 deg from their keyframe (one
-  /// run each changed); the front end costs 0.7 ms more per rpy frame (0.4-1.3 ms; docs/results.md).
-  /// (Warping from 2 deg on was no better on rpy and worse on halfsphere: the resampled patch is blurred.)
+  /// refined from 5 deg on and their LK error adds up again (on the sim's rpy sequence it halves the ATE
+  /// for 0.7 ms per frame). Below 5 deg the unwarped patch does as well or better: a warped one is blurred.
   bool refine_rotation_compensated = true;
   double pnp_threshold_px = 2.0;      ///< reprojection inlier threshold of PnP-RANSAC
   double track_max_error_px = 4.0;    ///< tracks (kept or culled) further than this from their point's
@@ -76,11 +67,8 @@ struct FrontEndOptions {
   double keyframe_min_tracked_ratio = 0.5;  ///< ... or fewer tracks than this share of the keyframe's ...
   double keyframe_max_translation_m = 0.1;  ///< ... or the camera moved this far from the keyframe ...
   double keyframe_max_rotation_deg = 15.0;  ///< ... or turned this much.
-  // keyframe_max_translation_m was 0.2 m until session 11. Measured on the sim, `dynamic_vo` seeds 1-12,
-  // four sequences, 0.2 -> 0.1 m: oracle summed ATE static / xyz / rpy / halfsphere 4.8 / 13.0 / 15.7 /
-  // 19.1 -> 4.8 / 12.9 / 15.7 / 16.5 cm; recommended preset 7.8 / 18.1 / 21.8 / 26.2 -> 7.8 / 17.1 / 21.8 /
-  // 24.6 cm, its halfsphere precision 0.88-0.90 -> 0.91-0.92; 15-18 % more keyframes on xyz and
-  // halfsphere. 0.15 m and 0.07 m were no better (docs/results.md, session 11).
+  // 0.1 m rather than 0.2 m: shorter keyframe baselines lower the ATE on the translating sequences (xyz,
+  // halfsphere) for 15-18 % more keyframes.
   std::uint64_t seed = 7;             ///< PnP-RANSAC seed (deterministic runs)
 };
 

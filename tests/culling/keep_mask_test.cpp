@@ -65,7 +65,7 @@ TEST(KeepMask, CompactsEveryParallelArrayTogether) {
 
 TEST(KeepMask, MismatchedSizesTouchNothing) {
   std::vector<int> a = {1, 2, 3, 4, 5};
-  std::vector<int> b = {1, 2, 3};  // the forgotten "N" of ORB-SLAM3 issue #815
+  std::vector<int> b = {1, 2, 3};  // an array left unshrunk, like ORB-SLAM3's N in forks
   const CompactResult r = compact_parallel(make_keep_mask(kLabels), a, b);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_FALSE(r.reason.empty());

@@ -66,7 +66,7 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_EQ(o.min_survivors, 30u);
   EXPECT_FLOAT_EQ(o.detections.box_padding_px, 5.f);
   EXPECT_DOUBLE_EQ(o.depth_mask.eps_m, 0.5);  // 000's range is 0.3-0.5 m; see the test below
-  EXPECT_EQ(o.static_history.min_frames, 6);  // session 17 (docs/results.md)
+  EXPECT_EQ(o.static_history.min_frames, 6);  // docs/results.md
   EXPECT_FLOAT_EQ(o.static_history.max_residual_px, 0.8f);
 }
 

@@ -50,7 +50,7 @@ bool run_short_xyz(int frames, const std::vector<vo::StrategySpec>& strategies, 
 
 // 45 frames of the sim's xyz walking sequence, where the two slow walkers crossing close to the
 // camera pull the un-culled front end off (measured: 106 mm ATE after 1.5 s, `dynamic_vo --sequences xyz
-// --frames 45 --seeds 1`, session 11): the recommended preset must cut that ATE by a clear margin
+// --frames 45 --seeds 1`): the recommended preset must cut that ATE by a clear margin
 // (measured 4.1 mm, -96 %) and label most moving features (measured precision 0.97, recall 0.97; over
 // 300 frames recall and, but for rpy, precision are below the 0.9 target, see docs/results.md; the
 // bounds here guard against regressions, not the target).

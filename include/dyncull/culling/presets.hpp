@@ -1,6 +1,7 @@
 /// @file presets.hpp
-/// Pipeline configurations reproducing each seed paper (000 DLD-SLAM, 001 RTD-SLAM, 002 Zhu et al.,
-/// 003 DFD-SLAM, 004 Zhang et al.) and the recommended combination (reasons in the comments and docs).
+/// Pipeline configurations reproducing each source paper (000 DLD-SLAM, Yu et al. 2024; 001 RTD-SLAM, Gao
+/// et al. 2024; 002 Zhu et al. 2024; 003 DFD-SLAM, Qian et al. 2024; 004 Zhang et al. 2023; numbered as in
+/// docs/algorithms.md) and the recommended combination (reasons in the comments, figures in docs/results.md).
 #pragma once
 
 #include "dyncull/culling/pipeline.hpp"
