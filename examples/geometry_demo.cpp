@@ -1,7 +1,7 @@
 // geometry_demo: dyncull's geometry on synthetic data, side by side with OpenCV.
 //   F-RANSAC    dyncull::estimate_fundamental_ransac  vs cv::findFundamentalMat(USAC_FAST)
 //   PnP-RANSAC  dyncull::solve_pnp_ransac             vs cv::solvePnPRansac(SOLVEPNP_P3P)
-//   rotation    dyncull::estimate_rotation_centre (seed 003 Algorithm 2; no OpenCV equivalent)
+//   rotation    dyncull::estimate_rotation_centre (DFD-SLAM, Qian et al. 2024, Algorithm 2; no OpenCV equivalent)
 // Data: 640x480 pinhole camera (fx = fy = 535), 0.5 px noise, 30 % outliers (20 % for the rotation).
 // Times are medians over repeated runs of one thread on this machine; accuracy is against the truth.
 // Usage: geometry_demo [num_points=1000] [repeats=15]
@@ -245,7 +245,7 @@ void rotation_demo(int repeats) {
   dyncull::RotationCentreOptions cauchy = huber;
   cauchy.loss = dyncull::RobustLoss::Cauchy;
   run("IRLS Cauchy 2 px", cauchy);
-  print_table("Frame rotation (seed 003 Alg. 2), 500 flow vectors, 25 deg about (340, 230), 20 % translating", rows);
+  print_table("Frame rotation (DFD-SLAM Alg. 2), 500 flow vectors, 25 deg about (340, 230), 20 % translating", rows);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Descriptor matching for the seed 003 §3.3 switch: our brute-force Hamming (256-bit ORB) and L2
+// Descriptor matching for the DFD-SLAM (Qian et al. 2024) §3.3 switch: our brute-force Hamming (256-bit ORB) and L2
 // (256-float learned) matchers against cv::BFMatcher, and the eq. 18 keyframe search (4096 floats)
 // against a cv::norm loop. Counter `agree` = fraction of queries whose match equals OpenCV's.
 #include "dyncull/culling/descriptor_switch.hpp"

@@ -1,5 +1,5 @@
-// Multi-view depth check (seed 001 §III.A, DynaSLAM) on a keyframe of 600 points 8 frames back against
-// a 640x480 depth image: the check against its floor (transform + project + one depth read per point),
+// Multi-view depth check (RTD-SLAM, Gao et al. 2024, §III.A; DynaSLAM) on a keyframe of 600 points 8 frames back
+// against a 640x480 depth image: the check against its floor (transform + project + one depth read per point),
 // and the region growing of the dynamic seeds against cv::floodFill (fixed range, 4-connected) on the
 // same seeds and tolerance.
 #include "dyncull/culling/multiview_check.hpp"

@@ -1,4 +1,4 @@
-// The small fixed-size BFGS (seed 003 eq. 10-14) on two standard problems against Ceres'
+// The small fixed-size BFGS (DFD-SLAM, Qian et al. 2024, eq. 10-14) on two standard problems against Ceres'
 // GradientProblemSolver with the BFGS direction, same start, same objective code: the 2-D Rosenbrock
 // function from (-1.2, 1) and a 6-D ill-conditioned quadratic (condition number 1e4).
 // Counters: iterations, evaluations, and distance to the known minimiser.

@@ -1,5 +1,5 @@
-// Epipolar distances for 1000 correspondences: ours (batch seed 003 eq. 3, Sampson, thresholded labels;
-// float and double) vs cv::computeCorrespondEpilines plus the point-line distance loop.
+// Epipolar distances for 1000 correspondences: ours (batch eq. 3 of DFD-SLAM, Qian et al. 2024; Sampson;
+// thresholded labels; float and double) vs cv::computeCorrespondEpilines plus the point-line distance loop.
 #include "dyncull/geometry/epipolar.hpp"
 
 #include "support/two_view.hpp"
@@ -19,7 +19,7 @@ namespace {
 using dyncull::Mat3;
 
 #ifdef DYNCULL_HAS_OPENCV
-// One thread for every peer (PERFORMANCE.md): OpenCV's parallel_for would otherwise hide wall time
+// One thread for every peer: OpenCV's parallel_for would otherwise hide wall time
 // behind other cores, and the machine is shared.
 [[maybe_unused]] const int kSingleThread = [] {
   cv::setNumThreads(1);

@@ -20,7 +20,7 @@ namespace {
 using dyncull::Mat3;
 
 #ifdef DYNCULL_HAS_OPENCV
-// One thread for every peer (PERFORMANCE.md): OpenCV's parallel_for would otherwise hide wall time
+// One thread for every peer: OpenCV's parallel_for would otherwise hide wall time
 // behind other cores, and the machine is shared.
 [[maybe_unused]] const int kSingleThread = [] {
   cv::setNumThreads(1);

@@ -23,7 +23,7 @@ using dyncull::test::make_pnp_scene;
 using dyncull::test::rotation_error_deg;
 using dyncull::test::translation_error;
 
-constexpr int kScenes = 8;  // several data sets: RANSAC time depends on the data (PERFORMANCE.md)
+constexpr int kScenes = 8;  // several data sets: RANSAC time depends on the data
 
 template <class T>
 std::vector<dyncull::test::PnpScene<T>> scenes(int n) {

@@ -1,4 +1,4 @@
-// Rotation centre (seed 003 Algorithm 2) on 500 noisy flow vectors: our exact 2x2 solve and our BFGS
+// Rotation centre (DFD-SLAM, Qian et al. 2024, Algorithm 2) on 500 noisy flow vectors: our exact 2x2 solve and our BFGS
 // against Ceres' GradientProblemSolver (BFGS) on the same normalised bisectors, from the image centre.
 // Counters: distance to the tightly converged Ceres minimiser (px) and to the true centre (px).
 #include "dyncull/geometry/rotation_centre.hpp"

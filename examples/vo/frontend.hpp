@@ -46,7 +46,7 @@ struct FrontEndOptions {
   /// leaves fewer corners and a weaker VO, so the default is 1 and the culling discounts flags on depth
   /// edges instead (PipelineOptions::edge_evidence_radius_px).
   int depth_edge_radius_px = 1;
-  int lk_window_px = 21;              ///< LK window and pyramid depth (PRIOR_ART: 21 px, 3-5 levels)
+  int lk_window_px = 21;              ///< LK window and pyramid depth (dynamic ORB-SLAM forks: 21 px, 3-5 levels)
   int lk_levels = 3;
   /// Re-track every feature from its keyframe image, starting at the frame-to-frame LK result, so its
   /// position error does not accumulate frame after frame (see track()).

@@ -39,7 +39,7 @@ TYPED_TEST(CameraTest, ProjectBackprojectRoundTrip) {
 
 TYPED_TEST(CameraTest, UsesFyForY) {
   using T = TypeParam;
-  // fx != fy exposes the seed 002 eq. 6 typo (y divided by fx).
+  // fx != fy exposes the typo of Zhu et al. (2024) eq. 6 (y divided by fx).
   const dyncull::PinholeCamera<T> cam{T(500), T(600), T(320), T(240), 640, 480};
   const dyncull::Vec3<T> p = cam.backproject(dyncull::Vec2<T>(320, 300), T(2));
   EXPECT_NEAR(p.y(), T(60) * T(2) / T(600), T(1e-6));

@@ -1,4 +1,5 @@
-// Tests of culling/descriptor_switch.hpp: the 20° switch (seed 003 eq. 17), Hamming and L2 distances,
+// Tests of culling/descriptor_switch.hpp: the 20° switch (DFD-SLAM, Qian et al. 2024, eq. 17), Hamming and L2
+// distances,
 // brute-force matchers against a naive oracle (and cv::BFMatcher when OpenCV is present), ratio test,
 // cross-check, strides, and the eq. 18 nearest-keyframe search.
 #include "dyncull/culling/descriptor_switch.hpp"

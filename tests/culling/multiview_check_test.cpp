@@ -1,4 +1,4 @@
-// Tests of the multi-view depth check (seed 001 §III.A) on ray-cast scenes with known motion.
+// Tests of the multi-view depth check (RTD-SLAM, Gao et al. 2024, §III.A) on ray-cast scenes with known motion.
 #include "dyncull/culling/multiview_check.hpp"
 
 #include "support/culling_scenes.hpp"

@@ -1,5 +1,5 @@
-// Tests of geometry/epipolar.hpp: seed 003 eq. 3 distance, symmetric and Sampson distances, batch kernels
-// against a scalar double-precision oracle, thresholded labels, and cv::computeCorrespondEpilines.
+// Tests of geometry/epipolar.hpp: DFD-SLAM (Qian et al. 2024) eq. 3 distance, symmetric and Sampson distances,
+// batch kernels against a scalar double-precision oracle, thresholded labels, and cv::computeCorrespondEpilines.
 #include "dyncull/geometry/epipolar.hpp"
 
 #include "support/two_view.hpp"

@@ -1,4 +1,4 @@
-// Tests of geometry/rotation_centre.hpp (seed 003 Algorithm 2): exact centre and angle on synthetic
+// Tests of geometry/rotation_centre.hpp (DFD-SLAM, Qian et al. 2024, Algorithm 2): exact centre and angle on synthetic
 // rotations, agreement of the normal equations, BFGS and Ceres, robust losses against outlier flow,
 // and every "no rotation" reason (translation, zoom, too few, NaN, size mismatch).
 #include "dyncull/geometry/rotation_centre.hpp"

@@ -54,7 +54,7 @@ TEST(SimActors, MovingFlagsFollowWhatMoves) {
       const auto id = static_cast<std::uint16_t>(SceneInstance::kWalkerA + w);
       EXPECT_GT(m[id].moving, 0u) << "walker " << w << " t " << t;
     }
-    // Seed 003's Figure 8 case: the seated person's legs stay, the upper body moves.
+    // The case of DFD-SLAM's Figure 8 (Qian et al. 2024): the seated person's legs stay, the upper body moves.
     EXPECT_GT(m[SceneInstance::kSittingPerson].moving, 0u);
     EXPECT_GT(m[SceneInstance::kSittingPerson].still, 0u);
   }

@@ -46,7 +46,7 @@ const std::uint16_t kClutter[] = {SceneInstance::kMonitorA,  SceneInstance::kMon
                                   SceneInstance::kBottle,    SceneInstance::kCup,      SceneInstance::kBook,
                                   SceneInstance::kLaptop};
 
-TEST(SimDeskScene, NewInstancesMapToTheirCocoClasses) {
+TEST(SimDeskScene, DeskAndWalkerInstancesMapToTheirCocoClasses) {
   EXPECT_EQ(instance_class(SceneInstance::kDeskPersonA), CocoClass::kPerson);
   EXPECT_EQ(instance_class(SceneInstance::kDeskPersonB), CocoClass::kPerson);
   EXPECT_EQ(instance_class(SceneInstance::kDeskChairA), CocoClass::kChair);
@@ -66,7 +66,7 @@ TEST(SimDeskScene, NewInstancesMapToTheirCocoClasses) {
   for (int id = 1; id < SceneInstance::kCount; ++id) EXPECT_GE(instance_class(static_cast<std::uint16_t>(id)), 0) << id;
 }
 
-TEST(SimDeskScene, DefaultSceneHasNoneOfTheNewActors) {
+TEST(SimDeskScene, DefaultSceneHasNoDeskActorsOrExtraWalkers) {
   std::vector<Primitive> prims;
   build_scene(2.0, kDt, 1, ActorOptions{}, &prims);
   for (const Primitive& p : prims) EXPECT_LE(p.instance, SceneInstance::kTv);

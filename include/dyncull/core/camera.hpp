@@ -1,6 +1,6 @@
 /// @file camera.hpp
 /// Pinhole camera without distortion (TUM RGB-D images are given undistorted or nearly so):
-/// u = fx x/z + cx, v = fy y/z + cy, and its inverse for a known depth (seed 002 eq. 5-6, with fy
+/// u = fx x/z + cx, v = fy y/z + cy, and its inverse for a known depth (Zhu et al. 2024, eq. 5-6, with fy
 /// for y where the paper's eq. 6 has a typo dividing by fx).
 #pragma once
 

@@ -80,7 +80,7 @@ using detection_scalar_t = std::decay_t<decltype(std::declval<const Dets&>()[std
 constexpr std::uint8_t kInHigh = 1, kInMedium = 2, kInLow = 4, kNonFinite = 8;
 
 /// flags[i] |= bit when point i lies in the box: branch-free over structure-of-arrays points,
-/// bounds in locals so the store to flags cannot alias them (PERFORMANCE.md).
+/// bounds in locals so the store to flags cannot alias them (g++ would reload them per point).
 template <class T>
 void mark_points_in_box(const T* xs, const T* ys, std::size_t begin, std::size_t n, const Box<T>& box,
                         std::uint8_t bit, std::uint8_t* flags) {

@@ -1,7 +1,7 @@
 /// @file descriptor_switch.hpp
-/// Descriptor choice after the frame-rotation estimate (seed 003 §3.3: above 20° match ORB by Hamming
-/// distance, below learned descriptors by L2, eq. 17), brute-force matchers for both, and the nearest
-/// keyframes by L2 distance of global descriptors (§3.4, eq. 18).
+/// Descriptor choice after the frame-rotation estimate (DFD-SLAM, Qian et al. 2024, §3.3: above 20° match
+/// ORB by Hamming distance, below learned descriptors by L2, eq. 17), brute-force matchers for both, and
+/// the nearest keyframes by L2 distance of global descriptors (§3.4, eq. 18).
 #pragma once
 
 #include "dyncull/core/status.hpp"

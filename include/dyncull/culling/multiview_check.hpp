@@ -1,6 +1,7 @@
 /// @file multiview_check.hpp
-/// Multi-view depth check (seed 001 §III.A, after DynaSLAM): keyframe keypoints are back-projected with
-/// their depth, moved by the relative pose and projected; d_proj - d' > tau_d marks a moving surface at x'.
+/// Multi-view depth check (RTD-SLAM, Gao et al. 2024, §III.A, after DynaSLAM): keyframe keypoints are
+/// back-projected with their depth, moved by the relative pose and projected; d_proj - d' > tau_d marks a
+/// moving surface at x'.
 #pragma once
 
 #include "dyncull/core/box.hpp"
@@ -25,12 +26,12 @@
 
 namespace dyncull {
 
-/// Options of the multi-view check. Defaults follow seed 001 (30 deg, 0.4 m) and DynaSLAM's code
+/// Options of the multi-view check. Defaults follow RTD-SLAM (30 deg, 0.4 m) and DynaSLAM's code
 /// for what the paper leaves out (depth gates 6 m / 7 m, region growing 0.2 m).
 template <class T>
 struct MultiViewOptions {
   T max_parallax_deg = T(30);        ///< skip points whose viewing rays differ more (occlusion, not motion)
-  T depth_threshold_m = T(0.4);      ///< tau_d of seed 001 (DynaSLAM's code uses 0.6)
+  T depth_threshold_m = T(0.4);      ///< tau_d of RTD-SLAM (DynaSLAM's code uses 0.6)
   int search_radius_px = 2;          ///< d' is the valid depth closest to d_proj in a (2r+1)^2 window (DynaSLAM: 20)
   T max_reference_depth_m = T(6);    ///< keyframe keypoints deeper than this are not used (DynaSLAM)
   T max_projected_depth_m = T(7);    ///< projections deeper than this are not used (DynaSLAM)
@@ -252,7 +253,7 @@ void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>
     }
     r.outcome[i] = MultiViewOutcome::Checked;
     ++r.num_checked;
-    // Something now in front of the remembered surface: the thing at x' moved there (seed 001).
+    // Something now in front of the remembered surface: the thing at x' moved there (RTD-SLAM).
     if (X_cur.z() - measured > options.depth_threshold_m) {
       r.labels[i] = FeatureLabel::Dynamic;
       ++r.num_dynamic;

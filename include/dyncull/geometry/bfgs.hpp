@@ -1,6 +1,6 @@
 /// @file bfgs.hpp
 /// Small fixed-size BFGS minimiser (Nocedal & Wright Alg. 6.1) with an Armijo backtracking line search
-/// that interpolates and extrapolates; the inverse-Hessian update is seed 003 eq. 10-14.
+/// that interpolates and extrapolates; the inverse-Hessian update is eq. 10-14 of DFD-SLAM (Qian et al. 2024).
 #pragma once
 
 #include "dyncull/core/status.hpp"

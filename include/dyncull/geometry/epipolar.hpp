@@ -1,6 +1,7 @@
 /// @file epipolar.hpp
-/// Epipolar lines and distances for a fundamental matrix F (x2^T F x1 = 0): seed 003 eq. 3 point-to-line
-/// distance D = |p2^T F p1| / sqrt(X^2 + Y^2), (X, Y, Z) = F p1; symmetric (HZ eq. 11.10) and Sampson (HZ eq. 11.9).
+/// Epipolar lines and distances for a fundamental matrix F (x2^T F x1 = 0): the point-to-line distance of
+/// DFD-SLAM (Qian et al. 2024) eq. 3, D = |p2^T F p1| / sqrt(X^2 + Y^2), (X, Y, Z) = F p1; symmetric
+/// (Hartley & Zisserman eq. 11.10) and Sampson (HZ eq. 11.9).
 #pragma once
 
 #include "dyncull/core/status.hpp"
@@ -39,7 +40,7 @@ Vec3<T> epipolar_line_in_first(const Mat3<T>& F, const P2& p2) {
   return F.transpose() * Vec3<T>(point_x<T>(p2), point_y<T>(p2), T(1));
 }
 
-/// Seed 003 eq. 3: distance in pixels of p2 to the line F p1. NaN when the line is undefined
+/// DFD-SLAM eq. 3: distance in pixels of p2 to the line F p1. NaN when the line is undefined
 /// (p1 at the epipole, X = Y = 0) or the input is not finite.
 template <class T, class P1, class P2>
 T epipolar_distance(const Mat3<T>& F, const P1& p1, const P2& p2) {
@@ -87,7 +88,7 @@ template <class T> using ConstArrayMap = Eigen::Map<const Eigen::Array<T, Eigen:
 
 /// Which distance a batch call writes.
 enum class EpipolarDistance : std::uint8_t {
-  PointToLine,       ///< seed 003 eq. 3, px (one-sided, in image 2)
+  PointToLine,       ///< DFD-SLAM eq. 3, px (one-sided, in image 2)
   PointToLineSq,     ///< its square, px^2
   SymmetricSq,       ///< HZ eq. 11.10, px^2
   SampsonSq,         ///< HZ eq. 11.9, px^2
@@ -129,7 +130,7 @@ void epipolar_distances_soa(const Mat3<T>& F, const T* x1, const T* y1, const T*
   }
 }
 
-/// Labels without sqrt or division: out[i] = 1 when the seed 003 eq. 3 distance exceeds `threshold_px`,
+/// Labels without sqrt or division: out[i] = 1 when the DFD-SLAM eq. 3 distance exceeds `threshold_px`,
 /// i.e. (p2^T F p1)^2 > t^2 (X^2 + Y^2). Non-finite values give 0 (no evidence of motion). Returns the count of 1s.
 template <class T>
 std::size_t label_epipolar_soa(const Mat3<T>& F, const T* x1, const T* y1, const T* x2, const T* y2, std::size_t n,
@@ -148,7 +149,7 @@ std::size_t label_epipolar_soa(const Mat3<T>& F, const T* x1, const T* y1, const
     const auto Z = F(2, 0) * u1 + F(2, 1) * v1 + F(2, 2);
     detail::ArrayMap<T>(lhs, N) = (u2 * X + v2 * Y + Z).square();
     detail::ArrayMap<T>(rhs, N) = t2 * (X.square() + Y.square());
-    // Local pointer copies: the uint8 store must not alias the bound (PERFORMANCE.md).
+    // Local pointer copies: the uint8 store must not alias the bound, or g++ reloads it every iteration.
     std::uint8_t* dst = out + begin;
     for (std::size_t i = 0; i < len; ++i) {
       const std::uint8_t v = static_cast<std::uint8_t>(lhs[i] > rhs[i]);
@@ -232,7 +233,7 @@ void load_block(const C& points, std::size_t begin, std::size_t len, T* x, T* y)
   }
 }
 
-/// Seed 003 eq. 3 straight from packed (x, y) pairs, in one pass: the block copy of for_each_soa_block
+/// DFD-SLAM eq. 3 straight from packed (x, y) pairs, in one pass: the block copy of for_each_soa_block
 /// cost as much as the arithmetic (double, 1000 points: 0.62x -> 0.40x of OpenCV's epilines + distance
 /// at -O3, docs/benchmarks.md). Same operations in the same order as epipolar_distances_soa (tested equal).
 template <class T>
@@ -376,7 +377,7 @@ Status symmetric_epipolar_distances_sq(const Mat3<T>& F, const C1& points1, cons
   return epipolar_distances(F, points1, points2, out, EpipolarDistance::SymmetricSq);
 }
 
-/// Thresholded labels (1 = seed 003 eq. 3 distance above `threshold_px`) for corresponding containers,
+/// Thresholded labels (1 = DFD-SLAM eq. 3 distance above `threshold_px`) for corresponding containers,
 /// without sqrt or division. `labels` holds points1.size() bytes; `count` (optional) receives the number of 1s.
 /// Statuses as epipolar_distances (F normalised first), and InvalidInput for a threshold that is negative
 /// or not finite (labels all 0 on any failure but a size mismatch). Non-finite points get 0.

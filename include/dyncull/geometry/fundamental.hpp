@@ -1,5 +1,6 @@
 /// @file fundamental.hpp
-/// Fundamental matrix x2^T F x1 = 0 (seed 003 eq. 1-2): Hartley-normalised 8-point with rank 2 enforced,
+/// Fundamental matrix x2^T F x1 = 0 (DFD-SLAM, Qian et al. 2024, eq. 1-2): Hartley-normalised 8-point with
+/// rank 2 enforced,
 /// the 7-point minimal solver (cubic det constraint, up to 3 solutions) and LO-RANSAC on Sampson error (px).
 #pragma once
 
@@ -32,7 +33,7 @@ template <class T>
 struct FundamentalOptions {
   /// ransac.max_residual is the Sampson distance threshold in pixels (not squared). Sampson is the
   /// first-order reprojection error of the correspondence in both images; for an error in image 2 only it is
-  /// about the seed 003 eq. 3 distance / sqrt(2).
+  /// about the DFD-SLAM eq. 3 distance / sqrt(2).
   RansacOptions ransac{};
   /// LO refit weights each 8-point row by 1 / (Sampson denominator) of the current model, so the algebraic
   /// least squares approximates least squares on Sampson error (Torr's reweighting). false: plain 8-point.

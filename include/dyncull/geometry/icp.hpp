@@ -1,6 +1,6 @@
 /// @file icp.hpp
 /// Point-to-point ICP (Besl & McKay 1992): nearest neighbours from a static k-d tree, Umeyama/Kabsch
-/// closed form per iteration (ALGORITHMS.md §8, seed 002 §2 eq. 4); Open3D's convergence criteria.
+/// closed form per iteration (Zhu et al. 2024, §2 eq. 4); Open3D's convergence criteria.
 #pragma once
 
 #include "dyncull/core/status.hpp"

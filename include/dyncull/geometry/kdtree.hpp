@@ -1,6 +1,6 @@
 /// @file kdtree.hpp
 /// Static 3-D k-d tree for exact nearest-neighbour queries (Friedman-Bentley-Finkel 1977; the
-/// correspondence search of point-to-point ICP, ALGORITHMS.md §8). Built once, allocation-free queries.
+/// correspondence search of point-to-point ICP). Built once, allocation-free queries.
 #pragma once
 
 #include "dyncull/core/status.hpp"

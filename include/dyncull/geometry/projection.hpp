@@ -1,6 +1,6 @@
 /// @file projection.hpp
 /// Batch pinhole projection and back-projection, depth image to point cloud with dynamic pixels masked
-/// out (seed 002 eq. 5-6, with fy for y: the paper's eq. 6 divides y by fx, a typo), voxel downsampling.
+/// out (Zhu et al. 2024, eq. 5-6, with fy for y: the paper's eq. 6 divides y by fx, a typo), voxel downsampling.
 #pragma once
 
 #include "dyncull/core/camera.hpp"

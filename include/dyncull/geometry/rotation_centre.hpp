@@ -1,7 +1,7 @@
 /// @file rotation_centre.hpp
-/// In-plane frame rotation from optical flow, seed 003 §3.3 Algorithm 2: perpendicular bisectors of the
-/// flow vectors (eq. 4), the centre OP minimising eq. 5 (exact 2x2 normal equations by default, BFGS of
-/// eq. 6-14 or IRLS for robust losses), the equidistance filter (eq. 15) and the mean angle (eq. 16).
+/// In-plane frame rotation from optical flow, DFD-SLAM (Qian et al. 2024) §3.3 Algorithm 2: perpendicular
+/// bisectors of the flow vectors (eq. 4), the centre OP minimising eq. 5 (exact 2x2 normal equations by
+/// default, BFGS of eq. 6-14 or IRLS for robust losses), the equidistance filter (eq. 15) and the mean angle (eq. 16).
 #pragma once
 
 #include "dyncull/core/status.hpp"
