@@ -11,7 +11,7 @@ if(DOXYGEN_FOUND)
   endif()
   configure_file("${CMAKE_CURRENT_SOURCE_DIR}/docs/Doxyfile.in" "${DYNCULL_DOC_OUTPUT_DIR}/Doxyfile" @ONLY)
   file(GLOB_RECURSE _dyncull_doc_inputs CONFIGURE_DEPENDS
-    "${CMAKE_CURRENT_SOURCE_DIR}/include/dyncull/*.hpp")
+    "${CMAKE_CURRENT_SOURCE_DIR}/include/dyncull/*.hpp" "${CMAKE_CURRENT_SOURCE_DIR}/docs/*.md")
   add_custom_command(
     OUTPUT "${DYNCULL_DOC_OUTPUT_DIR}/doxygen.stamp"
     COMMAND "${CMAKE_COMMAND}" -E remove -f "${DYNCULL_DOC_OUTPUT_DIR}/doxygen.stamp"
