@@ -97,6 +97,15 @@ PipelineResult<T> fresh_result(const PipelineOptions<T>& options, std::size_t n)
   return r;
 }
 
+/// An enabled stage that did not run for lack of an input of the frame, and whose reason names that input
+/// (as CullingFrame names it).
+inline void expect_lacks_input(const StageReport& stage, const char* input) {
+  EXPECT_TRUE(stage.enabled);
+  EXPECT_FALSE(stage.ran());
+  EXPECT_NE(stage.status, Status::Ok);
+  EXPECT_NE(stage.reason.find(input), std::string::npos) << stage.reason;
+}
+
 /// Appends the bytes of values (no padding in any type passed here).
 class Bytes {
  public:

@@ -120,9 +120,7 @@ TYPED_TEST(BoxesStageTest, WithoutDetectionsTheFilterSaysSoAndNoRegionIsLeft) {
   w.regions.dyn_boxes.resize(2);
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::collect_boxes(f.frame(), o, &tracker, &w.regions, &r);
-  EXPECT_TRUE(r.detections.enabled);
-  EXPECT_FALSE(r.detections.ran());
-  EXPECT_EQ(r.detections.reason, "no detections given");
+  test::expect_lacks_input(r.detections, "detections");
   EXPECT_TRUE(w.regions.boxes.empty());
   EXPECT_TRUE(w.regions.dyn_boxes.empty());
   EXPECT_TRUE(w.regions.dyn_box_track_id.empty());

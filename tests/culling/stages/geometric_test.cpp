@@ -146,25 +146,8 @@ TYPED_TEST(GeometricStageTest, WithoutTracksOrPointsEachCheckSaysWhatItLacked) {
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::gather_geometric_evidence(f.frame(), o, w.regions, w.semantic, &w.geometric, &r);
   EXPECT_FALSE(w.geometric.ok);
-  EXPECT_TRUE(r.moving_consistency.enabled);
-  EXPECT_FALSE(r.moving_consistency.ran());
-  EXPECT_EQ(r.moving_consistency.reason, "no previous-frame positions (tracks) given");
-  EXPECT_TRUE(r.reprojection.enabled);
-  EXPECT_FALSE(r.reprojection.ran());
-  EXPECT_EQ(r.reprojection.reason, "no 3-D points (CullingFrame::points_3d) given");
-}
-
-TYPED_TEST(GeometricStageTest, TracksOfAnotherLengthAreNotRead) {
-  using T = TypeParam;
-  auto f = moving_tracks<T>();
-  f.prev_keypoints.pop_back();
-  const PipelineOptions<T> o;
-  detail::PipelineWork<T> w;
-  PipelineResult<T> r = test::fresh_result(o, f.size());
-  detail::gather_geometric_evidence(f.frame(), o, w.regions, w.semantic, &w.geometric, &r);
-  EXPECT_FALSE(w.geometric.ok);
-  EXPECT_FALSE(r.moving_consistency.ran());
-  EXPECT_EQ(r.moving_consistency.reason, "prev_keypoints has 79 positions for 80 keypoints");
+  test::expect_lacks_input(r.moving_consistency, "prev_keypoints");
+  test::expect_lacks_input(r.reprojection, "points_3d");
 }
 
 }  // namespace

@@ -157,9 +157,7 @@ TYPED_TEST(ProbabilityStageTest, WithoutTracksItSaysSoAndDecidesNothing) {
   TrackStateStore store;
   detail::score_probability(f.frame(), o, w.regions, w.semantic, w.geometric, &store, &w.probability, &r);
   EXPECT_FALSE(w.probability.ok);
-  EXPECT_TRUE(r.probability.enabled);
-  EXPECT_FALSE(r.probability.ran());
-  EXPECT_EQ(r.probability.reason, "no previous-frame positions (tracks) given");
+  test::expect_lacks_input(r.probability, "prev_keypoints");
 }
 
 TYPED_TEST(ProbabilityStageTest, DisabledLeavesItsEvidenceInvalid) {

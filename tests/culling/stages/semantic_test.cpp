@@ -130,9 +130,7 @@ TYPED_TEST(SemanticStageTest, WithoutDepthTheMaskSaysSoAndTheBoxRuleStands) {
   w.regions = regions_of(f);
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::classify_by_boxes(f.frame(), o, w.regions, &w.semantic, &r);
-  EXPECT_TRUE(r.depth_mask.enabled);
-  EXPECT_FALSE(r.depth_mask.ran());
-  EXPECT_EQ(r.depth_mask.reason, "no depth image");
+  test::expect_lacks_input(r.depth_mask, "depth");
   EXPECT_FALSE(w.semantic.masks);
   EXPECT_EQ(w.semantic.labels, (std::vector<L>{L::Dynamic, L::Dynamic, L::Static, L::Candidate, L::Static, L::Dynamic}));
 }
