@@ -1,0 +1,573 @@
+/// @file culler.hpp
+/// A stateful culler that owns the evidence the culling pipeline (pipeline.hpp) reads against a reference
+/// keyframe: correspondences of each frame's keypoints to the keyframe's by guided descriptor matching
+/// (keyframe_matcher.hpp; Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-B), the keyframe's 3-D points
+/// back-projected from its depth (pinhole, x = z K^-1 u), stable track ids, frames since the keyframe and
+/// a keyframe policy. The host gives plain views per frame (keypoints, descriptors, depth, boxes, pose)
+/// and gets a keep mask, labels, reasons and a status naming any input the configuration lacked.
+///
+/// API:
+///   Culler<float> culler(camera);                        // PinholeCamera, no default intrinsics
+///   CullerFrame<float> f;  f.keypoints = points_view(keys);  f.descriptors = ...;  f.depth_m = ...;
+///   f.detections = &boxes;  f.cam_from_world = &predicted;  // each optional, see Culler::inputs()
+///   const CullerResult& r = culler.cull(f);               // r.keep[i]: 1 = static, parallel to keys
+#pragma once
+
+#include "dyncull/core/camera.hpp"
+#include "dyncull/core/depth.hpp"
+#include "dyncull/core/status.hpp"
+#include "dyncull/core/traits.hpp"
+#include "dyncull/core/types.hpp"
+#include "dyncull/culling/keyframe_matcher.hpp"
+#include "dyncull/culling/pipeline.hpp"
+#include "dyncull/culling/presets.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace dyncull {
+
+/// Read-only (u, v) pixel positions: point i's x at data + i * stride_bytes, its y right after it, both
+/// float or double. Built by points_view() from a contiguous container (cv::KeyPoint, cv::Point2f/d, Eigen
+/// 2-vectors, any struct with float/double x, y) or by hand from a pointer and a count. `given` tells an
+/// absent input from an empty one.
+struct PointsView {
+  const void* data = nullptr;
+  std::size_t count = 0;
+  std::size_t stride_bytes = 0;  ///< 0 means two packed scalars
+  bool is_double = false;
+  bool given = false;
+
+  static PointsView of(const float* xy, std::size_t n, std::size_t stride_bytes_ = 0) {
+    return PointsView{xy, n, stride_bytes_, false, true};
+  }
+  static PointsView of(const double* xy, std::size_t n, std::size_t stride_bytes_ = 0) {
+    return PointsView{xy, n, stride_bytes_, true, true};
+  }
+  std::size_t stride() const { return stride_bytes ? stride_bytes : (is_double ? 2 * sizeof(double) : 2 * sizeof(float)); }
+  double x(std::size_t i) const { return read(i, 0); }
+  double y(std::size_t i) const { return read(i, 1); }
+
+ private:
+  double read(std::size_t i, std::size_t k) const {
+    const unsigned char* p = static_cast<const unsigned char*>(data) + i * stride();
+    if (is_double) {
+      double v;
+      std::memcpy(&v, p + k * sizeof(double), sizeof v);
+      return v;
+    }
+    float v;
+    std::memcpy(&v, p + k * sizeof(float), sizeof v);
+    return static_cast<double>(v);
+  }
+};
+
+namespace detail {
+template <class P, class = void> struct culler_xy_address;
+template <class P>
+struct culler_xy_address<P, std::enable_if_t<has_pt_member<P>::value && !has_xy_members<P>::value>> {
+  static const auto* x(const P& p) { return &p.pt.x; }
+  static const auto* y(const P& p) { return &p.pt.y; }
+};
+template <class P>
+struct culler_xy_address<P, std::enable_if_t<has_xy_members<P>::value && !is_eigen_vec2<P>::value>> {
+  static const auto* x(const P& p) { return &p.x; }
+  static const auto* y(const P& p) { return &p.y; }
+};
+template <class P>
+struct culler_xy_address<P, std::enable_if_t<is_eigen_vec2<P>::value>> {
+  static const auto* x(const P& p) { return p.data(); }
+  static const auto* y(const P& p) { return p.data() + 1; }
+};
+}  // namespace detail
+
+/// PointsView over a contiguous container (std::vector, std::array) of points whose x and y are adjacent
+/// float or double members (cv::KeyPoint's pt, cv::Point2f/d, Eigen 2-vectors). The container must outlive
+/// the view and not be resized while the view is used.
+template <class Container>
+PointsView points_view(const Container& points) {
+  using P = std::decay_t<decltype(*points.data())>;
+  using A = detail::culler_xy_address<P>;
+  using S = std::remove_cv_t<std::remove_pointer_t<decltype(A::x(std::declval<const P&>()))>>;
+  static_assert(std::is_same<S, float>::value || std::is_same<S, double>::value,
+                "dyncull::points_view: point coordinates must be float or double");
+  PointsView v;
+  v.given = true;
+  v.is_double = std::is_same<S, double>::value;
+  v.count = static_cast<std::size_t>(points.size());
+  v.stride_bytes = sizeof(P);
+  if (v.count == 0) return v;
+  const P& first = points.data()[0];
+  v.data = A::x(first);
+  // x and y must be adjacent (every type above lays them out so); anything else is read as no points.
+  if (reinterpret_cast<const unsigned char*>(A::y(first)) != reinterpret_cast<const unsigned char*>(A::x(first)) + sizeof(S))
+    v.data = nullptr, v.count = 0;
+  return v;
+}
+
+/// Which inputs a configuration reads (Culler::inputs) or a frame lacked (CullerResult::missing).
+struct CullerInputs {
+  bool keypoints = false;
+  bool descriptors = false;  ///< to match the keyframe (not needed when the host gives keyframe_match)
+  bool depth = false;
+  bool detections = false;
+  bool pose = false;         ///< predicted cam_from_world
+
+  bool any() const { return keypoints || descriptors || depth || detections || pose; }
+  /// Comma-separated names, e.g. "keypoints, descriptors, depth".
+  std::string names() const {
+    std::string s;
+    auto add = [&](bool on, const char* name) {
+      if (!on) return;
+      if (!s.empty()) s += ", ";
+      s += name;
+    };
+    add(keypoints, "keypoints");
+    add(descriptors, "descriptors");
+    add(depth, "depth");
+    add(detections, "detections");
+    add(pose, "pose");
+    return s;
+  }
+};
+
+/// Who decides when the current frame becomes the reference keyframe.
+enum class KeyframePolicy : std::uint8_t {
+  Own = 0,  ///< the culler: pose moved or turned past a threshold, or too few keypoints matched the keyframe
+  Host,     ///< the host sets CullerFrame::is_keyframe (its own keyframes); the first frame always is one
+};
+
+template <class T>
+struct CullerOptions {
+  PipelineOptions<T> pipeline = presets::recommended<T>();
+  KeyframePolicy keyframe_policy = KeyframePolicy::Own;
+  /// Own policy: a new keyframe when the predicted pose is further than this from the keyframe's ...
+  /// (the demo front end's 0.1 m: shorter baselines lowered its ATE on translating sequences)
+  double keyframe_max_translation_m = 0.1;
+  double keyframe_max_rotation_deg = 15.0;   ///< ... or turned more than this ...
+  /// ... or fewer than this share of the keyframe's keypoints matched (the demo's 0.5 of its tracks).
+  double keyframe_min_matched_ratio = 0.5;
+  KeyframeMatchOptions matching{};
+  /// Keyframe depth used for its 3-D points: the TUM sensor's reliable range, and no point within
+  /// depth_edge_radius_px of a depth step above max_depth_step_ratio (it back-projects half on the object,
+  /// half behind it). Radius 0 switches the edge test off.
+  float min_depth_m = 0.4f;
+  float max_depth_m = 8.f;
+  int depth_edge_radius_px = 1;
+  double max_depth_step_ratio = 0.05;
+  /// The camera has lens distortion: every frame must carry CullerFrame::undistorted_keypoints, which the
+  /// geometry (matching, epipolar and reprojection checks, back-projection) uses.
+  bool camera_has_distortion = false;
+
+  /// Ok, or InvalidInput with the reason naming the field ("pipeline." / "matching." for nested ones).
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const std::string& why) {
+      if (reason) *reason = "CullerOptions: " + why;
+      return Status::InvalidInput;
+    };
+    std::string why;
+    if (pipeline.validate(&why) != Status::Ok) return bad("pipeline." + why);
+    if (matching.validate(&why) != Status::Ok) return bad("matching: " + why);
+    if (static_cast<int>(keyframe_policy) > 1) return bad("keyframe_policy must be Own or Host");
+    if (!(keyframe_max_translation_m > 0) || !std::isfinite(keyframe_max_translation_m))
+      return bad("keyframe_max_translation_m must be positive and finite");
+    if (!(keyframe_max_rotation_deg > 0 && keyframe_max_rotation_deg <= 180))
+      return bad("keyframe_max_rotation_deg must be in (0, 180]");
+    if (!(keyframe_min_matched_ratio >= 0 && keyframe_min_matched_ratio <= 1))
+      return bad("keyframe_min_matched_ratio must be in [0, 1]");
+    if (!(min_depth_m >= 0.f) || !std::isfinite(min_depth_m) || !(max_depth_m > min_depth_m))
+      return bad("min_depth_m must be finite and >= 0, max_depth_m above it");
+    if (depth_edge_radius_px < 0 || depth_edge_radius_px > 64) return bad("depth_edge_radius_px must be in [0, 64]");
+    if (!(max_depth_step_ratio >= 0) || !std::isfinite(max_depth_step_ratio))
+      return bad("max_depth_step_ratio must be finite and >= 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// One frame as the host has it: views it keeps valid during Culler::cull. All per-keypoint inputs are
+/// parallel to `keypoints`.
+template <class T>
+struct CullerFrame {
+  PointsView keypoints;              ///< image pixels, as detected
+  PointsView undistorted_keypoints;  ///< required when CullerOptions::camera_has_distortion
+  DescriptorRows descriptors;        ///< one row per keypoint (data null: not given)
+  DepthView<float> depth_m;          ///< depth in metres, or ...
+  DepthView<std::uint16_t> depth_raw;  ///< ... raw uint16 with units_per_metre (TUM: 5000); neither: monocular
+  const std::vector<Detection<T>>* detections = nullptr;  ///< pixel boxes after NMS (empty: none seen)
+  const Rigid3<T>* cam_from_world = nullptr;  ///< predicted pose (a motion model is enough)
+  /// Host's correspondences: per keypoint the index of its match among the keypoints of the culler's
+  /// keyframe (the frame CullerResult::keyframe last reported), -1 for none. Given: no own matching.
+  const int* keyframe_match = nullptr;
+  bool is_keyframe = false;  ///< KeyframePolicy::Host: this frame becomes the reference after culling
+};
+
+/// Outcome of one frame; vectors parallel to the frame's keypoints.
+struct CullerResult {
+  /// Ok; InvalidInput / NonFinite (nothing culled: every keep is 1) when an input cannot be read or the
+  /// arrays disagree in size; MissingInput when an input the configuration reads is missing (`missing`),
+  /// or the pipeline could not run a stage (the first frame has no keyframe to track against): the stages
+  /// that need it did not run and the others culled.
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+
+  std::vector<std::uint8_t> keep;     ///< 1 = static: apply to every parallel array of the host
+  std::vector<FeatureLabel> labels;   ///< Static or Dynamic
+  std::vector<CullReason> reasons;    ///< deciding stage (None for untouched statics)
+  std::vector<std::int64_t> track_ids;  ///< the keyframe point's id when matched, else a new id
+  std::size_t num_features = 0, num_kept = 0;
+  std::size_t matched = 0;            ///< keypoints matched to the keyframe
+  int frames_since_keyframe = 0;      ///< baseline of this frame's evidence (0: no keyframe yet)
+  bool keyframe = false;              ///< this frame became the reference keyframe
+  CullerInputs missing;               ///< inputs the configuration reads that this frame lacked
+};
+
+/// Owns the reference keyframe and the pipeline state; one per camera stream. Not thread-safe.
+template <class T>
+class Culler {
+ public:
+  static_assert(std::is_floating_point<T>::value, "dyncull::Culler: T is float or double");
+
+  /// `camera`: the pinhole model of the (undistorted) keypoints; an invalid camera or options make every
+  /// cull() return InvalidInput with the reason (status() says it at once).
+  explicit Culler(const PinholeCamera<T>& camera, const CullerOptions<T>& options = CullerOptions<T>())
+      : camera_(camera), options_(options) {
+    if (!camera_.valid()) {
+      status_ = Status::InvalidInput;
+      reason_ = "camera: needs finite, positive focal lengths, a finite principal point and a positive image size "
+                "(no default intrinsics)";
+    } else {
+      status_ = options_.validate(&reason_);
+    }
+  }
+
+  Status status() const { return status_; }
+  const std::string& reason() const { return reason_; }
+  const CullerOptions<T>& options() const { return options_; }
+  const PinholeCamera<T>& camera() const { return camera_; }
+
+  /// The inputs this configuration reads; a frame lacking one gets a non-Ok status naming it.
+  CullerInputs inputs() const { return inputs_of(options_); }
+
+  static CullerInputs inputs_of(const CullerOptions<T>& o) {
+    const PipelineOptions<T>& p = o.pipeline;
+    CullerInputs in;
+    in.keypoints = true;
+    const bool tracks = p.use_moving_consistency || p.use_reprojection || p.use_probability || p.use_subbox ||
+                        p.static_history.min_frames > 0;
+    in.descriptors = tracks;
+    in.depth = p.use_depth_mask || p.use_reprojection || p.use_multiview || p.edge_evidence_radius_px > 0 ||
+               p.low_override_by_depth || p.assign_overlaps_by_depth;
+    in.detections = p.use_box_rule || p.use_depth_mask || p.use_probability || p.use_subbox || p.use_box_tracker;
+    in.pose = p.use_reprojection || p.use_multiview || (tracks && o.keyframe_policy == KeyframePolicy::Own);
+    return in;
+  }
+
+  /// Culls one frame and, when the policy says so, makes it the reference keyframe. The result is valid
+  /// until the next call.
+  const CullerResult& cull(const CullerFrame<T>& f) {
+    CullerResult& r = result_;
+    r.status = Status::Ok;
+    r.reason.clear();
+    r.missing = CullerInputs{};
+    r.matched = 0;
+    r.keyframe = false;
+    const std::size_t n = f.keypoints.given ? f.keypoints.count : 0;
+    r.num_features = n;
+    r.frames_since_keyframe = have_keyframe_ ? frames_since_keyframe_ + 1 : 0;
+    std::string why;
+    Status s = check_frame(f, n, &why);
+    if (s != Status::Ok) return refuse(s, why, n);
+
+    // Positions the geometry reads: undistorted when given.
+    const PointsView& geo = f.undistorted_keypoints.given ? f.undistorted_keypoints : f.keypoints;
+    cur_px_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) cur_px_[i] = Vec2<T>(static_cast<T>(geo.x(i)), static_cast<T>(geo.y(i)));
+
+    const CullerInputs need = inputs();
+    const bool have_depth = !f.depth_m.empty() || !f.depth_raw.empty();
+    const bool have_pose = f.cam_from_world != nullptr;
+    r.missing.depth = need.depth && !have_depth;
+    r.missing.detections = need.detections && f.detections == nullptr;
+    r.missing.descriptors = need.descriptors && f.descriptors.data == nullptr && f.keyframe_match == nullptr;
+    r.missing.pose = need.pose && !have_pose;
+    const Rigid3<T> pose = have_pose ? *f.cam_from_world : (have_keyframe_ ? keyframe_pose_ : Rigid3<T>::identity());
+
+    // Correspondences to the keyframe, and from them the evidence arrays.
+    const T nan = std::numeric_limits<T>::quiet_NaN();
+    prev_px_.assign(n, Vec2<T>(nan, nan));
+    valid_.assign(n, 0);
+    points_world_.assign(n, Vec3<T>(nan, nan, nan));
+    r.track_ids.resize(n);
+    if (have_keyframe_) {
+      if (f.keyframe_match) {
+        // check_frame copied and range-checked them into match_index_.
+      } else if (f.descriptors.data != nullptr && keyframe_desc_rows_ > 0) {
+        const Rigid3<T> cam_from_keyframe = pose * keyframe_pose_.inverse();
+        match_to_keyframe(keyframe_px_, keyframe_cam_points_,
+                          DescriptorRows(keyframe_desc_.data(), keyframe_desc_rows_, 0, keyframe_row_bytes_), cur_px_,
+                          f.descriptors, camera_, have_pose ? &cam_from_keyframe : nullptr, options_.matching,
+                          match_ws_, &match_);
+        if (match_.status == Status::InvalidInput || match_.status == Status::NonFinite)
+          return refuse(match_.status, match_.reason, n);
+      } else {
+        match_.keyframe_index.assign(n, -1);
+      }
+    }
+    const std::vector<int>& m = f.keyframe_match || !have_keyframe_ ? match_index_ : match_.keyframe_index;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int k = have_keyframe_ ? m[i] : -1;
+      if (k >= 0) {
+        const std::size_t ku = static_cast<std::size_t>(k);
+        prev_px_[i] = keyframe_px_[ku];
+        valid_[i] = 1;
+        points_world_[i] = keyframe_world_points_[ku];
+        r.track_ids[i] = keyframe_ids_[ku];
+        ++r.matched;
+      } else {
+        r.track_ids[i] = next_id_++;
+      }
+    }
+
+    // Keyframe decision before the pipeline: its multi-view store takes this frame's static features.
+    bool new_keyframe = !have_keyframe_;
+    if (have_keyframe_ && options_.keyframe_policy == KeyframePolicy::Host) new_keyframe = f.is_keyframe;
+    if (have_keyframe_ && options_.keyframe_policy == KeyframePolicy::Own) {
+      const Rigid3<T> rel = pose * keyframe_pose_.inverse();
+      const double moved = static_cast<double>(rel.t.norm());
+      const double turned = static_cast<double>(rotation_angle(rel.R)) * Constants<double>::rad_to_deg();
+      const double base = static_cast<double>(keyframe_px_.size() < n ? keyframe_px_.size() : n);
+      new_keyframe = moved > options_.keyframe_max_translation_m || turned > options_.keyframe_max_rotation_deg ||
+                     static_cast<double>(r.matched) < options_.keyframe_min_matched_ratio * base;
+    }
+
+    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, float, std::vector<Vec3<T>>> pf;
+    pf.keypoints = &cur_px_;
+    if (have_keyframe_) {
+      pf.prev_keypoints = &prev_px_;
+      pf.track_valid = valid_;
+      // Without a pose the residuals of the 3-D points would be the camera's own motion.
+      if (have_pose && keyframe_has_depth_) pf.points_3d = &points_world_;
+      pf.evidence_frames = r.frames_since_keyframe;
+    }
+    pf.track_ids = &r.track_ids;
+    pf.detections = f.detections;
+    pf.camera = camera_;
+    pf.cam_from_world = have_pose ? &pose : nullptr;
+    pf.is_keyframe = new_keyframe;
+    const PipelineResult<T>* pr = nullptr;
+    if (!f.depth_raw.empty()) {
+      CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t, std::vector<Vec3<T>>> pu;
+      copy_frame(pf, &pu);
+      pu.depth = f.depth_raw;
+      pr = &cull_frame(pu, options_.pipeline, &state_);
+    } else {
+      pf.depth = f.depth_m;
+      pr = &cull_frame(pf, options_.pipeline, &state_);
+    }
+    r.keep = pr->keep;
+    r.labels = pr->labels;
+    r.reasons = pr->reasons;
+    r.num_kept = 0;
+    for (std::uint8_t k : r.keep) r.num_kept += k != 0;
+    describe(*pr, have_pose, have_depth, &r);
+
+    if (new_keyframe && pr->keep.size() == n) {
+      if (!f.depth_raw.empty())
+        store_keyframe(f, f.depth_raw, pose);
+      else
+        store_keyframe(f, f.depth_m, pose);
+      r.keyframe = true;
+    } else if (have_keyframe_) {
+      ++frames_since_keyframe_;
+    }
+    return r;
+  }
+
+  /// The last cull()'s result.
+  const CullerResult& result() const { return result_; }
+  /// The pipeline's full result of the last cull() (per-stage reports, traces).
+  const PipelineResult<T>& pipeline_result() const { return state_.result; }
+  /// Keypoints of the reference keyframe (geometry positions), in the order CullerFrame::keyframe_match indexes.
+  const std::vector<Vec2<T>>& keyframe_keypoints() const { return keyframe_px_; }
+  bool has_keyframe() const { return have_keyframe_; }
+
+ private:
+  /// InvalidInput / NonFinite with the reason naming the input, or Ok.
+  Status check_frame(const CullerFrame<T>& f, std::size_t n, std::string* why) {
+    if (status_ != Status::Ok) return (*why = reason_, status_);
+    if (!f.keypoints.given) return (*why = "missing input: keypoints", Status::InvalidInput);
+    if (n > 0 && f.keypoints.data == nullptr) return (*why = "keypoints: null data with a count", Status::InvalidInput);
+    if (options_.camera_has_distortion && !f.undistorted_keypoints.given)
+      return (*why = "missing input: undistorted_keypoints (the camera has distortion; the geometry needs them)",
+              Status::InvalidInput);
+    if (f.undistorted_keypoints.given &&
+        (f.undistorted_keypoints.count != n || (n > 0 && f.undistorted_keypoints.data == nullptr)))
+      return (*why = "undistorted_keypoints has " + std::to_string(f.undistorted_keypoints.count) + " points for " +
+                     std::to_string(n) + " keypoints",
+              Status::InvalidInput);
+    if (f.descriptors.data != nullptr && f.descriptors.rows != n)
+      return (*why = "descriptors has " + std::to_string(f.descriptors.rows) + " rows for " + std::to_string(n) +
+                     " keypoints",
+              Status::InvalidInput);
+    if (f.descriptors.data != nullptr && (f.descriptors.row_bytes == 0 || f.descriptors.stride() < f.descriptors.row_bytes))
+      return (*why = "descriptors: row_bytes must be positive and at most the stride", Status::InvalidInput);
+    if (!f.depth_m.empty() && !f.depth_raw.empty())
+      return (*why = "depth: give depth_m (metres) or depth_raw (uint16), not both", Status::InvalidInput);
+    std::string d;
+    if (f.depth_m.validate(&d) != Status::Ok || f.depth_raw.validate(&d) != Status::Ok)
+      return (*why = "depth: " + d, Status::InvalidInput);
+    const int dw = !f.depth_m.empty() ? f.depth_m.width : f.depth_raw.width;
+    const int dh = !f.depth_m.empty() ? f.depth_m.height : f.depth_raw.height;
+    if ((!f.depth_m.empty() || !f.depth_raw.empty()) && (dw != camera_.width || dh != camera_.height))
+      return (*why = "depth is " + std::to_string(dw) + "x" + std::to_string(dh) + " for a camera of " +
+                     std::to_string(camera_.width) + "x" + std::to_string(camera_.height),
+              Status::InvalidInput);
+    if (f.cam_from_world && !f.cam_from_world->all_finite())
+      return (*why = "cam_from_world has a NaN or Inf entry", Status::NonFinite);
+    if (f.keyframe_match) {
+      const std::size_t nk = have_keyframe_ ? keyframe_px_.size() : 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const int k = f.keyframe_match[i];
+        if (k < -1 || (k >= 0 && static_cast<std::size_t>(k) >= nk))
+          return (*why = "keyframe_match[" + std::to_string(i) + "] = " + std::to_string(k) +
+                         " is not -1 or an index of the keyframe's " + std::to_string(nk) + " keypoints",
+                  Status::InvalidInput);
+      }
+      match_index_.assign(f.keyframe_match, f.keyframe_match + n);
+    }
+    why->clear();
+    return Status::Ok;
+  }
+
+  const CullerResult& refuse(Status s, const std::string& why, std::size_t n) {
+    CullerResult& r = result_;
+    r.status = s;
+    r.reason = why;
+    r.keep.assign(n, 1);
+    r.labels.assign(n, FeatureLabel::Static);
+    r.reasons.assign(n, CullReason::None);
+    r.track_ids.assign(n, -1);
+    r.num_kept = n;
+    r.matched = 0;
+    r.keyframe = false;
+    return r;
+  }
+
+  template <class A, class B>
+  static void copy_frame(const A& a, B* b) {
+    b->keypoints = a.keypoints;
+    b->prev_keypoints = a.prev_keypoints;
+    b->track_valid = a.track_valid;
+    b->track_ids = a.track_ids;
+    b->points_3d = a.points_3d;
+    b->detections = a.detections;
+    b->camera = a.camera;
+    b->cam_from_world = a.cam_from_world;
+    b->is_keyframe = a.is_keyframe;
+    b->evidence_frames = a.evidence_frames;
+  }
+
+  /// Status and reason: the culler's missing inputs first, then the pipeline's own.
+  void describe(const PipelineResult<T>& pr, bool have_pose, bool have_depth, CullerResult* r) const {
+    std::string& s = r->reason;
+    if (r->missing.any()) {
+      r->status = Status::MissingInput;
+      s = "missing input: " + r->missing.names();
+      if (r->missing.depth)
+        s += "; monocular (no depth): the depth mask and the reprojection check did not run, epipolar evidence only";
+      if (r->missing.descriptors) s += "; no descriptors and no keyframe_match: no tracks, box evidence only";
+      if (r->missing.pose) s += "; no predicted pose: the keyframe's pose stands in (no motion prior)";
+      if (r->missing.detections) s += "; no detections: the box stages did not run";
+    } else if (!have_pose && have_depth && options_.pipeline.use_reprojection) {
+      s = "no predicted pose: the reprojection check did not run";
+    }
+    if (!have_keyframe_) {
+      if (!s.empty()) s += "; ";
+      s += "first frame: no keyframe yet, no track evidence";
+    }
+    if (!pr.ok()) {
+      if (r->status == Status::Ok) r->status = pr.status;
+      if (!s.empty()) s += "; ";
+      s += "pipeline: " + pr.reason;
+    }
+  }
+
+  template <class Raw>
+  void store_keyframe(const CullerFrame<T>& f, const DepthView<Raw>& depth, const Rigid3<T>& pose) {
+    const std::size_t n = cur_px_.size();
+    keyframe_px_.swap(cur_px_);
+    keyframe_ids_.assign(result_.track_ids.begin(), result_.track_ids.end());
+    keyframe_pose_ = pose;
+    const Rigid3<T> world_from_cam = pose.inverse();
+    const T nan = std::numeric_limits<T>::quiet_NaN();
+    keyframe_cam_points_.assign(n, Vec3<T>(nan, nan, nan));
+    keyframe_world_points_.assign(n, Vec3<T>(nan, nan, nan));
+    keyframe_has_depth_ = !depth.empty();
+    if (keyframe_has_depth_) {
+      const int r = options_.depth_edge_radius_px;
+      for (std::size_t i = 0; i < n; ++i) {
+        // Depth where the keypoint is in the image (as detected), ray through its undistorted position.
+        const double u = f.keypoints.x(i), v = f.keypoints.y(i);
+        if (!std::isfinite(u) || !std::isfinite(v)) continue;
+        const int x = static_cast<int>(std::lround(u)), y = static_cast<int>(std::lround(v));
+        if (x < r || y < r || x >= depth.width - r || y >= depth.height - r) continue;
+        const float z = depth.depth_m(x, y);
+        if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
+        if (r > 0 && depth_step_near(depth, x, y, r, options_.max_depth_step_ratio)) continue;
+        const Vec2<T>& p = keyframe_px_[i];
+        if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
+        keyframe_cam_points_[i] = camera_.backproject(p, static_cast<T>(z));
+        keyframe_world_points_[i] = world_from_cam.apply(keyframe_cam_points_[i]);
+      }
+    } else {
+      keyframe_cam_points_.clear();  // the matcher's "no depth at all"
+    }
+    keyframe_desc_rows_ = 0;
+    if (f.descriptors.data != nullptr) {
+      keyframe_row_bytes_ = f.descriptors.row_bytes;
+      keyframe_desc_.resize(n * keyframe_row_bytes_);
+      for (std::size_t i = 0; i < n; ++i)
+        std::memcpy(keyframe_desc_.data() + i * keyframe_row_bytes_, f.descriptors.row(i), keyframe_row_bytes_);
+      keyframe_desc_rows_ = n;
+    }
+    frames_since_keyframe_ = 0;
+    have_keyframe_ = true;
+  }
+
+  PinholeCamera<T> camera_;
+  CullerOptions<T> options_;
+  Status status_ = Status::Ok;
+  std::string reason_;
+  PipelineState<T> state_;
+  CullerResult result_;
+
+  // Reference keyframe.
+  bool have_keyframe_ = false;
+  bool keyframe_has_depth_ = false;
+  int frames_since_keyframe_ = 0;
+  Rigid3<T> keyframe_pose_;  // cam_from_world
+  std::vector<Vec2<T>> keyframe_px_;
+  std::vector<Vec3<T>> keyframe_cam_points_, keyframe_world_points_;
+  std::vector<std::int64_t> keyframe_ids_;
+  std::vector<std::uint8_t> keyframe_desc_;
+  std::size_t keyframe_desc_rows_ = 0, keyframe_row_bytes_ = 32;
+  std::int64_t next_id_ = 0;
+
+  // Per-frame buffers, reused.
+  std::vector<Vec2<T>> cur_px_, prev_px_;
+  std::vector<Vec3<T>> points_world_;
+  std::vector<std::uint8_t> valid_;
+  std::vector<int> match_index_;  // the host's keyframe_match, checked
+  KeyframeMatchWorkspace<T> match_ws_;
+  KeyframeMatchResult<T> match_;
+};
+
+}  // namespace dyncull
