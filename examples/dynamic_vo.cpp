@@ -9,11 +9,13 @@
 
 #include "vo/ablation.hpp"
 #include "vo/culling.hpp"
+#include "vo/figures.hpp"
 #include "vo/frontend.hpp"
 #include "vo/report.hpp"
 #include "vo/runner.hpp"
 #include "vo/sources.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -267,6 +269,28 @@ struct SimJob {
   sim::SceneOptions options;
 };
 
+// One annotated frame per family for the summary strip: the middle drawn frame of its first xyz sequence
+// (else its first sequence), so the strip shows every family under the same camera motion.
+std::vector<vo::StripFrame> family_frames(const std::vector<vo::SequenceReport>& reports) {
+  std::vector<std::string> families;
+  std::vector<vo::StripFrame> out;
+  for (const auto& r : reports)
+    if (std::find(families.begin(), families.end(), r.family) == families.end()) families.push_back(r.family);
+  for (const std::string& family : families) {
+    std::vector<std::string> frames;
+    for (int pass = 0; pass < 2 && frames.empty(); ++pass) {
+      for (const auto& r : reports) {
+        if (r.family != family || (pass == 0 && r.sequence != "xyz")) continue;
+        for (const std::string& f : r.files)
+          if (f.find("_frame") != std::string::npos) frames.push_back(f);
+        if (!frames.empty()) break;
+      }
+    }
+    if (!frames.empty()) out.push_back({frames[frames.size() / 2], family + ": green kept, red culled"});
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -436,6 +460,7 @@ int main(int argc, char** argv) {
   const bool several_families = args.tum.empty() && args.families.size() > 1;
   if (args.tum.empty() && args.seeds.size() > 1 && !several_families) table += "\n" + vo::format_seed_summary(reports);
   std::string summary;
+  std::vector<std::string> figures;
   if (args.tum.empty() && args.families_set) {
     const std::vector<vo::FamilyStrategySummary> rows = vo::summarise_families(reports);
     summary = vo::format_family_summary(rows);
@@ -443,6 +468,8 @@ int main(int argc, char** argv) {
                " frames a sequence)\n";
     std::ofstream(args.out + "/family_summary.md") << summary;
     std::ofstream(args.out + "/family_summary.csv") << vo::family_summary_csv(rows);
+    if (vo::plot_family_summary(args.out + "/family_summary.png", rows)) figures.push_back("family_summary.png");
+    if (vo::write_frame_strip(args.out + "/frame_strip.png", family_frames(reports))) figures.push_back("frame_strip.png");
     table = summary + "\n" + table;
   }
   // Several families: the summary alone on screen (the per-sequence table is in results.md).
@@ -459,6 +486,7 @@ int main(int argc, char** argv) {
   std::printf("\nwrote %s\n", md.c_str());
   if (!summary.empty())
     std::printf("wrote %s/family_summary.md\nwrote %s/family_summary.csv\n", args.out.c_str(), args.out.c_str());
+  for (const std::string& f : figures) std::printf("wrote %s/%s\n", args.out.c_str(), f.c_str());
   std::size_t files = 0;
   for (const auto& r : reports) {
     for (const auto& f : r.files) {

@@ -61,5 +61,11 @@ if [[ -x "$vo" ]]; then
   "$vo" --list | awk '$1 ~ /^recommended-no_/' | sed 's/ *(ablation).*//' >"$ablation/strategies.txt"
 fi
 
+# The demo's two pictures, for this page and the README.
+mkdir -p "$root/docs/images"
+for f in family_summary.png frame_strip.png; do
+  [[ -f "$suite/$f" ]] && cp "$suite/$f" "$root/docs/images/$f"
+done
+
 python3 "$root/scripts/results_page.py" "$suite" "$ablation" >"$page"
 echo "results.sh: wrote $page"

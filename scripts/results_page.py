@@ -128,6 +128,13 @@ fr3/walking_*) and scene seeds 1, 2 and 3, 150 frames each. The families:
 
 {run_info(suite)}
 
+![Median ATE per scene family and strategy](images/family_summary.png)
+
+One frame of each family's xyz sequence with the recommended preset (green: kept; red: culled; yellow
+ring: a moving feature kept; red cross: a static feature culled; blue: detection boxes):
+
+![One annotated frame per family](images/frame_strip.png)
+
 {table_lines(read(os.path.join(suite, "family_summary.md")))}
 
 Against the targets (median over motions x seeds per family; the families sorted from nearest to
