@@ -151,8 +151,12 @@ struct CullerOptions {
   /// (the demo front end's 0.1 m: shorter baselines lowered its ATE on translating sequences)
   double keyframe_max_translation_m = 0.1;
   double keyframe_max_rotation_deg = 15.0;   ///< ... or turned more than this ...
-  /// ... or fewer than this share of the keyframe's keypoints matched (the demo's 0.5 of its tracks).
-  double keyframe_min_matched_ratio = 0.5;
+  /// ... or fewer than this share of the keypoints matched the keyframe's. Lower than the demo's 0.5 of
+  /// its LK tracks: a detector that re-detects every frame matches about half of its keypoints one frame
+  /// later (repeatability, and movers the pose-guided search does not find), so at 0.5 nearly every
+  /// frame would be a keyframe and the evidence a one-frame baseline, on which the recommended preset
+  /// leaves the decision to the box rule (min_evidence_frames).
+  double keyframe_min_matched_ratio = 0.3;
   KeyframeMatchOptions matching{};
   /// Keyframe depth used for its 3-D points: the TUM sensor's reliable range, and no point within
   /// depth_edge_radius_px of a depth step above max_depth_step_ratio (it back-projects half on the object,
