@@ -14,11 +14,17 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <ostream>
 #include <string>
 #include <type_traits>
 #include <vector>
 
 namespace dyncull {
+
+// Labels and reasons by name in GoogleTest's failure messages (found by argument-dependent lookup).
+inline void PrintTo(FeatureLabel label, std::ostream* os) { *os << to_string(label); }
+inline void PrintTo(CullReason reason, std::ostream* os) { *os << to_string(reason); }
+
 namespace test {
 
 /// One frame drawn by hand: owns every input a CullingFrame points to. Depth in float metres, 0 = none.
