@@ -36,7 +36,7 @@ const Data& data() {
         if (det.box.contains(x.scene.keypoints[i].x(), x.scene.keypoints[i].y())) x.in_box[i] = 1;
     }
     check_reprojection(x.scene.prev_points_world, x.scene.keypoints, x.scene.camera, ReprojectionCheckOptions<float>{},
-                       &x.reprojection, x.scene.track_valid.data(), x.in_box.data());
+                       &x.reprojection, x.scene.track_valid, x.in_box);
     return x;
   }();
   return d;
@@ -72,7 +72,7 @@ void BM_CoherentMotion_ReprojectionCheck(benchmark::State& state) {
   ReprojectionCheckResult<float> r;
   for (auto _ : state) {
     check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, ReprojectionCheckOptions<float>{}, &r,
-                       d.scene.track_valid.data(), d.in_box.data());
+                       d.scene.track_valid, d.in_box);
     benchmark::DoNotOptimize(r.labels.data());
   }
   state.counters["features"] = double(r.labels.size());

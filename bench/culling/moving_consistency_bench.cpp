@@ -62,8 +62,8 @@ void BM_MovingConsistency_Dyncull(benchmark::State& state) {
   const bool boxes = state.range(1) != 0;
   MovingConsistencyResult<float> r;
   for (auto _ : state) {
-    check_moving_consistency(d.scene.prev_keypoints, d.scene.keypoints, o, &r, d.scene.track_valid.data(),
-                             boxes ? d.in_box.data() : nullptr);
+    check_moving_consistency(d.scene.prev_keypoints, d.scene.keypoints, o, &r, d.scene.track_valid,
+                             boxes ? FlagView(d.in_box) : nullptr);
     benchmark::DoNotOptimize(r.labels.data());
   }
   std::vector<std::uint8_t> dyn, truth;

@@ -64,8 +64,8 @@ void BM_ReprojectionCheck_Dyncull(benchmark::State& state) {
   o.uncertainty_sigmas = float(state.range(0));
   ReprojectionCheckResult<float> r;
   for (auto _ : state) {
-    check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, o, &r, d.scene.track_valid.data(),
-                       d.in_box.data());
+    check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, o, &r, d.scene.track_valid,
+                       d.in_box);
     benchmark::DoNotOptimize(r.labels.data());
   }
   accuracy(state, [&](std::size_t i) { return r.labels[i] == FeatureLabel::Dynamic; });
@@ -79,8 +79,8 @@ void BM_ReprojectionCheck_DyncullWithDepth(benchmark::State& state) {
   o.max_depth_residual_sigmas = 5.f;
   ReprojectionCheckResult<float> r;
   for (auto _ : state) {
-    check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, o, &r, d.scene.track_valid.data(),
-                       d.in_box.data(), d.scene.depth_view());
+    check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, o, &r, d.scene.track_valid,
+                       d.in_box, d.scene.depth_view());
     benchmark::DoNotOptimize(r.labels.data());
   }
   state.counters["depth_flagged"] = double(r.num_depth_dynamic);
@@ -94,7 +94,7 @@ void BM_ReprojectionCheck_EpipolarOnSameTracks(benchmark::State& state) {
   MovingConsistencyOptions<float> o;
   MovingConsistencyResult<float> r;
   for (auto _ : state) {
-    check_moving_consistency(d.scene.prev_keypoints, d.scene.keypoints, o, &r, d.scene.track_valid.data(), d.in_box.data());
+    check_moving_consistency(d.scene.prev_keypoints, d.scene.keypoints, o, &r, d.scene.track_valid, d.in_box);
     benchmark::DoNotOptimize(r.labels.data());
   }
   accuracy(state, [&](std::size_t i) { return r.labels[i] == FeatureLabel::Dynamic; });

@@ -40,7 +40,7 @@ void BM_StaticHistory_Update(benchmark::State& state) {
         if ((i + frame) % 20 != 0) ids[w++] = ids[i];
       while (w < kTracks) ids[w++] = next_id++;
     }
-    history.update(ids, labels.data(), residuals.data(), true, 0.8f, &counts);
+    history.update(ids, labels, residuals, true, 0.8f, &counts);
     benchmark::DoNotOptimize(counts.data());
   }
   state.counters["tracks"] = double(history.num_tracks());

@@ -67,7 +67,7 @@ void BM_SubBoxMemory_LastVoteFrame(benchmark::State& state) {
     ++frame;
     memory.remember_states(ids, votes, options, frame, 2);
     memory.recall_states(ids, 3, frame + 1, 2, &states);
-    apply_subbox_states(points, geometric.data(), boxes, states.data(), options, &out);
+    apply_subbox_states(points, geometric.data(), boxes, states, options, &out);
     benchmark::DoNotOptimize(out.labels.data());
   }
   state.counters["dynamic"] = double(out.num_dynamic);

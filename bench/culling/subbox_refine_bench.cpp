@@ -39,8 +39,8 @@ const Data& data() {
         if (det.box.contains(x.scene.keypoints[i].x(), x.scene.keypoints[i].y())) in_box[i] = 1;
     }
     MovingConsistencyOptions<float> o;
-    x.geometric = check_moving_consistency(x.scene.prev_keypoints, x.scene.keypoints, o, x.scene.track_valid.data(),
-                                           in_box.data())
+    x.geometric = check_moving_consistency(x.scene.prev_keypoints, x.scene.keypoints, o, x.scene.track_valid,
+                                           in_box)
                       .labels;
     return x;
   }();

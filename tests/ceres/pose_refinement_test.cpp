@@ -61,10 +61,10 @@ TYPED_TEST(CeresPoseTest, MaskAndBadInput) {
   const auto s = make_pnp_scene<T>(302, 50, 0.5, 0.0);
   std::vector<std::uint8_t> mask(50, 0);
   mask[0] = mask[1] = 1;
-  EXPECT_EQ(dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, s.cam_from_world, {}, mask.data()).status,
+  EXPECT_EQ(dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, s.cam_from_world, {}, mask).status,
             Status::TooFewPoints);
   std::fill(mask.begin(), mask.end(), 1);
-  const auto r = dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, s.cam_from_world, {}, mask.data());
+  const auto r = dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, s.cam_from_world, {}, mask);
   EXPECT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_points, 50u);
   Rigid3<T> nan_pose;
@@ -72,6 +72,11 @@ TYPED_TEST(CeresPoseTest, MaskAndBadInput) {
   EXPECT_EQ(dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, nan_pose).status, Status::NonFinite);
   std::vector<Vec2<T>> fewer(s.pixels.begin(), s.pixels.begin() + 10);
   EXPECT_EQ(dyncull::refine_pose_ceres(s.world, fewer, s.camera, s.cam_from_world).status, Status::InvalidInput);
+  // A mask of another length is refused before a flag is read.
+  const std::vector<std::uint8_t> short_mask(10, 1);
+  const auto m = dyncull::refine_pose_ceres(s.world, s.pixels, s.camera, s.cam_from_world, {}, short_mask);
+  EXPECT_EQ(m.status, Status::InvalidInput);
+  EXPECT_EQ(m.reason, "refine_pose_ceres: mask has 10 entries for 50 correspondences");
 }
 
 TYPED_TEST(CeresPoseTest, InvalidOptionsAreRefusedWithTheFieldNamed) {

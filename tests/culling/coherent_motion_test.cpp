@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace dyncull {
@@ -137,7 +138,7 @@ TYPED_TEST(CoherentMotionTest, OnlyTheObjectsEligibleStaticFeaturesChange) {
   s.labels[40] = FeatureLabel::Candidate;  // cell 2
   CoherentMotionResult<T> r;
   flag_coherent_cells(s.points, s.residuals.data(), s.boxes, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r,
-                      nullptr, bits.data(), eligible.data());
+                      nullptr, bits, eligible);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_cells_tested, 7u);
   EXPECT_EQ(r.num_cells_flagged, 1u);
@@ -204,6 +205,32 @@ TEST(CoherentMotion, BuffersAreReusedAcrossFrames) {
   EXPECT_EQ(r.scratch_order.data(), order);
   EXPECT_EQ(r.scratch_u.data(), u);
   EXPECT_EQ(r.num_cells_flagged, 3u);
+}
+
+// Per-feature views shorter than the points: InvalidInput naming the view and both sizes, no label changed,
+// nothing read past the end (AddressSanitizer).
+TYPED_TEST(CoherentMotionTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
+  using T = TypeParam;
+  auto s = make_cell_scene<T>(20, 0.25, Vec2<double>(0.7, 0.4));
+  const std::size_t n = s.points.size();
+  const auto before = s.labels;
+  const CoherentMotionOptions<T> o;
+  const std::vector<std::uint8_t> few(10, 1), all(n, 1);
+  const std::vector<std::uint32_t> few_bits(10, 1u), bits(n, 1u);
+  const std::string tail = " has 10 entries for " + std::to_string(n) + " points";
+  CoherentMotionResult<T> r;
+  flag_coherent_cells(s.points, s.residuals.data(), s.boxes, T(0.25), o, s.labels.data(), &r, few);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_EQ(r.reason, "in_object_mask" + tail);
+  flag_coherent_cells(s.points, s.residuals.data(), s.boxes, T(0.25), o, s.labels.data(), &r, all, few_bits);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_EQ(r.reason, "object_box_bits" + tail);
+  flag_coherent_cells(s.points, s.residuals.data(), s.boxes, T(0.25), o, s.labels.data(), &r, all, bits, few);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_EQ(r.reason, "eligible" + tail);
+  EXPECT_EQ(s.labels, before);
+  flag_coherent_cells(s.points, s.residuals.data(), s.boxes, T(0.25), o, s.labels.data(), &r, all, bits, all);
+  EXPECT_TRUE(r.ok()) << r.reason;
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
+#include <string>
 #include <vector>
 
 namespace dyncull {
@@ -56,7 +58,7 @@ TYPED_TEST(MovingConsistencyTest, FlagsMoversAndKeepsTheStaticRoom) {
   const auto s = test::make_culling_scene<T>(SceneConfig{});
   const auto in_box = in_boxes_of(s, {0, 56});
   const auto r = check_moving_consistency(s.prev_keypoints, s.keypoints, MovingConsistencyOptions<T>{},
-                                          s.track_valid.data(), in_box.data());
+                                          s.track_valid, in_box);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_TRUE(r.fitted_outside_boxes);
   EXPECT_LT(r.num_fit, r.num_valid);
@@ -80,12 +82,12 @@ TYPED_TEST(MovingConsistencyTest, FlagsMoversAndKeepsTheStaticRoom) {
   // SG-SLAM's 0.2 px inside boxes flags most of the still legs: why 0.5 px is the default.
   MovingConsistencyOptions<T> sg;
   sg.max_epipolar_distance_in_boxes_px = T(0.2);
-  const auto q = check_moving_consistency(s.prev_keypoints, s.keypoints, sg, s.track_valid.data(), in_box.data());
+  const auto q = check_moving_consistency(s.prev_keypoints, s.keypoints, sg, s.track_valid, in_box);
   EXPECT_GT(count_kind(s, q, SceneKind::SittingLower).rate(), 0.4);
   // Too few tracks outside the boxes: F is fitted on all of them.
   MovingConsistencyOptions<T> many;
   many.min_tracks_outside_boxes = s.size();
-  const auto a = check_moving_consistency(s.prev_keypoints, s.keypoints, many, s.track_valid.data(), in_box.data());
+  const auto a = check_moving_consistency(s.prev_keypoints, s.keypoints, many, s.track_valid, in_box);
   EXPECT_FALSE(a.fitted_outside_boxes);
 }
 
@@ -102,8 +104,8 @@ TYPED_TEST(MovingConsistencyTest, InlierRefitImprovesTheRansacModel) {
     MovingConsistencyOptions<T> raw;
     raw.refit_iterations = 0;
     const auto a = check_moving_consistency(s.prev_keypoints, s.keypoints, MovingConsistencyOptions<T>{},
-                                            s.track_valid.data(), in_box.data());
-    const auto b = check_moving_consistency(s.prev_keypoints, s.keypoints, raw, s.track_valid.data(), in_box.data());
+                                            s.track_valid, in_box);
+    const auto b = check_moving_consistency(s.prev_keypoints, s.keypoints, raw, s.track_valid, in_box);
     ASSERT_TRUE(a.ok() && b.ok());
     for (std::size_t i = 0; i < s.size(); ++i) {
       if (s.kind[i] != SceneKind::Room || !s.track_valid[i]) continue;
@@ -123,7 +125,7 @@ TYPED_TEST(MovingConsistencyTest, InvalidTracksAreCandidatesAndFewTracksAreSkipp
   valid[0] = 0;
   auto prev = s.prev_keypoints;
   prev[1].x() = Constants<T>::nan();
-  const auto r = check_moving_consistency(prev, s.keypoints, MovingConsistencyOptions<T>{}, valid.data());
+  const auto r = check_moving_consistency(prev, s.keypoints, MovingConsistencyOptions<T>{}, valid);
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r.labels[0], FeatureLabel::Candidate);
   EXPECT_EQ(r.labels[1], FeatureLabel::Candidate);
@@ -149,7 +151,7 @@ TYPED_TEST(MovingConsistencyTest, StaticCameraKeepsStaticTracksStaticOrReportsDe
   config.static_camera = true;
   const auto s = test::make_culling_scene<T>(config);
   const auto r = check_moving_consistency(s.prev_keypoints, s.keypoints, MovingConsistencyOptions<T>{},
-                                          s.track_valid.data());
+                                          s.track_valid);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_LT(count_kind(s, r, SceneKind::Room).rate(), 0.04);
   EXPECT_LT(count_kind(s, r, SceneKind::SittingLower).rate(), 0.04);
@@ -158,7 +160,7 @@ TYPED_TEST(MovingConsistencyTest, StaticCameraKeepsStaticTracksStaticOrReportsDe
   SceneConfig still = config;
   still.walking = still.sitting = still.chair = false;
   const auto t = test::make_culling_scene<T>(still);
-  const auto d = check_moving_consistency(t.prev_keypoints, t.keypoints, strict, t.track_valid.data());
+  const auto d = check_moving_consistency(t.prev_keypoints, t.keypoints, strict, t.track_valid);
   EXPECT_EQ(d.status, Status::Degenerate);
   EXPECT_FALSE(d.reason.empty());
   for (auto l : d.labels) EXPECT_EQ(l, FeatureLabel::Candidate);
@@ -173,12 +175,12 @@ TYPED_TEST(MovingConsistencyTest, AllDynamicFrameCannotBeSeenByGeometryAlone) {
   config.all_dynamic = true;
   const auto s = test::make_culling_scene<T>(config);
   const auto r = check_moving_consistency(s.prev_keypoints, s.keypoints, MovingConsistencyOptions<T>{},
-                                          s.track_valid.data());
+                                          s.track_valid);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_LT(double(r.num_dynamic), 0.1 * double(r.num_valid));
   MovingConsistencyOptions<T> strict;
   strict.fundamental.check_homography_degeneracy = true;
-  EXPECT_EQ(check_moving_consistency(s.prev_keypoints, s.keypoints, strict, s.track_valid.data()).status,
+  EXPECT_EQ(check_moving_consistency(s.prev_keypoints, s.keypoints, strict, s.track_valid).status,
             Status::Degenerate);
 }
 
@@ -195,15 +197,15 @@ TYPED_TEST(MovingConsistencyTest, AnyPointContainerAndDeterministic) {
     cur.push_back({float(s.keypoints[i].x()), float(s.keypoints[i].y())});
   }
   MovingConsistencyOptions<T> o;
-  const auto a = check_moving_consistency(prev, cur, o, s.track_valid.data());
-  const auto b = check_moving_consistency(prev, cur, o, s.track_valid.data());
+  const auto a = check_moving_consistency(prev, cur, o, s.track_valid);
+  const auto b = check_moving_consistency(prev, cur, o, s.track_valid);
   ASSERT_TRUE(a.ok());
   EXPECT_EQ(a.labels, b.labels);
   EXPECT_EQ(a.inlier_mask, b.inlier_mask);
   // Reusing a result object gives the same answer.
   MovingConsistencyResult<T> reuse;
-  check_moving_consistency(prev, cur, o, &reuse, s.track_valid.data());
-  check_moving_consistency(prev, cur, o, &reuse, s.track_valid.data());
+  check_moving_consistency(prev, cur, o, &reuse, s.track_valid);
+  check_moving_consistency(prev, cur, o, &reuse, s.track_valid);
   EXPECT_EQ(reuse.labels, a.labels);
 }
 
@@ -220,7 +222,7 @@ TYPED_TEST(MovingConsistencyTest, NonOkResultLabelsNothingAndOkResultCountsEvery
       prev[i] = (s.prev_keypoints[i].template cast<double>() * scale).template cast<T>();
       cur[i] = (s.keypoints[i].template cast<double>() * scale).template cast<T>();
     }
-    const auto r = check_moving_consistency(prev, cur, MovingConsistencyOptions<T>{}, s.track_valid.data());
+    const auto r = check_moving_consistency(prev, cur, MovingConsistencyOptions<T>{}, s.track_valid);
     std::size_t dynamic = 0, static_ = 0;
     for (std::size_t i = 0; i < r.labels.size(); ++i) {
       dynamic += r.labels[i] == FeatureLabel::Dynamic;
@@ -240,6 +242,30 @@ TYPED_TEST(MovingConsistencyTest, NonOkResultLabelsNothingAndOkResultCountsEvery
       EXPECT_EQ(r.num_static, static_) << scale;
     }
   }
+}
+
+// Flags of another length than the tracks: InvalidInput naming them and both sizes, every track Candidate,
+// and no flag read past the end (AddressSanitizer would report it).
+TYPED_TEST(MovingConsistencyTest, FlagsOfAnotherLengthAreInvalidInputAndNotRead) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>(SceneConfig{});
+  const std::size_t n = s.size();
+  const std::vector<std::uint8_t> few(10, 1), all(n, 1);
+  const MovingConsistencyOptions<T> o;
+  const auto short_valid = check_moving_consistency(s.prev_keypoints, s.keypoints, o, few, all);
+  const auto short_in_box = check_moving_consistency(s.prev_keypoints, s.keypoints, o, all, few);
+  EXPECT_EQ(short_valid.status, Status::InvalidInput);
+  EXPECT_EQ(short_valid.reason, "valid has 10 entries for " + std::to_string(n) + " tracks");
+  EXPECT_EQ(short_in_box.status, Status::InvalidInput);
+  EXPECT_EQ(short_in_box.reason, "in_box has 10 entries for " + std::to_string(n) + " tracks");
+  for (const auto* r : {&short_valid, &short_in_box}) {
+    ASSERT_EQ(r->labels.size(), n);
+    for (FeatureLabel l : r->labels) EXPECT_EQ(l, FeatureLabel::Candidate);
+  }
+  // A pointer with its count is checked as a vector is; nullptr means no flags.
+  EXPECT_EQ(check_moving_consistency(s.prev_keypoints, s.keypoints, o, FlagView(all.data(), n - 1)).status,
+            Status::InvalidInput);
+  EXPECT_TRUE(check_moving_consistency(s.prev_keypoints, s.keypoints, o, FlagView(all.data(), n), nullptr).ok());
 }
 
 }  // namespace

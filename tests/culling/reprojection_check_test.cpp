@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace dyncull {
@@ -79,7 +80,7 @@ double flagged_rate(const std::vector<FeatureLabel>& labels, const std::vector<s
 TYPED_TEST(ReprojectionCheckTest, SeesMotionAlongTheEpipolarLine) {
   using T = TypeParam;
   const auto s = make_along_ray_scene<T>();
-  const auto r = check_reprojection(s.points, s.pixels, s.camera, ReprojectionCheckOptions<T>{}, nullptr, s.in_box.data());
+  const auto r = check_reprojection(s.points, s.pixels, s.camera, ReprojectionCheckOptions<T>{}, nullptr, s.in_box);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_TRUE(r.fitted_outside_boxes);
   EXPECT_EQ(r.num_valid, s.points.size());
@@ -111,7 +112,7 @@ TYPED_TEST(ReprojectionCheckTest, SeesMotionAlongTheEpipolarLine) {
   // The epipolar check on the same tracks is blind to this motion.
   MovingConsistencyOptions<T> epi;
   epi.max_epipolar_distance_in_boxes_px = T(1);
-  const auto e = check_moving_consistency(s.ref_pixels, s.pixels, epi, nullptr, s.in_box.data());
+  const auto e = check_moving_consistency(s.ref_pixels, s.pixels, epi, nullptr, s.in_box);
   ASSERT_TRUE(e.ok()) << e.reason;
   EXPECT_LT(flagged_rate<T>(e.labels, s.moving, true), 0.1);
 }
@@ -142,11 +143,11 @@ TYPED_TEST(ReprojectionCheckTest, ThresholdGrowsWhereThePoseIsLoose) {
   ReprojectionCheckOptions<T> fixed;
   fixed.uncertainty_sigmas = T(0);
   fixed.min_tracks_outside_boxes = 20;
-  const auto loose = check_reprojection(points, pixels, PinholeCamera<T>(cam.cast<T>()), fixed, nullptr, in_box.data());
+  const auto loose = check_reprojection(points, pixels, PinholeCamera<T>(cam.cast<T>()), fixed, nullptr, in_box);
   ASSERT_TRUE(loose.ok()) << loose.reason;
   ReprojectionCheckOptions<T> aware = fixed;
   aware.uncertainty_sigmas = T(1);
-  const auto r = check_reprojection(points, pixels, PinholeCamera<T>(cam.cast<T>()), aware, nullptr, in_box.data());
+  const auto r = check_reprojection(points, pixels, PinholeCamera<T>(cam.cast<T>()), aware, nullptr, in_box);
   ASSERT_TRUE(r.ok()) << r.reason;
   std::size_t flagged_fixed = 0, flagged_aware = 0;
   double sd_near = 0;
@@ -218,12 +219,12 @@ TYPED_TEST(ReprojectionCheckTest, DepthResidualSeesMotionAlongTheViewingRay) {
   const auto s = make_towards_camera_scene<T>(0.08);
   const auto& b = s.base;
   ReprojectionCheckOptions<T> o;
-  const auto pixel_only = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box.data(), s.view());
+  const auto pixel_only = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box, s.view());
   ASSERT_TRUE(pixel_only.ok()) << pixel_only.reason;
   EXPECT_LT(flagged_rate<T>(pixel_only.labels, b.moving, true), 0.2);
   EXPECT_TRUE(std::isnan(double(pixel_only.depth_residual_m[0])));  // off: not evaluated
   o.max_depth_residual_sigmas = T(5);
-  const auto with_depth = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box.data(), s.view());
+  const auto with_depth = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box, s.view());
   ASSERT_TRUE(with_depth.ok()) << with_depth.reason;
   EXPECT_GT(flagged_rate<T>(with_depth.labels, b.moving, true), 0.95);
   EXPECT_EQ(with_depth.num_dynamic - pixel_only.num_dynamic, with_depth.num_depth_dynamic);
@@ -249,11 +250,11 @@ TYPED_TEST(ReprojectionCheckTest, DepthResidualSeesMotionAlongTheViewingRay) {
   EXPECT_LE(static_flagged, static_n / 50) << "hidden wall tracks: " << hidden;
   EXPECT_NEAR(moving_dz / double(moving_n), -0.08 * 0.99, 0.01);  // closer: measured < predicted
   // No depth image: the option has nothing to compare; a pixel without depth is not evaluated either.
-  const auto no_depth = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box.data());
+  const auto no_depth = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box);
   EXPECT_EQ(no_depth.num_dynamic, pixel_only.num_dynamic);
   auto holes = s;
   std::fill(holes.depth.begin(), holes.depth.end(), 0.f);
-  const auto none = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box.data(), holes.view());
+  const auto none = check_reprojection(b.points, b.pixels, b.camera, o, nullptr, b.in_box, holes.view());
   EXPECT_EQ(none.num_dynamic, pixel_only.num_dynamic);
   EXPECT_EQ(none.num_depth_dynamic, 0u);
   o.max_depth_residual_sigmas = T(-1);
@@ -293,7 +294,7 @@ TYPED_TEST(ReprojectionCheckTest, BadInputGetsAReason) {
   s.pixels[1].x() = nan;
   std::vector<std::uint8_t> valid(s.points.size(), 1);
   valid[2] = 0;
-  r = check_reprojection(s.points, s.pixels, s.camera, options, valid.data(), s.in_box.data());
+  r = check_reprojection(s.points, s.pixels, s.camera, options, valid, s.in_box);
   ASSERT_TRUE(r.ok()) << r.reason;
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(r.labels[i], FeatureLabel::Candidate) << i;
@@ -322,15 +323,37 @@ TYPED_TEST(ReprojectionCheckTest, BadInputGetsAReason) {
 TEST(ReprojectionCheck, BuffersAreReusedAcrossFrames) {
   const auto s = make_along_ray_scene<double>();
   ReprojectionCheckResult<double> r;
-  check_reprojection(s.points, s.pixels, s.camera, ReprojectionCheckOptions<double>{}, &r, nullptr, s.in_box.data());
+  check_reprojection(s.points, s.pixels, s.camera, ReprojectionCheckOptions<double>{}, &r, nullptr, s.in_box);
   ASSERT_TRUE(r.ok()) << r.reason;
   const auto* labels = r.labels.data();
   const auto* scratch = r.scratch_points.data();
   const std::size_t dyn = r.num_dynamic;
-  check_reprojection(s.points, s.pixels, s.camera, ReprojectionCheckOptions<double>{}, &r, nullptr, s.in_box.data());
+  check_reprojection(s.points, s.pixels, s.camera, ReprojectionCheckOptions<double>{}, &r, nullptr, s.in_box);
   EXPECT_EQ(r.labels.data(), labels);
   EXPECT_EQ(r.scratch_points.data(), scratch);
   EXPECT_EQ(r.num_dynamic, dyn);
+}
+
+// Flags of another length than the tracks: InvalidInput naming them and both sizes, every track Candidate,
+// and no flag read past the end (AddressSanitizer would report it).
+TYPED_TEST(ReprojectionCheckTest, FlagsOfAnotherLengthAreInvalidInputAndNotRead) {
+  using T = TypeParam;
+  const auto s = make_along_ray_scene<T>();
+  const std::size_t n = s.pixels.size();
+  const std::vector<std::uint8_t> few(10, 1), all(n, 1);
+  const ReprojectionCheckOptions<T> o;
+  const auto short_valid = check_reprojection(s.points, s.pixels, s.camera, o, few, all);
+  const auto short_in_box = check_reprojection(s.points, s.pixels, s.camera, o, all, few);
+  EXPECT_EQ(short_valid.status, Status::InvalidInput);
+  EXPECT_EQ(short_valid.reason, "valid has 10 entries for " + std::to_string(n) + " tracks");
+  EXPECT_EQ(short_in_box.status, Status::InvalidInput);
+  EXPECT_EQ(short_in_box.reason, "in_box has 10 entries for " + std::to_string(n) + " tracks");
+  for (const auto* r : {&short_valid, &short_in_box}) {
+    ASSERT_EQ(r->labels.size(), n);
+    for (FeatureLabel l : r->labels) EXPECT_EQ(l, FeatureLabel::Candidate);
+  }
+  EXPECT_EQ(check_reprojection(s.points, s.pixels, s.camera, o, FlagView(nullptr, n)).status, Status::InvalidInput);
+  EXPECT_TRUE(check_reprojection(s.points, s.pixels, s.camera, o, all, s.in_box).ok());
 }
 
 }  // namespace

@@ -292,7 +292,7 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     o.dilation_radius_px = maybe_wild_int(rng, 3);
     std::vector<std::uint8_t> in_object(n);
     for (auto& f : in_object) f = static_cast<std::uint8_t>(rng.index(2));
-    const SubBoxResult<T> r = refine_subboxes(points, geo.data(), boxes, o, in_object.data());
+    const SubBoxResult<T> r = refine_subboxes(points, geo.data(), boxes, o, in_object);
     if (!r.ok()) {
       EXPECT_FALSE(r.reason.empty()) << trial;
       continue;
@@ -311,7 +311,7 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     EXPECT_LE(subbox_mask(r, boxes, o, ConstMaskView{}, mask.view(), &scratch), 100u * 80u) << trial;
     std::vector<std::uint8_t> states(r.cells.size(), 2);
     SubBoxResult<T> applied;
-    apply_subbox_states(points, geo.data(), boxes, states.data(), o, &applied);
+    apply_subbox_states(points, geo.data(), boxes, states, o, &applied);
     EXPECT_TRUE(applied.ok()) << applied.reason;
   }
   EXPECT_GT(checked, 30u) << "trials that reached the output checks";
@@ -497,7 +497,7 @@ TYPED_TEST(StageInputsTest, MovingConsistencyPropertyStatusOrDefinedLabels) {
       valid[i] = static_cast<std::uint8_t>(rng.index(8) != 0);
       in_box[i] = static_cast<std::uint8_t>(rng.index(3) == 0);
     }
-    const auto r = check_moving_consistency(prev, cur, o, valid.data(), in_box.data());
+    const auto r = check_moving_consistency(prev, cur, o, valid, in_box);
     ASSERT_EQ(r.labels.size(), cur.size());
     if (!r.ok()) {
       EXPECT_FALSE(r.reason.empty()) << trial;

@@ -111,8 +111,8 @@ TEST(SubBoxMemory, RefinementAppliesRememberedCellsToEligibleFeaturesInTheObject
   const std::vector<std::uint8_t> eligible = {1, 0, 1, 1, 1, 1};
   const std::vector<std::uint8_t> in_object = {1, 1, 0, 1, 1, 1};
   SubBoxResult<float> r;
-  refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<float>{}, &r, in_object.data(), nullptr, extra.data(),
-                  eligible.data());
+  refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<float>{}, &r, in_object, nullptr, extra,
+                  eligible);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
   EXPECT_EQ(r.reasons[0], CullReason::SubBox);
@@ -179,7 +179,7 @@ TEST(SubBoxMemory, ApplyingStatesKeepsStaticCellsAndCullsTheObjectElsewhere) {
   const std::vector<std::uint8_t> in_object = {1, 1, 1, 0, 1, 1, 1};
   SubBoxOptions<float> options;
   SubBoxResult<float> r;
-  apply_subbox_states(pts, geo.data(), boxes, states.data(), options, &r, in_object.data());
+  apply_subbox_states(pts, geo.data(), boxes, states, options, &r, in_object);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_invalid_boxes, 1u);
   EXPECT_EQ(r.labels[0], FeatureLabel::Static) << "static cell, although flagged itself";
@@ -196,10 +196,10 @@ TEST(SubBoxMemory, ApplyingStatesKeepsStaticCellsAndCullsTheObjectElsewhere) {
   EXPECT_EQ(r.votes[0].num_dynamic_cells, 8);
   EXPECT_EQ(r.dyn_count[4] + r.static_count[4], 0u) << "nothing was voted";
   options.keep_geometric_outside_boxes = false;
-  apply_subbox_states(pts, geo.data(), boxes, states.data(), options, &r, in_object.data());
+  apply_subbox_states(pts, geo.data(), boxes, states, options, &r, in_object);
   EXPECT_EQ(r.labels[6], FeatureLabel::Static);
   options.grid = 9;
-  apply_subbox_states(pts, geo.data(), boxes, states.data(), options, &r);
+  apply_subbox_states(pts, geo.data(), boxes, states, options, &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.labels.size(), pts.size());
 }

@@ -6,7 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
+#include <cstdint>
+#include <string>
 #include <vector>
 
 namespace dyncull {
@@ -150,7 +151,7 @@ TYPED_TEST(SubBoxTest, EmptyAndInvalidBoxesAndObjectMask) {
   EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, eight).votes[1].num_dynamic_cells, 4);
   // Object-mask flags: a feature in a dynamic cell but outside the object mask stays static.
   const std::vector<std::uint8_t> in_mask{0, 1, 1, 1, 1};
-  const auto m = refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<T>{}, in_mask.data());
+  const auto m = refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<T>{}, in_mask);
   EXPECT_EQ(m.labels[0], FeatureLabel::Static);
   EXPECT_EQ(m.labels[1], FeatureLabel::Dynamic);
   // Invalid options.
@@ -276,14 +277,14 @@ TYPED_TEST(SubBoxTest, OverlappingBoxesActOnTheirOwnObjectsOnly) {
 
   // One object flag for all boxes (the chair is in its own box's mask): the overlap is culled.
   SubBoxOptions<T> o;
-  const auto flat = refine_subboxes(pts, geo.data(), boxes, o, in_any.data());
+  const auto flat = refine_subboxes(pts, geo.data(), boxes, o, in_any);
   ASSERT_TRUE(flat.ok());
   EXPECT_EQ(flat.labels[chair0], FeatureLabel::Dynamic);
   EXPECT_EQ(flat.static_count[8], 2u);  // the chair votes in the walker's cell
 
   // Per-box bits: the chair keeps its features; the walker is still dynamic everywhere.
   o.object_mask_votes_only = true;
-  const auto own = refine_subboxes(pts, geo.data(), boxes, o, in_any.data(), bits.data());
+  const auto own = refine_subboxes(pts, geo.data(), boxes, o, in_any, bits);
   ASSERT_TRUE(own.ok());
   for (std::size_t i = 0; i < pts.size(); ++i)
     EXPECT_EQ(own.labels[i], i < chair0 ? FeatureLabel::Dynamic : FeatureLabel::Static) << "feature " << i;
@@ -361,6 +362,46 @@ TEST(SubBoxDilation, RoiAndLargeRadiiMatchBruteForce) {
       EXPECT_EQ(m.pixels, ref.pixels) << "roi " << roi.c0 << "," << roi.r0 << " radius " << R;
     }
   }
+}
+
+// Per-feature views shorter than the points, or per-cell flags shorter than the boxes' cells: InvalidInput
+// naming the view and both sizes, every feature Static, nothing read past the end (AddressSanitizer).
+TYPED_TEST(SubBoxTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
+  using T = TypeParam;
+  // Features 0 and 1 share cell 0 of box 1 (flagged: a dynamic cell), feature 2 lies in box 0's cell 0.
+  const std::vector<Vec2<T>> pts{Vec2<T>(3, 3), Vec2<T>(5, 4), Vec2<T>(105, 105)};
+  const std::vector<FeatureLabel> geo{FeatureLabel::Dynamic, FeatureLabel::Dynamic, FeatureLabel::Static};
+  const std::vector<Box<T>> boxes{Box<T>{T(100), T(100), T(200), T(200)}, Box<T>{T(0), T(0), T(29), T(29)}};
+  const SubBoxOptions<T> o;
+  const std::vector<std::uint8_t> one(1, 1), flags(3, 1), cells(18, 0), few_cells(9, 1);
+  const std::vector<std::uint32_t> one_bits(1, 3u), bits(3, 3u);
+  auto expect_invalid = [&](const SubBoxResult<T>& r, const std::string& reason) {
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_EQ(r.reason, reason);
+    ASSERT_EQ(r.labels.size(), pts.size());
+    for (FeatureLabel l : r.labels) EXPECT_EQ(l, FeatureLabel::Static);
+  };
+  SubBoxResult<T> r;
+  refine_subboxes(pts, geo.data(), boxes, o, &r, one, bits);
+  expect_invalid(r, "in_object_mask has 1 entries for 3 points");
+  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, one_bits);
+  expect_invalid(r, "object_box_bits has 1 entries for 3 points");
+  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, bits, few_cells, flags);
+  expect_invalid(r, "extra_dynamic_cells has 9 entries for 18 cells (boxes x grid x grid)");
+  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, bits, cells, one);
+  expect_invalid(r, "extra_eligible has 1 entries for 3 points");
+  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, bits, cells, flags);
+  EXPECT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);
+
+  apply_subbox_states(pts, geo.data(), boxes, few_cells, o, &r);
+  expect_invalid(r, "states has 9 entries for 18 cells (boxes x grid x grid)");
+  apply_subbox_states(pts, geo.data(), boxes, nullptr, o, &r);
+  expect_invalid(r, "states has 0 entries for 18 cells (boxes x grid x grid)");
+  apply_subbox_states(pts, geo.data(), boxes, cells, o, &r, one);
+  expect_invalid(r, "in_object_mask has 1 entries for 3 points");
+  apply_subbox_states(pts, geo.data(), boxes, cells, o, &r, flags, bits);
+  EXPECT_TRUE(r.ok()) << r.reason;
 }
 
 }  // namespace

@@ -173,7 +173,7 @@ TYPED_TEST(PnpTest, HuberRefinementResistsOutliers) {
   // With a mask excluding the corrupted points, plain least squares is as good as Huber.
   std::vector<std::uint8_t> mask(200, 1);
   std::fill(mask.begin(), mask.begin() + 20, 0);
-  const auto c = dyncull::refine_pose(s.world, s.pixels, s.camera, start, ls, mask.data());
+  const auto c = dyncull::refine_pose(s.world, s.pixels, s.camera, start, ls, mask);
   ASSERT_TRUE(c.ok());
   EXPECT_EQ(c.num_points, 180u);
   EXPECT_LT(translation_error(c.cam_from_world, s.cam_from_world), 0.01);
@@ -384,5 +384,17 @@ void pnp_property(std::uint64_t seed) {
 
 TEST(PnpProperty, FloatPoseIsFiniteOrTheCallFails) { pnp_property<float>(61); }
 TEST(PnpProperty, DoublePoseIsFiniteOrTheCallFails) { pnp_property<double>(62); }
+
+// A mask of another length than the correspondences: InvalidInput naming it and both sizes, nothing read
+// past the end (AddressSanitizer).
+TYPED_TEST(PnpTest, MaskOfAnotherLengthIsInvalidInputAndNotRead) {
+  using T = TypeParam;
+  const auto s = make_pnp_scene<T>(45, 50, 0.5, 0.0);
+  const std::vector<std::uint8_t> few(10, 1), all(50, 1);
+  const auto r = dyncull::refine_pose(s.world, s.pixels, s.camera, s.cam_from_world, {}, few);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_EQ(r.reason, "refine_pose: mask has 10 entries for 50 correspondences");
+  EXPECT_TRUE(dyncull::refine_pose(s.world, s.pixels, s.camera, s.cam_from_world, {}, all).ok());
+}
 
 }  // namespace

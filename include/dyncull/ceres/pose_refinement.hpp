@@ -4,6 +4,7 @@
 #pragma once
 
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -49,7 +50,8 @@ struct ReprojectionResidual {
 
 /// Refines cam_from_world with Ceres' Levenberg-Marquardt on the same cost as refine_pose()
 /// (0.5 sum rho(|r|^2), Huber of options.huber_threshold_px when options.huber) over the finite
-/// correspondences in front of the initial camera (mask: optional, non-zero = use). Double
+/// correspondences in front of the initial camera (mask: optional, one flag per correspondence,
+/// non-zero = use; a given mask of another size than world: InvalidInput). Double
 /// internally; options.max_iterations, step_tolerance and cost_tolerance map to Ceres' limits.
 /// InvalidInput for sizes that differ, an invalid camera or options that fail options.validate()
 /// (the same checks as refine_pose()).
@@ -57,7 +59,7 @@ template <class T, class Points3, class Points2>
 PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
                                           const Rigid3<T>& initial_cam_from_world,
                                           const PoseRefinementOptions<T>& options = {},
-                                          const std::uint8_t* mask = nullptr) {
+                                          FlagView mask = nullptr) {
   static_assert(is_point_container_v<Points3> && PointTraits<container_point_t<Points3>>::dim == 3,
                 "refine_pose_ceres: world must be a container of 3-D points");
   static_assert(is_point_container_v<Points2>, "refine_pose_ceres: pixels must be a container of 2-D points");
@@ -69,6 +71,11 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   }
   {
     std::string why;
+    if (!detail::flags_fit(mask, static_cast<std::size_t>(world.size()), "mask", "correspondences", &why)) {
+      res.status = Status::InvalidInput;
+      res.reason = "refine_pose_ceres: " + why;
+      return res;
+    }
     if (options.validate(&why) != Status::Ok) {
       res.status = Status::InvalidInput;
       res.reason = "refine_pose_ceres: " + why;
@@ -96,7 +103,7 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   const std::size_t n = static_cast<std::size_t>(world.size());
   std::size_t used = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (mask && !mask[i]) continue;
+    if (mask.given && !mask[i]) continue;
     const Vec3<double> X = to_vec3<double>(world[i]);
     const Vec2<double> x = to_vec2<double>(pixels[i]);
     if (!X.allFinite() || !x.allFinite()) continue;
@@ -139,7 +146,7 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   double sq = 0;
   std::size_t m = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (mask && !mask[i]) continue;
+    if (mask.given && !mask[i]) continue;
     const Vec3<double> X = to_vec3<double>(world[i]);
     const Vec2<double> x = to_vec2<double>(pixels[i]);
     if (!X.allFinite() || !x.allFinite() || !((init.R * X + init.t)(2) > 0)) continue;

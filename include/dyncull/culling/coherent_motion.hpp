@@ -6,6 +6,7 @@
 #pragma once
 
 #include "dyncull/core/box.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -74,13 +75,14 @@ struct CoherentMotionResult {
 /// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
 /// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: min_noise_px).
 /// in_object_mask / object_box_bits as in refine_subboxes: a box's cells hold only its object's features.
-/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged). residuals, labels and
-/// the optional per-feature arrays are raw pointers that must hold points.size() entries.
+/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged). residuals and labels are
+/// raw pointers that must hold points.size() entries; a given flag view whose size is not points.size()
+/// gives InvalidInput naming it (nothing read).
 template <class T, class Points, class Boxes>
 void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const Boxes& boxes, T noise_px,
                          const CoherentMotionOptions<T>& options, FeatureLabel* labels, CoherentMotionResult<T>* out,
-                         const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr,
-                         const std::uint8_t* eligible = nullptr) {
+                         FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
+                         FlagView eligible = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::flag_coherent_cells: points must hold points (see PointTraits)");
   CoherentMotionResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -94,6 +96,13 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
   if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
     r.reason = "invalid options: " + why;
+    return;
+  }
+  if (!detail::flags_fit(in_object_mask, n, "in_object_mask", "points", &why) ||
+      !detail::flags_fit(object_box_bits, n, "object_box_bits", "points", &why) ||
+      !detail::flags_fit(eligible, n, "eligible", "points", &why)) {
+    r.status = Status::InvalidInput;
+    r.reason = why;
     return;
   }
   const std::size_t cells_per_box = static_cast<std::size_t>(g * g);
@@ -122,7 +131,7 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
     std::fill(start, start + cells_per_box + 1, 0u);
     for (std::size_t i = 0; i < n; ++i) {
       int c = -1;
-      if ((!eligible || eligible[i]) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b) &&
+      if ((!eligible.given || eligible[i]) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b) &&
           residuals[i].allFinite())
         c = detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
       r.scratch_cell[i] = static_cast<std::int8_t>(c);  // grid <= 8: cells 0-63

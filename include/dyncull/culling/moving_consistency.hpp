@@ -3,6 +3,7 @@
 /// each track's distance D = |p2^T F p1| / sqrt(X^2 + Y^2) to its epipolar line; D above a threshold = dynamic.
 #pragma once
 
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -93,13 +94,12 @@ struct MovingConsistencyResult {
 
 /// Runs the check on n tracks prev[i] -> cur[i] (any point containers of equal size), writing into `out`
 /// (buffers reused). valid: optional per-track flag (0 = no track, e.g. LK failed); in_box: optional
-/// per-track flag (1 = inside a dynamic-class box: excluded from the F fit when possible, tighter threshold);
-/// both raw pointers must hold cur.size() flags (cull_frame checks CullingFrame::track_valid's length).
-/// InvalidInput when prev and cur differ in size or the options fail MovingConsistencyOptions::validate.
+/// per-track flag (1 = inside a dynamic-class box: excluded from the F fit when possible, tighter threshold).
+/// InvalidInput (nothing read) when prev and cur differ in size, a given flag view does not hold cur.size()
+/// flags, or the options fail MovingConsistencyOptions::validate.
 template <class T, class C1, class C2>
 void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsistencyOptions<T>& options,
-                              MovingConsistencyResult<T>* out, const std::uint8_t* valid = nullptr,
-                              const std::uint8_t* in_box = nullptr) {
+                              MovingConsistencyResult<T>* out, FlagView valid = nullptr, FlagView in_box = nullptr) {
   static_assert(is_point_container_v<C1> && is_point_container_v<C2>,
                 "dyncull::check_moving_consistency: prev and cur must hold points (see PointTraits)");
   MovingConsistencyResult<T>& r = *out;
@@ -119,6 +119,12 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
     return;
   }
   std::string why;
+  if (!detail::flags_fit(valid, n, "valid", "tracks", &why) ||
+      !detail::flags_fit(in_box, n, "in_box", "tracks", &why)) {
+    r.status = Status::InvalidInput;
+    r.reason = why;
+    return;
+  }
   if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
     r.reason = "invalid options: " + why;
@@ -130,13 +136,13 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
   r.scratch_index.clear();
   std::size_t outside = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (valid && !valid[i]) continue;
+    if (valid.given && !valid[i]) continue;
     const T x1 = point_x<T>(prev[i]), y1 = point_y<T>(prev[i]), x2 = point_x<T>(cur[i]), y2 = point_y<T>(cur[i]);
     if (!std::isfinite(x1) || !std::isfinite(y1) || !std::isfinite(x2) || !std::isfinite(y2)) continue;
     r.scratch_prev.emplace_back(x1, y1);
     r.scratch_cur.emplace_back(x2, y2);
     r.scratch_index.push_back(static_cast<std::uint32_t>(i));
-    outside += !(in_box && in_box[i]);
+    outside += !(in_box.given && in_box[i]);
   }
   const std::size_t m = r.scratch_index.size();
   r.num_valid = m;
@@ -146,7 +152,8 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
                std::to_string(options.min_tracks < 8 ? 8 : options.min_tracks);
     return;
   }
-  const bool subset = in_box && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes && outside < m;
+  const bool subset =
+      in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes && outside < m;
   FundamentalResult<T> fr;
   if (subset) {
     r.scratch_fit_prev.clear();
@@ -212,7 +219,7 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
     const T d = r.scratch_distance[k];
     r.distance_px[i] = d;
     if (!std::isfinite(d)) continue;  // at the epipole: the line is undefined, no evidence
-    const T t = (in_box && in_box[i]) ? t_in : t_out;
+    const T t = (in_box.given && in_box[i]) ? t_in : t_out;
     const bool dyn = d > t;
     r.labels[i] = dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;
     r.num_dynamic += dyn;
@@ -224,8 +231,7 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
 template <class T, class C1, class C2>
 MovingConsistencyResult<T> check_moving_consistency(const C1& prev, const C2& cur,
                                                     const MovingConsistencyOptions<T>& options = {},
-                                                    const std::uint8_t* valid = nullptr,
-                                                    const std::uint8_t* in_box = nullptr) {
+                                                    FlagView valid = nullptr, FlagView in_box = nullptr) {
   MovingConsistencyResult<T> r;
   check_moving_consistency(prev, cur, options, &r, valid, in_box);
   return r;

@@ -7,6 +7,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/mask.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
@@ -257,26 +258,6 @@ struct PipelineResult {
   std::vector<FeatureTrace> trace;  ///< per feature, parallel to labels
 };
 
-
-/// Non-owning view of per-track flags with their count (data[i] != 0: valid). Built from a
-/// std::vector<std::uint8_t> (implicitly) or a pointer and a count: then given, and its count is checked
-/// against the keypoints' (an empty vector for keypoints is a mismatch, not "all valid"); default or
-/// nullptr: no flags.
-struct FlagView {
-  const std::uint8_t* data = nullptr;
-  std::size_t size = 0;
-  bool given = false;
-
-  FlagView() = default;
-  FlagView(std::nullptr_t) {}  // NOLINT(google-explicit-constructor): nullptr means "no flags"
-  FlagView(const std::uint8_t* flags, std::size_t count) : data(flags), size(count), given(true) {}
-  FlagView(const std::vector<std::uint8_t>& flags)  // NOLINT(google-explicit-constructor)
-      : data(flags.data()), size(flags.size()), given(true) {}
-  bool empty() const { return !given; }
-  /// Given, and readable for n entries.
-  bool holds(std::size_t n) const { return given && size == n && (data != nullptr || n == 0); }
-  std::uint8_t operator[](std::size_t i) const { return data[i]; }
-};
 
 /// One frame as the front end has it. Keypoints: the caller's container (cv::KeyPoint, Eigen, ...);
 /// prev_keypoints: previous-frame positions parallel to keypoints (any point container), with

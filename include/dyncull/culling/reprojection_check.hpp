@@ -8,6 +8,7 @@
 
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
@@ -139,15 +140,15 @@ struct ReprojectionCheckResult {
 /// reference keyframe's camera), pixels[i] its position in the current image; camera: the current
 /// image's intrinsics. Non-finite points (no depth) are not evaluated. valid: optional per-track flag;
 /// in_box: optional per-track flag (1 = inside a dynamic-class box: excluded from the fit when possible,
-/// tighter threshold); both raw pointers must hold pixels.size() flags (they carry no length to check:
-/// cull_frame checks CullingFrame::track_valid's). depth: the current depth image, used by the depth
-/// residual when enabled. InvalidInput when points and pixels differ in size, or the options
-/// (ReprojectionCheckOptions::validate), the depth view or the camera are invalid.
+/// tighter threshold). depth: the current depth image, used by the depth residual when enabled.
+/// InvalidInput (nothing read) when points and pixels differ in size, a given flag view does not hold
+/// pixels.size() flags, or the options (ReprojectionCheckOptions::validate), the depth view or the camera
+/// are invalid.
 /// Writes into `out` (buffers reused).
 template <class T, class Points3, class Pixels, class Raw = float>
 void check_reprojection(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera,
                         const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* out,
-                        const std::uint8_t* valid = nullptr, const std::uint8_t* in_box = nullptr,
+                        FlagView valid = nullptr, FlagView in_box = nullptr,
                         const DepthView<Raw>& depth = DepthView<Raw>{}) {
   static_assert(is_point_container_v<Points3> && is_point_container_v<Pixels>,
                 "dyncull::check_reprojection: points and pixels must hold points (see PointTraits)");
@@ -172,6 +173,12 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
     return;
   }
   std::string why;
+  if (!detail::flags_fit(valid, n, "valid", "tracks", &why) ||
+      !detail::flags_fit(in_box, n, "in_box", "tracks", &why)) {
+    r.status = Status::InvalidInput;
+    r.reason = why;
+    return;
+  }
   if (options.validate(&why) != Status::Ok) {
     r.status = Status::InvalidInput;
     r.reason = "invalid options: " + why;
@@ -190,12 +197,12 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
   // Usable tracks: valid, finite pixel and point. Count those outside boxes for the fit subset.
   std::size_t usable = 0, outside = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (valid && !valid[i]) continue;
+    if (valid.given && !valid[i]) continue;
     const T X = point_x<T>(points[i]), Y = point_y<T>(points[i]), Z = point_z<T>(points[i]);
     const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
     if (!(std::isfinite(X) && std::isfinite(Y) && std::isfinite(Z) && std::isfinite(u) && std::isfinite(v))) continue;
     ++usable;
-    outside += !(in_box && in_box[i]);
+    outside += !(in_box.given && in_box[i]);
   }
   r.num_valid = usable;
   if (usable < options.min_tracks || usable < 4) {
@@ -204,12 +211,12 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
                std::to_string(options.min_tracks < 4 ? 4 : options.min_tracks);
     return;
   }
-  const bool subset = in_box && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes;
+  const bool subset = in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes;
   r.scratch_points.clear();
   r.scratch_pixels.clear();
   r.scratch_index.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    if ((valid && !valid[i]) || (subset && in_box[i])) continue;
+    if ((valid.given && !valid[i]) || (subset && in_box[i])) continue;
     const Vec3<T> X(point_x<T>(points[i]), point_y<T>(points[i]), point_z<T>(points[i]));
     const Vec2<T> x(point_x<T>(pixels[i]), point_y<T>(pixels[i]));
     if (!X.allFinite() || !x.allFinite()) continue;
@@ -272,13 +279,13 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
                                options.depth_sigma_reference_m);
   };
   for (std::size_t i = 0; i < n; ++i) {
-    if (valid && !valid[i]) continue;
+    if (valid.given && !valid[i]) continue;
     const Vec3<T> X(point_x<T>(points[i]), point_y<T>(points[i]), point_z<T>(points[i]));
     const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
     if (!X.allFinite() || !std::isfinite(u) || !std::isfinite(v)) continue;
     const Vec3<T> pc = R * X + t;
     T res = std::numeric_limits<T>::infinity();
-    T limit = (in_box && in_box[i]) ? t_in : t_out;
+    T limit = (in_box.given && in_box[i]) ? t_in : t_out;
     if (pc.z() > T(0)) {
       const T du = camera.fx * pc.x() / pc.z() + camera.cx - u, dv = camera.fy * pc.y() / pc.z() + camera.cy - v;
       res = std::sqrt(du * du + dv * dv);
@@ -326,7 +333,7 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
 template <class T, class Points3, class Pixels, class Raw = float>
 ReprojectionCheckResult<T> check_reprojection(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera,
                                               const ReprojectionCheckOptions<T>& options = {},
-                                              const std::uint8_t* valid = nullptr, const std::uint8_t* in_box = nullptr,
+                                              FlagView valid = nullptr, FlagView in_box = nullptr,
                                               const DepthView<Raw>& depth = DepthView<Raw>{}) {
   ReprojectionCheckResult<T> r;
   check_reprojection(points, pixels, camera, options, &r, valid, in_box, depth);

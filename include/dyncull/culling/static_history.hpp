@@ -4,6 +4,8 @@
 /// the box rule (002/004) or the sub-box vote (003 Algorithm 1) says about the region it lies in.
 #pragma once
 
+#include "dyncull/core/flags.hpp"
+#include "dyncull/core/status.hpp"
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/validation.hpp"
 
@@ -11,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace dyncull {
@@ -43,19 +46,28 @@ struct StaticHistoryOptions {
 class StaticHistory {
  public:
   /// Advances one frame over the n tracks `ids`. labels / residual_px (n each): each track's own geometric
-  /// label (Static, Dynamic, or Candidate for no evidence) and residual this frame; nullptr or
+  /// label (Static, Dynamic, or Candidate for no evidence) and residual this frame; not given (nullptr) or
   /// evaluated == false when this frame is no evidence (a baseline too short to see a slow mover, or the
   /// check did not run): the counts then carry over unchanged. A Candidate label leaves its track's count
   /// unchanged; Dynamic, a residual at or above max_residual_px, or a non-finite one resets it to 0.
-  /// counts (resized to n): the track's count after this frame. labels and residual_px are raw pointers
-  /// that must hold ids.size() entries.
+  /// counts (resized to n): the track's count after this frame. A given labels or residual_px view whose
+  /// size is not ids.size(): InvalidInput with the reason (if asked), nothing read, history unchanged.
+  /// (T is deduced from max_residual_px alone, so residual_px converts from a vector or nullptr.)
   template <class T>
-  void update(const std::vector<std::int64_t>& ids, const FeatureLabel* labels, const T* residual_px, bool evaluated,
-              T max_residual_px, std::vector<std::uint16_t>* counts) {
+  Status update(const std::vector<std::int64_t>& ids, ArrayView<FeatureLabel> labels,
+                ArrayView<std::common_type_t<T>> residual_px, bool evaluated, T max_residual_px,
+                std::vector<std::uint16_t>* counts, std::string* reason = nullptr) {
     const std::size_t n = ids.size();
+    std::string why;
+    if (!detail::flags_fit(labels, n, "labels", "track ids", &why) ||
+        !detail::flags_fit(residual_px, n, "residual_px", "track ids", &why)) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    }
+    if (reason) reason->clear();
     counts->resize(n);
     next_.resize(n);
-    const bool evidence = evaluated && labels && residual_px;
+    const bool evidence = evaluated && labels.given && residual_px.given;
     // Front ends usually keep their tracks in creation order (ascending ids): then one merge walk over the
     // sorted history replaces a binary search per track, and the new buffer needs no sort.
     const bool ascending = std::is_sorted(ids.begin(), ids.end());
@@ -77,6 +89,7 @@ class StaticHistory {
     }
     if (!ascending) std::sort(next_.begin(), next_.end(), [](const Entry& a, const Entry& b) { return a.id < b.id; });
     entries_.swap(next_);
+    return Status::Ok;
   }
 
   /// Count of a track after the last update (0 when unknown).

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "dyncull/core/box.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/mask.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
@@ -151,9 +152,9 @@ std::uint8_t subbox_cell_vote(std::uint32_t dyn, std::uint32_t stat, const SubBo
 }
 
 /// Whether feature i belongs to box b's object (no mask given: every feature does).
-inline bool subbox_in_object(const std::uint8_t* in_object, const std::uint32_t* box_bits, std::size_t i, std::size_t b) {
-  if (box_bits && b < 32) return ((box_bits[i] >> b) & 1u) != 0;
-  return !in_object || in_object[i] != 0;
+inline bool subbox_in_object(FlagView in_object, BoxBitsView box_bits, std::size_t i, std::size_t b) {
+  if (box_bits.given && b < 32) return ((box_bits[i] >> b) & 1u) != 0;
+  return !in_object.given || in_object[i] != 0;
 }
 
 /// Starts a result for n features and nb boxes: status Ok, every feature Static, counts zeroed.
@@ -182,6 +183,25 @@ bool subbox_options_valid(const SubBoxOptions<T>& options, SubBoxResult<T>* r) {
   return false;
 }
 
+/// The per-feature views hold n entries and the per-cell one `cells` entries (those given); else
+/// InvalidInput into the result started by subbox_begin, naming the view and both sizes (nothing read).
+template <class T>
+bool subbox_inputs_fit(std::size_t n, std::size_t cells, FlagView in_object_mask, BoxBitsView object_box_bits,
+                       FlagView extra_dynamic_cells, FlagView extra_eligible, SubBoxResult<T>* r) {
+  std::string why;
+  if (flags_fit(in_object_mask, n, "in_object_mask", "points", &why) &&
+      flags_fit(object_box_bits, n, "object_box_bits", "points", &why) &&
+      flags_fit(extra_dynamic_cells, cells, "extra_dynamic_cells", "cells (boxes x grid x grid)", &why) &&
+      flags_fit(extra_eligible, n, "extra_eligible", "points", &why))
+    return true;
+  r->status = Status::InvalidInput;
+  r->reason = why;
+  r->votes.clear();
+  r->cells.clear();
+  r->grid = 0;
+  return false;
+}
+
 /// Zeroed per-box votes and per-cell buffers for nb boxes of grid*grid cells; returns grid*grid.
 template <class T>
 std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
@@ -199,9 +219,8 @@ std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
 /// started by subbox_begin.
 template <class T, class Points, class Boxes>
 void subbox_label_features(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
-                           const SubBoxOptions<T>& options, SubBoxResult<T>* out, const std::uint8_t* in_object_mask,
-                           const std::uint32_t* object_box_bits, const std::uint8_t* extra_dynamic_cells,
-                           const std::uint8_t* extra_eligible) {
+                           const SubBoxOptions<T>& options, SubBoxResult<T>* out, FlagView in_object_mask,
+                           BoxBitsView object_box_bits, FlagView extra_dynamic_cells, FlagView extra_eligible) {
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
@@ -217,7 +236,8 @@ void subbox_label_features(const Points& points, const FeatureLabel* geometric, 
       if (c < 0) continue;
       in_box = true;
       const std::size_t cell = b * cells_per_box + static_cast<std::size_t>(c);
-      const bool extra = extra_dynamic_cells && extra_dynamic_cells[cell] && (!extra_eligible || extra_eligible[i]);
+      const bool extra =
+          extra_dynamic_cells.given && extra_dynamic_cells[cell] && (!extra_eligible.given || extra_eligible[i]);
       in_dynamic = (r.cells[cell] != 0 || extra) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
     }
     const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
@@ -251,14 +271,14 @@ void subbox_label_features(const Points& points, const FeatureLabel* geometric, 
 /// extra_dynamic_cells: optional per box grid*grid flags (box-major, as SubBoxResult::cells) of cells that
 /// are dynamic besides this frame's vote (remembered from earlier frames, subbox_memory.hpp); they take no
 /// part in merging or in the whole-box count and act only on the features with extra_eligible[i] != 0
-/// (nullptr: on all), inside the object mask as the voted cells. The raw pointers carry no length: the
-/// per-feature ones must hold points.size() entries, extra_dynamic_cells boxes.size() * grid * grid.
-/// Options failing SubBoxOptions::validate give InvalidInput (every feature Static).
+/// (not given: on all), inside the object mask as the voted cells. Options failing SubBoxOptions::validate,
+/// or a given view whose size is not points.size() (boxes.size() * grid * grid for extra_dynamic_cells),
+/// give InvalidInput (every feature Static, the view and both sizes named).
 template <class T, class Points, class Boxes>
 void refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
-                     const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr,
-                     const std::uint8_t* extra_dynamic_cells = nullptr, const std::uint8_t* extra_eligible = nullptr) {
+                     FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
+                     FlagView extra_dynamic_cells = nullptr, FlagView extra_eligible = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::refine_subboxes: points must hold points (see PointTraits)");
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -266,6 +286,9 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
+  const std::size_t cells = nb * static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  if (!detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, extra_dynamic_cells, extra_eligible, &r))
+    return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
 
   // Votes: every labelled feature counts in every box containing it (boxes may overlap).
@@ -348,8 +371,8 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
 /// Convenience overload returning a fresh result.
 template <class T, class Points, class Boxes>
 SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
-                                const SubBoxOptions<T>& options = {}, const std::uint8_t* in_object_mask = nullptr,
-                                const std::uint32_t* object_box_bits = nullptr) {
+                                const SubBoxOptions<T>& options = {}, FlagView in_object_mask = nullptr,
+                                BoxBitsView object_box_bits = nullptr) {
   SubBoxResult<T> r;
   refine_subboxes(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   return r;
@@ -359,11 +382,12 @@ SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geomet
 /// earlier frame): per box grid*grid states, box-major, 0 = static with evidence, 1 = dynamic, 2 =
 /// unknown; unknown cells act as dynamic (inside the object mask, as voted ones), so a box without a
 /// remembered vote falls back to the box rule. The counts in `out` stay zero: nothing was voted.
-/// `states` must hold boxes.size() * grid * grid entries (a raw pointer: its length cannot be checked).
+/// `states` must hold boxes.size() * grid * grid entries and the given per-feature views points.size():
+/// else InvalidInput (every feature Static, the view and both sizes named).
 template <class T, class Points, class Boxes>
-void apply_subbox_states(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
-                         const std::uint8_t* states, const SubBoxOptions<T>& options, SubBoxResult<T>* out,
-                         const std::uint8_t* in_object_mask = nullptr, const std::uint32_t* object_box_bits = nullptr) {
+void apply_subbox_states(const Points& points, const FeatureLabel* geometric, const Boxes& boxes, FlagView states,
+                         const SubBoxOptions<T>& options, SubBoxResult<T>* out, FlagView in_object_mask = nullptr,
+                         BoxBitsView object_box_bits = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::apply_subbox_states: points must hold points (see PointTraits)");
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -371,6 +395,17 @@ void apply_subbox_states(const Points& points, const FeatureLabel* geometric, co
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
+  const std::size_t cells = nb * static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
+  if (!states.holds(cells)) {  // required, unlike the other views
+    r.status = Status::InvalidInput;
+    r.reason = "states has " + std::to_string(states.given ? states.size : 0) + " entries for " +
+               std::to_string(cells) + " cells (boxes x grid x grid)";
+    r.votes.clear();
+    r.cells.clear();
+    r.grid = 0;
+    return;
+  }
+  if (!detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, nullptr, nullptr, &r)) return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
   for (std::size_t b = 0; b < nb; ++b) {
     if (!detail::subbox_as_box(boxes[b]).valid()) {

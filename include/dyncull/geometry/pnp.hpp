@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -128,12 +129,12 @@ template <class T, class Points3, class Points2>
 PnpResult<T> solve_pnp_dlt(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera);
 
 /// Levenberg-Marquardt refinement of cam_from_world on all finite correspondences in front of the
-/// camera (mask: optional, non-zero = use). Never throws; NonFinite / TooFewPoints on bad input.
+/// camera (mask: optional, one flag per correspondence, non-zero = use). Never throws; NonFinite /
+/// TooFewPoints on bad input, InvalidInput when a given mask's size is not world.size().
 template <class T, class Points3, class Points2>
 PoseRefinementResult<T> refine_pose(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
                                     const Rigid3<T>& initial_cam_from_world,
-                                    const PoseRefinementOptions<T>& options = {},
-                                    const std::uint8_t* mask = nullptr);
+                                    const PoseRefinementOptions<T>& options = {}, FlagView mask = nullptr);
 
 /// Pose from all correspondences (no outliers expected): DLT when >= 6 non-coplanar points, else the
 /// best P3P solution on a well-spread triple; then LM when options.refine.
@@ -768,12 +769,17 @@ PnpResult<T> solve_pnp_dlt(const Points3& world, const Points2& pixels, const Pi
 template <class T, class Points3, class Points2>
 PoseRefinementResult<T> refine_pose(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
                                     const Rigid3<T>& initial_cam_from_world, const PoseRefinementOptions<T>& options,
-                                    const std::uint8_t* mask) {
+                                    FlagView mask) {
   PoseRefinementResult<T> res;
   res.cam_from_world = initial_cam_from_world;
   if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) return res;
   {
     std::string why;
+    if (!detail::flags_fit(mask, static_cast<std::size_t>(world.size()), "mask", "correspondences", &why)) {
+      res.status = Status::InvalidInput;
+      res.reason = "refine_pose: " + why;
+      return res;
+    }
     if (options.validate(&why) != Status::Ok) {
       res.status = Status::InvalidInput;
       res.reason = "refine_pose: " + why;
@@ -783,7 +789,7 @@ PoseRefinementResult<T> refine_pose(const Points3& world, const Points2& pixels,
   detail::PnpData<T> d;
   detail::load_pnp_data(world, pixels, camera, &d);
   std::vector<std::uint32_t> idx;
-  if (mask) {
+  if (mask.given) {
     idx.reserve(d.size());
     for (std::size_t i = 0; i < d.size(); ++i)
       if (mask[d.index[i]]) idx.push_back(static_cast<std::uint32_t>(i));

@@ -95,8 +95,9 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
   // A baseline too short to vote (min_evidence_frames) is too short to prove a slow mover still.
   const bool evaluated = checked && (frame.evidence_frames <= 0 ||
                                      frame.evidence_frames >= std::max(1, options.min_evidence_frames));
-  history->update(*frame.track_ids, checked ? rp.labels.data() : nullptr, checked ? rp.residual_px.data() : nullptr,
-                  evaluated, options.static_history.max_residual_px, still_frames);
+  history->update(*frame.track_ids, checked ? ArrayView<FeatureLabel>(rp.labels) : nullptr,
+                  checked ? ArrayView<T>(rp.residual_px) : nullptr, evaluated, options.static_history.max_residual_px,
+                  still_frames);
   if (!checked) {
     r->static_history.reason =
         "needs the reprojection check (use_reprojection, points_3d), which did not run: counts carried over";

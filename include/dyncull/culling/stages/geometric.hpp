@@ -24,11 +24,6 @@ std::string no_tracks_reason(const Frame& frame, std::size_t n) {
                                     " positions for " + std::to_string(n) + " keypoints"
                               : std::string("no previous-frame positions (tracks) given");
 }
-template <class Frame>
-const std::uint8_t* track_valid_of(const Frame& frame) {
-  return frame.track_valid.empty() ? nullptr : frame.track_valid.data;
-}
-
 /// Geometric evidence of this frame (out->labels, valid when out->ok); reports into
 /// r.moving_consistency and r.reprojection.
 template <class T, class Frame>
@@ -37,13 +32,12 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
   GeometricEvidence<T>& g = *out;
-  const std::uint8_t* const track_valid = track_valid_of(frame);
-  const std::uint8_t* const in_boxes = regions.dyn_boxes.empty() ? nullptr : semantic.in_dyn_box.data();
+  const FlagView in_boxes = regions.dyn_boxes.empty() ? nullptr : FlagView(semantic.in_dyn_box);
   if (options.use_moving_consistency) {
     if (!have_tracks(frame, n)) {
       r->moving_consistency.reason = no_tracks_reason(frame, n);
     } else {
-      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &g.moving, track_valid, in_boxes);
+      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &g.moving, frame.track_valid, in_boxes);
       r->moving_consistency.status = g.moving.status;
       r->moving_consistency.reason = g.moving.reason;
       r->moving_consistency.num_dynamic = g.moving.num_dynamic;
@@ -57,7 +51,7 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
     if (!frame.points_3d) {
       r->reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
     } else {
-      check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &g.reprojection, track_valid,
+      check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &g.reprojection, frame.track_valid,
                          in_boxes, frame.depth);
       r->reprojection.status = g.reprojection.status;
       r->reprojection.reason = g.reprojection.reason;

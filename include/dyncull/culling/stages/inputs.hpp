@@ -63,9 +63,7 @@ bool accept_inputs(const Frame& frame, const PipelineOptions<T>& options, Pipeli
   if (options.validate(&why) != Status::Ok) {
     why = "invalid options: " + why;
   } else if (frame.depth.validate(&why) != Status::Ok) {
-  } else if (!frame.track_valid.empty() && !frame.track_valid.holds(n)) {
-    why = "track_valid has " + std::to_string(frame.track_valid.size) + " flags for " + std::to_string(n) +
-          " keypoints";
+  } else if (!flags_fit(frame.track_valid, n, "track_valid", "keypoints", &why)) {
   } else {
     return true;
   }

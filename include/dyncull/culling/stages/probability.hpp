@@ -24,11 +24,11 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
     r->probability.reason = no_tracks_reason(frame, n);
     return;
   }
-  const std::uint8_t* const track_valid = track_valid_of(frame);
+  const FlagView track_valid = frame.track_valid;  // accept_inputs checked its size
   p.levels.assign(n, MotionLevel::Ignore);
   p.prev.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const bool valid = !track_valid || track_valid[i] != 0;
+    const bool valid = !track_valid.given || track_valid[i] != 0;
     p.prev[i] = valid ? Vec2<T>(point_x<T>((*frame.prev_keypoints)[i]), point_y<T>((*frame.prev_keypoints)[i]))
                       : Vec2<T>(Constants<T>::nan(), Constants<T>::nan());
     if (semantic.in_dyn_box[i] && semantic.in_object[i] && semantic.rule_ok && i < semantic.rule.box_index.size() &&

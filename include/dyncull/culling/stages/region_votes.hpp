@@ -28,8 +28,8 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
   const bool masks = semantic.masks;
-  const std::uint8_t* const in_object = masks ? semantic.in_object.data() : nullptr;
-  const std::uint32_t* const box_bits = masks ? semantic.object_box_bits.data() : nullptr;
+  const FlagView in_object = masks ? FlagView(semantic.in_object) : nullptr;
+  const BoxBitsView box_bits = masks ? BoxBitsView(semantic.object_box_bits) : nullptr;
   if (!geometric.ok) {
     r->subbox.reason = "needs geometric labels (moving consistency or reprojection), unavailable this frame";
   } else if (regions.dyn_boxes.empty()) {
@@ -42,7 +42,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
                                           options.min_evidence_frames, &v.remembered_cells)
             : 0;
     if (recalled > 0) {
-      apply_subbox_states(kp, geometric.labels.data(), regions.dyn_boxes, v.remembered_cells.data(), options.subbox,
+      apply_subbox_states(kp, geometric.labels.data(), regions.dyn_boxes, v.remembered_cells, options.subbox,
                           &v.subbox, in_object, box_bits);
       r->subbox.status = v.subbox.status;
       r->subbox.num_dynamic = v.subbox.num_dynamic;
@@ -73,7 +73,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
         evidence = v.evidence.data();
         flag_coherent_cells(kp, geometric.reprojection.residual_vec.data(), regions.dyn_boxes,
                             geometric.reprojection.inlier_noise_px, co, v.evidence.data(), &v.coherent, in_object,
-                            box_bits, v.coherent_eligible.data());
+                            box_bits, v.coherent_eligible);
         r->coherent_motion.status = v.coherent.status;
         r->coherent_motion.reason = v.coherent.reason;
         r->coherent_motion.num_dynamic = v.coherent.num_flagged;
@@ -88,7 +88,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
                                   &v.memory_eligible);
     }
     refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits,
-                    memory ? v.remembered_cells.data() : nullptr, memory ? v.memory_eligible.data() : nullptr);
+                    memory ? FlagView(v.remembered_cells) : nullptr, memory ? FlagView(v.memory_eligible) : nullptr);
     if (memory && v.subbox.ok())
       memory_store->remember(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
                              options.subbox_memory_frames);
