@@ -12,7 +12,8 @@ namespace {
 
 constexpr Status kAll[] = {Status::Ok,           Status::TooFewPoints, Status::Degenerate,
                            Status::NonFinite,    Status::NotConverged, Status::InvalidInput,
-                           Status::Skipped,      Status::IoError,      Status::ParseError};
+                           Status::Skipped,      Status::IoError,      Status::ParseError,
+                           Status::MissingInput};
 
 TEST(Status, NamesAreDistinctLowerCaseAndKnown) {
   std::set<std::string> names;
@@ -32,6 +33,7 @@ TEST(Status, OkIsZeroAndNamesAreStable) {
   EXPECT_STREQ(to_string(Status::Ok), "ok");
   EXPECT_STREQ(to_string(Status::Degenerate), "degenerate");
   EXPECT_STREQ(to_string(Status::Skipped), "skipped");
+  EXPECT_STREQ(to_string(Status::MissingInput), "missing input");
   EXPECT_STREQ(to_string(static_cast<Status>(99)), "unknown");
 }
 

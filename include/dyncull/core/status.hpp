@@ -16,6 +16,7 @@ enum class Status {
   Skipped,        ///< the step did not run (missing pose, no depth, disabled) — not an error
   IoError,        ///< a file could not be read or written
   ParseError,     ///< a file was read but a line could not be parsed
+  MissingInput,   ///< an enabled step lacked an input it needs; the result is from the steps that ran
 };
 
 /// Stable lower-case name of a status, for logs and reasons.
@@ -30,6 +31,7 @@ constexpr const char* to_string(Status status) noexcept {
     case Status::Skipped: return "skipped";
     case Status::IoError: return "i/o error";
     case Status::ParseError: return "parse error";
+    case Status::MissingInput: return "missing input";
   }
   return "unknown";
 }
