@@ -365,7 +365,8 @@ class Culler {
     pf.detections = f.detections;
     pf.camera = camera_;
     pf.cam_from_world = have_pose ? &pose : nullptr;
-    pf.is_keyframe = new_keyframe;
+    // Only the multi-view check reads the pipeline's keyframe store; filling it otherwise costs allocations.
+    pf.is_keyframe = new_keyframe && options_.pipeline.use_multiview;
     const PipelineResult<T>* pr = nullptr;
     if (!f.depth_raw.empty()) {
       CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t, std::vector<Vec3<T>>> pu;

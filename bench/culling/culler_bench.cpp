@@ -1,0 +1,151 @@
+// The stateful culler's whole per-frame cost (culling/culler.hpp: its own guided matching to the keyframe,
+// the keyframe's 3-D points, the recommended pipeline, the keyframe policy) on ~1000 ORB features of the
+// 640x480 synthetic walking scene, next to cv::ORB detectAndCompute of the same frames in the same binary.
+// Counter `vs_orb` = the culler's CPU time per frame / ORB's on the same frames (target <= 0.35);
+// `keyframes` = share of frames that became keyframes.
+#include "dyncull/culling/culler.hpp"
+
+#include "dyncull/sim/scene.hpp"
+
+#include <benchmark/benchmark.h>
+
+#ifdef DYNCULL_HAS_OPENCV
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#if defined(__unix__)
+#include <time.h>
+#endif
+
+namespace {
+
+/// CPU seconds of the calling thread: the ratio stays meaningful on a loaded machine.
+double cpu_seconds() {
+#if defined(__unix__) && defined(CLOCK_THREAD_CPUTIME_ID)
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+#else
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+#endif
+}
+
+#ifdef DYNCULL_HAS_OPENCV
+using dyncull::Vec2;
+
+struct Frame {
+  cv::Mat gray;
+  std::vector<Vec2<float>> keys;
+  std::vector<std::uint8_t> descriptors;  // 32 bytes per key
+  std::vector<float> depth;
+  std::vector<dyncull::Detection<float>> detections;
+  dyncull::Rigid3<float> cam_from_world;
+};
+
+struct Sequence {
+  dyncull::PinholeCamera<float> camera;
+  std::vector<Frame> frames;
+  double orb_seconds = 0;  // median ORB detectAndCompute per frame
+  std::size_t features = 0;
+};
+
+const Sequence& sequence() {
+  static const Sequence seq = [] {
+    cv::setNumThreads(1);  // ORB on one core, as the culler runs
+    Sequence s;
+    dyncull::sim::SceneOptions options;
+    options.num_frames = 30;
+    const dyncull::sim::Scene scene(options);
+    s.camera = scene.camera().cast<float>();
+    auto orb = cv::ORB::create(1000);
+    std::vector<double> t;
+    dyncull::sim::FrameData f;
+    for (int i = 0; i < options.num_frames; ++i) {
+      scene.render(i, &f);
+      Frame fr;
+      cv::Mat(f.height, f.width, CV_8UC1, f.gray.data()).copyTo(fr.gray);
+      std::vector<cv::KeyPoint> keys;
+      cv::Mat desc;
+      orb->detectAndCompute(fr.gray, cv::noArray(), keys, desc);  // warm
+      for (int r = 0; r < 5; ++r) {
+        const double t0 = cpu_seconds();
+        orb->detectAndCompute(fr.gray, cv::noArray(), keys, desc);
+        t.push_back(cpu_seconds() - t0);
+      }
+      for (const cv::KeyPoint& k : keys) fr.keys.emplace_back(k.pt.x, k.pt.y);
+      fr.descriptors.assign(desc.datastart, desc.dataend);
+      fr.depth = f.depth_m;
+      fr.detections = f.detections;
+      fr.cam_from_world = f.world_from_cam.inverse().cast<float>();
+      s.features += keys.size();
+      s.frames.push_back(std::move(fr));
+    }
+    std::nth_element(t.begin(), t.begin() + long(t.size() / 2), t.end());
+    s.orb_seconds = t[t.size() / 2];
+    return s;
+  }();
+  return seq;
+}
+
+/// One pass over the sequence with a fresh culler per iteration; the first frame (no keyframe yet) is not timed.
+void BM_CullerPerFrame(benchmark::State& state) {
+  const Sequence& s = sequence();
+  double seconds = 0;
+  std::size_t frames = 0, keyframes = 0;
+  for (auto _ : state) {
+    dyncull::Culler<float> culler(s.camera);
+    for (std::size_t i = 0; i < s.frames.size(); ++i) {
+      const Frame& f = s.frames[i];
+      dyncull::CullerFrame<float> in;
+      in.keypoints = dyncull::points_view(f.keys);
+      in.descriptors = dyncull::DescriptorRows(f.descriptors.data(), f.keys.size(), 32, 32);
+      in.depth_m = dyncull::DepthView<float>{f.depth.data(), s.camera.width, s.camera.height, 0, 1.f, 0.4f, 8.f};
+      in.detections = &f.detections;
+      in.cam_from_world = &f.cam_from_world;
+      const double t0 = cpu_seconds();
+      const dyncull::CullerResult& r = culler.cull(in);
+      const double dt = cpu_seconds() - t0;
+      benchmark::DoNotOptimize(r.num_kept);
+      if (i == 0) continue;
+      seconds += dt;
+      ++frames;
+      keyframes += r.keyframe;
+    }
+  }
+  const double per_frame = seconds / double(frames);
+  state.counters["frame_us"] = 1e6 * per_frame;
+  state.counters["orb_us"] = 1e6 * s.orb_seconds;
+  state.counters["vs_orb"] = per_frame / s.orb_seconds;
+  state.counters["features"] = double(s.features) / double(s.frames.size());
+  state.counters["keyframes"] = double(keyframes) / double(frames);
+}
+BENCHMARK(BM_CullerPerFrame)->Unit(benchmark::kMillisecond);
+
+void BM_OpenCvOrbDetectAndCompute(benchmark::State& state) {
+  const Sequence& s = sequence();
+  auto orb = cv::ORB::create(1000);
+  std::vector<cv::KeyPoint> keys;
+  cv::Mat desc;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    orb->detectAndCompute(s.frames[i].gray, cv::noArray(), keys, desc);
+    benchmark::DoNotOptimize(keys.data());
+    i = (i + 1) % s.frames.size();
+  }
+}
+BENCHMARK(BM_OpenCvOrbDetectAndCompute)->Unit(benchmark::kMicrosecond);
+#else
+void BM_CullerNeedsOpenCv(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(cpu_seconds());
+  state.SetLabel("built without OpenCV: no ORB to compare with");
+}
+BENCHMARK(BM_CullerNeedsOpenCv);
+#endif
+
+}  // namespace
