@@ -4,7 +4,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
-#include "support/culling_scenes.hpp"
+#include "culling/pipeline_fixture.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -18,27 +18,9 @@
 
 namespace {
 using namespace dyncull;
+using Data = bench::PipelineBenchData;
 
-struct Data {
-  test::CullingScene<float> scene;
-  test::SceneKeyframe<float> keyframe;
-  std::vector<Detection<float>> dets;
-};
-
-const Data& data() {
-  static const Data d = [] {
-    Data x;
-    test::SceneConfig config;
-    config.num_uniform = 760;
-    x.scene = test::make_culling_scene<float>(config);
-    x.keyframe = test::make_scene_keyframe<float>(config, 8, 600);
-    x.dets = x.scene.detections;
-    // A fifth box: a cup (medium level) on the desk.
-    x.dets.push_back(Detection<float>{Box<float>{300.f, 330.f, 360.f, 390.f}, 41, 0.8f});
-    return x;
-  }();
-  return d;
-}
+const Data& data() { return bench::pipeline_bench_data(); }
 
 /// with_points: each track's 3-D point at the previous frame (the recommended preset's RGB-D input);
 /// with_ids: a track id per feature (the sub-box memory's input).
@@ -47,18 +29,7 @@ void run_pipeline(benchmark::State& state, const PipelineOptions<float>& options
   const Data& d = data();
   PipelineState<float> st;
   st.keyframes.push(d.keyframe.cam_from_world, d.keyframe.keypoints, d.keyframe.depth_m);
-  CullingFrame<float, std::vector<Vec2<float>>> frame;
-  frame.keypoints = &d.scene.keypoints;
-  frame.prev_keypoints = &d.scene.prev_keypoints;
-  frame.track_valid = d.scene.track_valid;
-  frame.detections = &d.dets;
-  frame.depth = d.scene.depth_view();
-  frame.camera = d.scene.camera;
-  frame.cam_from_world = &d.scene.cam_from_world;
-  if (with_points) frame.points_3d = &d.scene.prev_points_world;
-  std::vector<std::int64_t> ids(d.scene.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i);
-  if (with_ids) frame.track_ids = &ids;
+  const auto frame = bench::pipeline_bench_frame(d, with_points, with_ids);
   std::size_t dyn = 0;
   for (auto _ : state) {
     const auto& r = cull_frame(frame, options, &st);
