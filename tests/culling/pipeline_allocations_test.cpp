@@ -8,6 +8,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
+#include "support/culling_frames.hpp"
 #include "support/culling_scenes.hpp"
 
 #include <gtest/gtest.h>
@@ -60,16 +61,9 @@ std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& opt
   for (int round = 0; round <= warmup_rounds; ++round) {
     for (std::size_t k = 0; k < seq.size(); ++k) {
       const Frame& f = seq[k];
-      CullingFrame<float, std::vector<Vec2<float>>> frame;
-      frame.keypoints = &f.scene.keypoints;
-      frame.prev_keypoints = &f.scene.prev_keypoints;
-      frame.track_valid = f.scene.track_valid;
+      auto frame = test::frame_of(f.scene, f.detections);
       frame.track_ids = &f.ids;
       frame.points_3d = &f.scene.prev_points_world;
-      frame.detections = &f.detections;
-      frame.depth = f.scene.depth_view();
-      frame.camera = f.scene.camera;
-      frame.cam_from_world = &f.scene.cam_from_world;
       frame.is_keyframe = k == 0;
       frame.evidence_frames = 2;
       const std::size_t before = g_allocations.load();

@@ -5,6 +5,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
+#include "support/culling_frames.hpp"
 #include "support/culling_scenes.hpp"
 
 #include <gtest/gtest.h>
@@ -104,16 +105,9 @@ std::uint64_t hash_run(const std::vector<GoldenFrame<T>>& seq, const SceneConfig
   state.keyframes.push(kf.cam_from_world, kf.keypoints, kf.depth_m);
   Hash h;
   for (const GoldenFrame<T>& g : seq) {
-    CullingFrame<T, std::vector<Vec2<T>>> frame;
-    frame.keypoints = &g.scene.keypoints;
-    frame.prev_keypoints = &g.scene.prev_keypoints;
-    frame.track_valid = g.scene.track_valid;
+    auto frame = test::frame_of(g.scene, g.detections);
     frame.track_ids = &g.ids;
     frame.points_3d = &g.scene.prev_points_world;
-    frame.detections = &g.detections;
-    frame.depth = g.scene.depth_view();
-    frame.camera = g.scene.camera;
-    frame.cam_from_world = &g.scene.cam_from_world;
     frame.is_keyframe = g.keyframe;
     frame.evidence_frames = g.evidence_frames;
     const PipelineResult<T>& r = cull_frame(frame, options, &state);
