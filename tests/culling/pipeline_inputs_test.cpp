@@ -1,6 +1,7 @@
 // Bad input to cull_frame: options out of range (PipelineOptions::validate and its nested structs),
-// a track_valid of the wrong length, huge depths through the recommended preset, and random frames with
-// NaN / Inf / huge values: a non-Ok status with a reason, or defined labels and a parallel keep mask.
+// per-keypoint inputs of the wrong length, huge depths through the recommended preset, and random frames
+// with NaN / Inf / huge values: a non-Ok status with a reason, or defined labels and a parallel keep mask.
+// Missing input: a frame without an input an enabled stage needs says MissingInput, naming both.
 #include "dyncull/core/random.hpp"
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
@@ -14,6 +15,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -144,27 +146,170 @@ TYPED_TEST(PipelineInputsTest, TrackValidOfTheWrongLengthIsInvalidInput) {
   expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "track_valid");
   frame.track_valid = FlagView(nullptr, s.size());  // a count without flags
   expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "track_valid");
-  // Flags of the right length, or none at all, run the pipeline.
+  // Flags of the right length, or none at all, run the pipeline (labelled: this frame has no points_3d
+  // or track_ids, which the preset's reprojection check and static history say they lack).
   frame.track_valid = s.track_valid;
-  EXPECT_TRUE(cull_frame(frame, o, &state).ok());
+  EXPECT_TRUE(cull_frame(frame, o, &state).labelled());
   frame.track_valid = nullptr;
-  EXPECT_TRUE(cull_frame(frame, o, &state).ok());
+  EXPECT_TRUE(cull_frame(frame, o, &state).labelled());
 }
 
-TYPED_TEST(PipelineInputsTest, ShortPrevKeypointsSkipTheTrackStagesWithAReason) {
+// Per-keypoint inputs of another length than the keypoints: the frame is refused with both sizes named.
+TYPED_TEST(PipelineInputsTest, PerKeypointInputsOfAnotherLengthAreInvalidInputNamingBothSizes) {
   using T = TypeParam;
   const auto s = test::make_culling_scene<T>();
   const auto dets = detections_of(s);
+  const std::string n = std::to_string(s.size());
   const std::vector<Vec2<T>> prev(s.prev_keypoints.begin(), s.prev_keypoints.begin() + 10);
+  const std::vector<Vec3<T>> points(s.prev_points_world.begin(), s.prev_points_world.begin() + 10);
+  const std::vector<std::int64_t> ids(10, 1);
+  PipelineState<T> state;
   auto frame = frame_of(s, dets);
   frame.prev_keypoints = &prev;
   frame.track_valid = nullptr;
+  expect_nothing_culled(cull_frame(frame, presets::recommended<T>(), &state), s.size(),
+                        ("prev_keypoints has 10 positions for " + n + " keypoints").c_str());
+  frame = frame_of(s, dets);
+  frame.points_3d = &points;
+  expect_nothing_culled(cull_frame(frame, presets::recommended<T>(), &state), s.size(),
+                        ("points_3d has 10 points for " + n + " keypoints").c_str());
+  frame = frame_of(s, dets);
+  frame.track_ids = &ids;
+  expect_nothing_culled(cull_frame(frame, presets::recommended<T>(), &state), s.size(),
+                        ("track_ids has 10 ids for " + n + " keypoints").c_str());
+}
+
+/// Everything a frame can give, for the missing-input tests: one input at a time is then taken away.
+template <class T>
+struct FullFrame {
+  test::CullingScene<T> scene = test::make_culling_scene<T>();
+  std::vector<Detection<T>> dets = detections_of(scene);
+  std::vector<std::int64_t> ids;
+  test::SceneKeyframe<T> keyframe = test::make_scene_keyframe<T>(test::SceneConfig{}, 8, 600);
+  FullFrame() {
+    ids.resize(scene.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i);
+  }
+  CullingFrame<T, std::vector<Vec2<T>>> frame() const {
+    auto f = frame_of(scene, dets);
+    f.track_ids = &ids;
+    f.points_3d = &scene.prev_points_world;
+    return f;
+  }
+  /// A state holding one reference keyframe (or none).
+  void prime(PipelineState<T>* state, bool with_keyframe) const {
+    state->reset();
+    if (with_keyframe) state->keyframes.push(keyframe.cam_from_world, keyframe.keypoints, keyframe.depth_m);
+  }
+};
+
+/// The "stage: input" entries a frame without `input` must report under `o` (none: the preset does not
+/// need it), from the stages the options enable.
+template <class T>
+std::vector<std::string> expected_missing(const PipelineOptions<T>& o, const std::string& input) {
+  std::vector<std::string> out;
+  if (input == "detections") {
+    if (o.use_detection_filter) {
+      out.push_back("detection_filter: no detections given");
+    } else if (o.use_box_rule) {
+      out.push_back("box_rule: no detections given");
+    }
+  } else if (input == "depth") {
+    if (o.use_depth_mask) out.push_back("depth_mask: no depth given");
+    if (o.use_multiview) out.push_back("multiview: no depth given");
+  } else if (input == "prev_keypoints") {
+    if (o.use_probability) out.push_back("probability: no prev_keypoints given");
+    if (o.use_moving_consistency) out.push_back("moving_consistency: no prev_keypoints given");
+  } else if (input == "points_3d") {
+    if (o.use_reprojection) out.push_back("reprojection: no points_3d given");
+  } else if (input == "cam_from_world") {
+    if (o.use_multiview) out.push_back("multiview: no cam_from_world given");
+  } else if (input == "keyframe") {
+    if (o.use_multiview) out.push_back("multiview: no reference keyframe stored yet");
+  } else if (input == "track_ids") {
+    if (o.static_history.min_frames > 0) out.push_back("static_history: no track_ids given");
+  }
+  return out;
+}
+
+// For the recommended preset and each paper's, and for each input a stage of it needs: the full frame is
+// Ok; without the input the frame is MissingInput, its reason names each stage (as its option) and the
+// input, and the stage reports say so; the labels stay defined. An input no enabled stage needs changes
+// nothing. Detections given as an empty vector (a frame without people) are not missing.
+TYPED_TEST(PipelineInputsTest, AFrameLackingAStagesInputSaysWhichStageAndInput) {
+  using T = TypeParam;
+  const FullFrame<T> full;
+  const std::size_t n = full.scene.size();
+  const std::vector<Detection<T>> no_people;
+  const std::vector<std::pair<const char*, PipelineOptions<T>>> presets_to_test = {
+      {"recommended", presets::recommended<T>()}, {"none", presets::none<T>()},
+      {"dld_slam", presets::dld_slam<T>()},       {"rtd_slam", presets::rtd_slam<T>()},
+      {"zhu_2024", presets::zhu_2024<T>()},       {"dfd_slam", presets::dfd_slam<T>()},
+      {"zhang_2023", presets::zhang_2023<T>()}};
+  std::size_t missing_cases = 0;
+  for (const auto& [name, o] : presets_to_test) {
+    PipelineState<T> state;
+    full.prime(&state, true);
+    const PipelineResult<T>& all = cull_frame(full.frame(), o, &state);
+    EXPECT_EQ(all.status, Status::Ok) << name << ": " << all.reason;
+    EXPECT_TRUE(all.labelled()) << name;
+
+    for (const std::string input :
+         {"detections", "depth", "prev_keypoints", "points_3d", "cam_from_world", "keyframe", "track_ids"}) {
+      auto frame = full.frame();
+      if (input == "detections") frame.detections = nullptr;
+      if (input == "depth") frame.depth = DepthView<float>{};
+      if (input == "prev_keypoints") {
+        frame.prev_keypoints = nullptr;
+        frame.track_valid = nullptr;
+      }
+      if (input == "points_3d") frame.points_3d = nullptr;
+      if (input == "cam_from_world") frame.cam_from_world = nullptr;
+      if (input == "track_ids") frame.track_ids = nullptr;
+      full.prime(&state, input != "keyframe");
+      const PipelineResult<T>& r = cull_frame(frame, o, &state);
+      const std::vector<std::string> expected = expected_missing(o, input);
+      ASSERT_EQ(r.labels.size(), n) << name << " without " << input;
+      EXPECT_TRUE(r.labelled()) << name << " without " << input << ": " << r.reason;
+      if (expected.empty()) {
+        EXPECT_EQ(r.status, Status::Ok) << name << " without " << input << ": " << r.reason;
+        continue;
+      }
+      ++missing_cases;
+      EXPECT_EQ(r.status, Status::MissingInput) << name << " without " << input << ": " << r.reason;
+      for (const std::string& e : expected)
+        EXPECT_NE(r.reason.find(e), std::string::npos) << name << " without " << input << ": " << r.reason;
+      for (const StageReport* st : {&r.detections, &r.box_rule, &r.depth_mask, &r.probability, &r.moving_consistency,
+                                    &r.reprojection, &r.multiview, &r.static_history})
+        EXPECT_TRUE(st->status != Status::MissingInput || st->enabled) << name << " without " << input;
+      for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(r.keep[i], r.labels[i] == FeatureLabel::Static ? 1 : 0);
+    }
+
+    // A frame without people: detections given, none in it.
+    auto frame = full.frame();
+    frame.detections = &no_people;
+    full.prime(&state, true);
+    const PipelineResult<T>& empty = cull_frame(frame, o, &state);
+    EXPECT_EQ(empty.status, Status::Ok) << name << ": " << empty.reason;
+  }
+  EXPECT_GE(missing_cases, 15u) << "preset-stage-input cases that lacked an input";
+}
+
+// A stage switched off by its option is not missing anything, whatever the frame lacks.
+TYPED_TEST(PipelineInputsTest, ADisabledStageIsNotMissingInput) {
+  using T = TypeParam;
+  const FullFrame<T> full;
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.use_moving_consistency = false;
+  o.use_probability = false;
+  auto frame = full.frame();
+  frame.prev_keypoints = nullptr;
+  frame.track_valid = nullptr;
   PipelineState<T> state;
-  const PipelineResult<T>& r = cull_frame(frame, presets::recommended<T>(), &state);
-  EXPECT_TRUE(r.ok()) << r.reason;
-  EXPECT_FALSE(r.moving_consistency.ran());
-  EXPECT_NE(r.moving_consistency.reason.find("prev_keypoints has 10 positions"), std::string::npos)
-      << r.moving_consistency.reason;
+  full.prime(&state, true);
+  const PipelineResult<T>& r = cull_frame(frame, o, &state);
+  EXPECT_EQ(r.status, Status::Ok) << r.reason;
+  EXPECT_EQ(r.moving_consistency.status, Status::Skipped);
 }
 
 TYPED_TEST(PipelineInputsTest, InvalidDepthViewIsInvalidInput) {
@@ -185,7 +330,7 @@ TYPED_TEST(PipelineInputsTest, HugeFloatDepthThroughTheRecommendedPreset) {
   for (std::size_t k = 0; k < s.depth.size(); k += 3) s.depth[k] = 1e20f;
   PipelineState<T> state;
   const PipelineResult<T>& r = cull_frame(frame_of(s, dets), presets::recommended<T>(), &state);
-  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_TRUE(r.labelled()) << r.reason;  // MissingInput: no points_3d or track_ids in this frame
   ASSERT_EQ(r.labels.size(), s.size());
   for (FeatureLabel l : r.labels) EXPECT_TRUE(l == FeatureLabel::Static || l == FeatureLabel::Dynamic);
 }
@@ -277,7 +422,7 @@ TYPED_TEST(PipelineInputsTest, PropertyRandomFramesGiveAStatusOrDefinedLabels) {
       ASSERT_NO_THROW(r = &cull_frame(frame, o, &state)) << trial;
       ASSERT_EQ(r->labels.size(), n) << trial;
       ASSERT_EQ(r->keep.size(), n) << trial;
-      if (!r->ok()) {
+      if (!r->labelled()) {
         EXPECT_FALSE(r->reason.empty()) << trial;
         continue;
       }

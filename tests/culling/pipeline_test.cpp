@@ -95,7 +95,7 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   const auto dets = detections_of(s);
   PipelineState<T> state;
   const auto& r = run(s, dets, presets::recommended<T>(), &state, config);
-  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_TRUE(r.labelled()) << r.reason;  // MissingInput: no points_3d or track_ids in this frame
   EXPECT_TRUE(r.box_rule.ran());
   EXPECT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
   EXPECT_TRUE(r.moving_consistency.ran()) << r.moving_consistency.reason;
@@ -164,7 +164,7 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   frame.points_3d = &s.prev_points_world;
   PipelineState<T> state;
   const PipelineResult<T> r = cull_frame(frame, o, &state);
-  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_TRUE(r.labelled()) << r.reason;  // MissingInput: no track_ids for the static history
   ASSERT_TRUE(r.reprojection.ran()) << r.reprojection.reason;
   EXPECT_TRUE(r.moving_consistency.ran());
   EXPECT_TRUE(r.subbox.ran()) << r.subbox.reason;
@@ -208,7 +208,8 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   }
   EXPECT_GE(flags_either, flags_replace);
 
-  // No points, then points of the wrong size: a reason each, and the labels of the epipolar-only preset.
+  // No points: the reprojection check says so and the labels are the epipolar-only preset's. Points of the
+  // wrong size: the frame is refused.
   PipelineOptions<T> epipolar_only = o;
   epipolar_only.use_reprojection = false;
   PipelineState<T> state_epi;
@@ -224,9 +225,9 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   frame.points_3d = &too_few;
   PipelineState<T> state_bad;
   const PipelineResult<T>& rb = cull_frame(frame, o, &state_bad);
-  EXPECT_EQ(rb.reprojection.status, Status::InvalidInput);
-  EXPECT_FALSE(rb.reprojection.reason.empty());
-  EXPECT_EQ(rb.labels, epi_labels);
+  EXPECT_EQ(rb.status, Status::InvalidInput);  // a per-keypoint input of another length refuses the frame
+  EXPECT_NE(rb.reason.find("points_3d has 5 points"), std::string::npos) << rb.reason;
+  EXPECT_EQ(rb.num_dynamic, 0u);
 }
 
 // The seated person sways only about 1 px between the frames (a quarter of the scene's default): its
@@ -493,7 +494,7 @@ TYPED_TEST(PipelineTest, PaperPresetsReproduceTheirRules) {
   }
 }
 
-TYPED_TEST(PipelineTest, MissingInputsSkipStagesWithReasons) {
+TYPED_TEST(PipelineTest, MissingInputsSkipTheirStagesAndTheFrameNamesThem) {
   using T = TypeParam;
   const auto s = test::make_culling_scene<T>(SceneConfig{});
   const auto dets = detections_of(s);
@@ -505,14 +506,16 @@ TYPED_TEST(PipelineTest, MissingInputsSkipStagesWithReasons) {
   PipelineOptions<T> all_on = presets::recommended<T>();
   all_on.use_multiview = true;
   const auto& r = cull_frame(frame, all_on, &state);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.moving_consistency.status, Status::Skipped);
-  EXPECT_NE(r.moving_consistency.reason.find("tracks"), std::string::npos);
-  EXPECT_EQ(r.subbox.status, Status::Skipped);
-  EXPECT_EQ(r.multiview.status, Status::Skipped);
-  EXPECT_NE(r.multiview.reason.find("pose"), std::string::npos);
-  EXPECT_EQ(r.depth_mask.status, Status::Skipped);  // boxes without depth
-  EXPECT_FALSE(r.depth_mask.reason.empty());
+  ASSERT_TRUE(r.labelled()) << r.reason;
+  EXPECT_EQ(r.status, Status::MissingInput);
+  for (const char* missing : {"depth_mask: no depth given", "moving_consistency: no prev_keypoints given",
+                              "reprojection: no points_3d given", "multiview: no cam_from_world given",
+                              "static_history: no track_ids given"})
+    EXPECT_NE(r.reason.find(missing), std::string::npos) << r.reason;
+  EXPECT_EQ(r.moving_consistency.status, Status::MissingInput);
+  EXPECT_EQ(r.subbox.status, Status::Skipped);  // its evidence stages did not run: they say why
+  EXPECT_EQ(r.multiview.status, Status::MissingInput);
+  EXPECT_EQ(r.depth_mask.status, Status::MissingInput);  // boxes without depth
   // Semantics alone: boxed movers are culled, the tv and the room stay.
   EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
   EXPECT_LT(dynamic_rate(s, r, SceneKind::Tv), 0.05);
@@ -529,7 +532,8 @@ TYPED_TEST(PipelineTest, MissingInputsSkipStagesWithReasons) {
   bare.camera = s.camera;
   PipelineState<T> fresh;  // `state` would carry the last frame's boxes forward (box tracker)
   const auto& b = cull_frame(bare, presets::recommended<T>(), &fresh);
-  EXPECT_TRUE(b.ok());
+  EXPECT_TRUE(b.labelled()) << b.reason;
+  EXPECT_EQ(b.reason.find("detection"), std::string::npos) << "detections were given: " << b.reason;
   EXPECT_EQ(b.subbox.status, Status::Skipped);
   EXPECT_EQ(b.num_dynamic, 0u);
 
@@ -893,7 +897,7 @@ TYPED_TEST(PipelineTest, ShortBaselineLeavesPersonBoxesToTheBoxRule) {
   }
   PipelineState<T> state;
   const auto& r = cull_with_baseline(1, &state);
-  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_TRUE(r.labelled()) << r.reason;
   EXPECT_TRUE(r.moving_consistency.ran()) << r.moving_consistency.reason;
   EXPECT_FALSE(r.subbox.ran());
   EXPECT_NE(r.subbox.reason.find("min_evidence_frames"), std::string::npos) << r.subbox.reason;
@@ -934,7 +938,7 @@ TYPED_TEST(PipelineTest, ShortBaselineKeepsTheLastVoteOfTrackedBoxes) {
   ASSERT_TRUE(state.result.subbox.ran()) << state.result.subbox.reason;
   for (int repeat = 0; repeat < 2; ++repeat) {  // the vote is 1, then 2 frames back
     const auto& r = cull_with_baseline(1, &state);
-    ASSERT_TRUE(r.ok()) << r.reason;
+    ASSERT_TRUE(r.labelled()) << r.reason;
     EXPECT_TRUE(r.subbox.ran()) << r.subbox.reason;
     EXPECT_NE(r.subbox.reason.find("last vote"), std::string::npos) << r.subbox.reason;
     EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2) << repeat;
@@ -1018,7 +1022,11 @@ TEST(PipelineReadme, FrontEndExampleCompilesAndRuns) {
   // result.keep[i]: keep keypoint i (apply to every parallel array); result.reasons[i]: who culled it.
   // ---- end ----
 
-  EXPECT_TRUE(result.ok()) << result.reason;
+  // The preset's reprojection check and static history need points_3d and track_ids, which this frame
+  // does not give: the frame says so, and the other stages' labels stand.
+  EXPECT_TRUE(result.labelled()) << result.reason;
+  EXPECT_EQ(result.status, Status::MissingInput);
+  EXPECT_NE(result.reason.find("reprojection: no points_3d given"), std::string::npos) << result.reason;
   EXPECT_EQ(result.keep.size(), keys.size());
   EXPECT_GT(result.num_dynamic, 0u);
   EXPECT_GT(result.num_static, result.num_dynamic);

@@ -18,10 +18,14 @@
 namespace dyncull {
 
 /// Runs the enabled strategies on one frame and returns the labels (a reference into `state`, valid
-/// until the next call). Never throws; bad or missing inputs skip the stages that need them, with a
-/// reason in the stage report. Options that fail PipelineOptions::validate, an invalid depth view
-/// (DepthView::validate) or a track_valid whose size is not the keypoints' give status InvalidInput with
-/// the reason and cull nothing: every keypoint is labelled Static and kept.
+/// until the next call). Never throws. An enabled stage whose input the frame lacks (no prev_keypoints,
+/// depth, points_3d, cam_from_world, detections, track_ids, or no reference keyframe yet) does not run:
+/// its report says MissingInput, and so does the frame's status, with "stage: input" in the reason; the
+/// labels and keep mask are those of the stages that ran (labelled() is true). A stage with nothing to
+/// do (a frame without boxes, detections given as an empty vector) is not missing input. Options that
+/// fail PipelineOptions::validate, an invalid depth view (DepthView::validate) or a given per-keypoint
+/// input (prev_keypoints, track_valid, track_ids, points_3d) whose size is not the keypoints' give status
+/// InvalidInput with the reason and cull nothing: every keypoint is labelled Static and kept.
 ///
 /// Each stage reads the earlier stages' outputs and writes only its own (stages/context.hpp):
 ///   boxes -> semantic evidence (box rule, depth masks) -> geometric evidence (tracks, 3-D points)
@@ -49,6 +53,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   detail::combine_evidence(options, w, &r);
   detail::apply_static_history(frame, options, w.geometric, &s.static_history, &w.still_frames, &w.history_kept, &r);
   detail::guard_survivors(options, &r);
+  detail::report_missing_inputs(&r);
   detail::trace_features(w, &r);
   detail::store_keyframe(frame, r, &w.keypoint_depth, &s.keyframes);
   return r;

@@ -219,7 +219,9 @@ struct PipelineOptions {
   }
 };
 
-/// Outcome of one stage in one frame.
+/// Outcome of one stage in one frame. status: Ok (ran), Skipped (disabled, nothing to do this frame, or an
+/// earlier stage it builds on did not run), MissingInput (enabled, but an input of the frame it needs was
+/// not given: the reason names it), or the stage's own failure.
 struct StageReport {
   bool enabled = false;
   Status status = Status::Skipped;
@@ -238,11 +240,16 @@ struct FeatureTrace {
 };
 
 /// Per-frame result: labels for the caller's keypoint vector (same order), why, and per-stage counts.
+/// status: Ok; MissingInput when an enabled stage could not run for lack of an input of the frame (reason:
+/// "stage: input" for each, as the stage's option is named, joined with "; "), the labels and keep mask then
+/// being those of the stages that ran; InvalidInput when the frame could not be culled at all (nothing
+/// culled). labelled(): the labels are usable (Ok or MissingInput).
 template <class T>
 struct PipelineResult {
   Status status = Status::Ok;
   std::string reason;
   bool ok() const { return status == Status::Ok; }
+  bool labelled() const { return status == Status::Ok || status == Status::MissingInput; }
 
   std::vector<FeatureLabel> labels;  ///< Static or Dynamic (Candidates are resolved by CandidatePolicy)
   std::vector<CullReason> reasons;   ///< deciding strategy (None for untouched statics)

@@ -25,7 +25,7 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
       s.boxes = *frame.detections;
     }
   } else if (options.use_detection_filter) {
-    r->detections.reason = "no detections given";
+    lacks_input(&r->detections, "no detections given");
   }
   if (options.use_box_tracker) {
     // Only dynamic-class boxes are tracked: carrying a missed (or one-frame false positive) low-level box

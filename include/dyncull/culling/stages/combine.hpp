@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 namespace dyncull {
 namespace detail {
@@ -86,8 +87,8 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
   const std::size_t n = r->num_features;
   kept->assign(n, 0);
   if (!r->static_history.enabled) return;
-  if (!frame.track_ids || frame.track_ids->size() != n) {
-    r->static_history.reason = "needs CullingFrame::track_ids";
+  if (!frame.track_ids) {  // given ones hold n ids (accept_inputs)
+    lacks_input(&r->static_history, "no track_ids given");
     return;
   }
   const ReprojectionCheckResult<T>& rp = geometric.reprojection;
@@ -154,6 +155,27 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   r->num_dynamic = n - survivors;
   r->keep.resize(n);
   for (std::size_t i = 0; i < n; ++i) r->keep[i] = r->labels[i] == FeatureLabel::Static;
+}
+
+/// The frame's status: MissingInput, and "stage: input" in the reason (after the guard's, if any), for each
+/// enabled stage that lacked an input; the labels stay those of the stages that ran.
+template <class T>
+void report_missing_inputs(PipelineResult<T>* r) {
+  const std::pair<const char*, const StageReport*> stages[] = {
+      {"detection_filter", &r->detections}, {"box_tracker", &r->tracker},
+      {"box_rule", &r->box_rule},           {"depth_mask", &r->depth_mask},
+      {"probability", &r->probability},     {"moving_consistency", &r->moving_consistency},
+      {"reprojection", &r->reprojection},   {"coherent_motion", &r->coherent_motion},
+      {"subbox", &r->subbox},               {"multiview", &r->multiview},
+      {"static_history", &r->static_history}};
+  for (const auto& st : stages) {
+    if (!st.second->enabled || st.second->status != Status::MissingInput) continue;
+    r->status = Status::MissingInput;
+    if (!r->reason.empty()) r->reason += "; ";
+    r->reason += st.first;
+    r->reason += ": ";
+    r->reason += st.second->reason;
+  }
 }
 
 /// r.trace: what the stages saw of each feature.

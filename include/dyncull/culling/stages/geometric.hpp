@@ -13,17 +13,6 @@
 namespace dyncull {
 namespace detail {
 
-/// The tracks of a frame: previous positions parallel to the keypoints, or why there are none.
-template <class Frame>
-bool have_tracks(const Frame& frame, std::size_t n) {
-  return frame.prev_keypoints && static_cast<std::size_t>(frame.prev_keypoints->size()) == n;
-}
-template <class Frame>
-std::string no_tracks_reason(const Frame& frame, std::size_t n) {
-  return frame.prev_keypoints ? "prev_keypoints has " + std::to_string(frame.prev_keypoints->size()) +
-                                    " positions for " + std::to_string(n) + " keypoints"
-                              : std::string("no previous-frame positions (tracks) given");
-}
 /// Geometric evidence of this frame (out->labels, valid when out->ok); reports into
 /// r.moving_consistency and r.reprojection.
 template <class T, class Frame>
@@ -34,8 +23,8 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
   GeometricEvidence<T>& g = *out;
   const FlagView in_boxes = regions.dyn_boxes.empty() ? nullptr : FlagView(semantic.in_dyn_box);
   if (options.use_moving_consistency) {
-    if (!have_tracks(frame, n)) {
-      r->moving_consistency.reason = no_tracks_reason(frame, n);
+    if (!frame.prev_keypoints) {  // given ones hold n positions (accept_inputs)
+      lacks_input(&r->moving_consistency, "no prev_keypoints given");
     } else {
       check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &g.moving, frame.track_valid, in_boxes);
       r->moving_consistency.status = g.moving.status;
@@ -48,8 +37,8 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
     g.source.assign(n, CullReason::Epipolar);
   }
   if (options.use_reprojection) {
-    if (!frame.points_3d) {
-      r->reprojection.reason = "no 3-D points (CullingFrame::points_3d) given";
+    if (!frame.points_3d) {  // given ones hold n points (accept_inputs)
+      lacks_input(&r->reprojection, "no points_3d given");
     } else {
       check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &g.reprojection, frame.track_valid,
                          in_boxes, frame.depth);

@@ -42,7 +42,8 @@ void begin_frame(const PipelineOptions<T>& options, PipelineResult<T>* r) {
 }
 
 /// False (r filled: InvalidInput, every keypoint Static and kept) when the frame cannot be culled: no
-/// keypoints, invalid options, an invalid depth view or a track_valid of the wrong length.
+/// keypoints, invalid options, an invalid depth view, or a given per-keypoint input (prev_keypoints,
+/// track_valid, track_ids, points_3d) of another length than the keypoints.
 template <class T, class Frame>
 bool accept_inputs(const Frame& frame, const PipelineOptions<T>& options, PipelineResult<T>* r) {
   if (!frame.keypoints) {
@@ -63,7 +64,15 @@ bool accept_inputs(const Frame& frame, const PipelineOptions<T>& options, Pipeli
   if (options.validate(&why) != Status::Ok) {
     why = "invalid options: " + why;
   } else if (frame.depth.validate(&why) != Status::Ok) {
+  } else if (frame.prev_keypoints && static_cast<std::size_t>(frame.prev_keypoints->size()) != n) {
+    why = "prev_keypoints has " + std::to_string(frame.prev_keypoints->size()) + " positions for " +
+          std::to_string(n) + " keypoints";
   } else if (!flags_fit(frame.track_valid, n, "track_valid", "keypoints", &why)) {
+  } else if (frame.track_ids && frame.track_ids->size() != n) {
+    why = "track_ids has " + std::to_string(frame.track_ids->size()) + " ids for " + std::to_string(n) + " keypoints";
+  } else if (frame.points_3d && static_cast<std::size_t>(frame.points_3d->size()) != n) {
+    why = "points_3d has " + std::to_string(frame.points_3d->size()) + " points for " + std::to_string(n) +
+          " keypoints";
   } else {
     return true;
   }

@@ -24,15 +24,18 @@ void check_against_keyframes(const Frame& frame, const PipelineOptions<T>& optio
   if (!options.use_multiview) return;
   const auto& kp = *frame.keypoints;
   if (!frame.cam_from_world || !frame.cam_from_world->all_finite()) {
-    r->multiview.reason = "no current pose (tracking not initialised or lost)";
-    return;
-  }
-  if (keyframes.empty()) {
-    r->multiview.reason = "no keyframe stored yet";
+    lacks_input(&r->multiview, frame.cam_from_world ? "cam_from_world not finite (tracking lost)"
+                                                    : "no cam_from_world given");
     return;
   }
   if (frame.depth.empty()) {
-    r->multiview.reason = "no depth image";
+    lacks_input(&r->multiview, "no depth given");
+    return;
+  }
+  // Before the first keyframe is stored (is_keyframe, or pushed by hand) there is no reference view: an
+  // input the check lacks, as a pose or depth would be, so the frame says so.
+  if (keyframes.empty()) {
+    lacks_input(&r->multiview, "no reference keyframe stored yet");
     return;
   }
   if (!options.multiview_overrides_static &&

@@ -20,8 +20,8 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
   if (!options.use_probability) return;
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
-  if (!have_tracks(frame, n)) {
-    r->probability.reason = no_tracks_reason(frame, n);
+  if (!frame.prev_keypoints) {  // given ones hold n positions (accept_inputs)
+    lacks_input(&r->probability, "no prev_keypoints given");
     return;
   }
   const FlagView track_valid = frame.track_valid;  // accept_inputs checked its size

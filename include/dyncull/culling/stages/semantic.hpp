@@ -161,12 +161,15 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
       }
       r->box_rule.num_dynamic = s.rule.num_dynamic;
     }
+    // Without the detection filter, the box rule is the stage that reads the detections. It still ran on
+    // no boxes, so a non-finite keypoint is culled as on any frame.
+    if (!frame.detections && !options.use_detection_filter) lacks_input(&r->box_rule, "no detections given");
   }
 
   // Inside dynamic-class boxes only the object's depth band is culled.
   if (!options.use_depth_mask) return;
   if (frame.depth.empty()) {
-    r->depth_mask.reason = "no depth image";
+    lacks_input(&r->depth_mask, "no depth given");
     return;
   }
   const DepthMaskResult dm = depth_mask(frame.depth, regions.dyn_boxes, kp, options.depth_mask);
