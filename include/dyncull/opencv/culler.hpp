@@ -1,4 +1,4 @@
-/// @file culler.hpp (opencv)
+/// @file culler.hpp
 /// OpenCV face of the stateful culler (culling/culler.hpp): an ORB-SLAM-like front end's cv::KeyPoint
 /// vector, descriptor cv::Mat, depth cv::Mat (CV_32F metres or CV_16U raw units) and detector boxes in, a
 /// keep mask out. The camera comes from K, the image size and optional distortion (camera_from_K); with
