@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -278,6 +279,13 @@ TYPED_TEST(MultiViewTest, KeyframeRingKeepsNewestAndSelectsLargestMotionFirst) {
   EXPECT_NEAR(double(ring[0].cam_from_world.t.x()), 0.7, 1e-6);  // newest
   EXPECT_NEAR(double(ring[4].cam_from_world.t.x()), 0.3, 1e-6);  // oldest kept
   EXPECT_EQ(ring[0].points.size(), 2u);
+  // A keep mask of another length than the points is refused before a flag is read; one that fits selects.
+  const std::vector<std::uint8_t> short_keep(1, 1), keep{0, 1, 1};
+  EXPECT_EQ(ring.push(Rigid3<T>{}, pts, depth, short_keep), Status::InvalidInput);
+  EXPECT_NEAR(double(ring[0].cam_from_world.t.x()), 0.7, 1e-6) << "nothing stored";
+  KeyframeRing<T> kept(2);
+  ASSERT_EQ(kept.push(Rigid3<T>{}, pts, depth, keep), Status::Ok);
+  EXPECT_EQ(kept[0].points.size(), 1u);
   std::size_t idx[3];
   Rigid3<T> cur;
   cur.t = Vec3<T>(T(0.8), T(0), T(0));

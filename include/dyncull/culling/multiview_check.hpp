@@ -7,6 +7,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
+#include "dyncull/core/flags.hpp"
 #include "dyncull/core/mask.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
@@ -382,10 +383,12 @@ class KeyframeRing {
   }
 
   /// Stores a keyframe: points with valid depth (and keep[i] != 0 when keep is given, one flag per
-  /// point) are copied. InvalidInput, and nothing stored, when depths_m does not hold one depth per point.
+  /// point) are copied. InvalidInput, and nothing stored, when depths_m does not hold one depth per point
+  /// or a given keep does not hold one flag per point.
   template <class C, class D>
-  Status push(const Rigid3<T>& cam_from_world, const C& points, const D& depths_m, const std::uint8_t* keep = nullptr) {
+  Status push(const Rigid3<T>& cam_from_world, const C& points, const D& depths_m, FlagView keep = nullptr) {
     if (static_cast<std::size_t>(depths_m.size()) != static_cast<std::size_t>(points.size())) return Status::InvalidInput;
+    if (keep.given && !keep.holds(static_cast<std::size_t>(points.size()))) return Status::InvalidInput;
     MultiViewKeyframe<T>& slot = slots_[head_];
     head_ = (head_ + 1) % slots_.size();
     size_ = std::min(size_ + 1, slots_.size());
@@ -394,7 +397,7 @@ class KeyframeRing {
     slot.depth_m.clear();
     const std::size_t n = static_cast<std::size_t>(points.size());
     for (std::size_t i = 0; i < n; ++i) {
-      if (keep && !keep[i]) continue;
+      if (keep.given && !keep[i]) continue;
       const T d = static_cast<T>(depths_m[i]);
       const T u = point_x<T>(points[i]), v = point_y<T>(points[i]);
       if (!(d > T(0)) || !std::isfinite(d) || !std::isfinite(u) || !std::isfinite(v)) continue;

@@ -208,7 +208,7 @@ void store_keyframe(const Frame& frame, const PipelineResult<T>& r, std::vector<
     if (keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
       (*keypoint_depth)[i] = T(frame.depth.depth_m(u, v));
   }
-  keyframes->push(*frame.cam_from_world, kp, *keypoint_depth, r.keep.data());
+  keyframes->push(*frame.cam_from_world, kp, *keypoint_depth, r.keep);
 }
 
 }  // namespace detail
