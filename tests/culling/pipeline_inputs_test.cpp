@@ -6,6 +6,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
+#include "support/culling_frames.hpp"
 #include "support/culling_scenes.hpp"
 
 #include <gtest/gtest.h>
@@ -26,25 +27,8 @@ class PipelineInputsTest : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(PipelineInputsTest, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
-template <class T>
-std::vector<Detection<T>> detections_of(const test::CullingScene<T>& s) {
-  std::vector<Detection<T>> out;
-  for (const auto& d : s.detections) out.push_back(Detection<T>{d.box.template cast<T>(), d.class_id, T(d.confidence)});
-  return out;
-}
-
-template <class T>
-CullingFrame<T, std::vector<Vec2<T>>> frame_of(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets) {
-  CullingFrame<T, std::vector<Vec2<T>>> frame;
-  frame.keypoints = &s.keypoints;
-  frame.prev_keypoints = &s.prev_keypoints;
-  frame.track_valid = s.track_valid;
-  frame.detections = &dets;
-  frame.depth = s.depth_view();
-  frame.camera = s.camera;
-  frame.cam_from_world = &s.cam_from_world;
-  return frame;
-}
+using test::detections_of;
+using test::frame_of;  // the scene's frame as a front end would pass it (no 3-D points)
 
 template <class T>
 void expect_nothing_culled(const PipelineResult<T>& r, std::size_t n, const char* field) {

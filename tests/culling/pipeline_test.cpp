@@ -2,6 +2,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
+#include "support/culling_frames.hpp"
 #include "support/culling_scenes.hpp"
 
 #include <gtest/gtest.h>
@@ -35,26 +36,8 @@ double dynamic_rate(const test::CullingScene<T>& s, const PipelineResult<T>& r, 
   return n ? double(d) / double(n) : 0.0;
 }
 
-template <class T>
-std::vector<Detection<T>> detections_of(const test::CullingScene<T>& s) {
-  std::vector<Detection<T>> out;
-  for (const auto& d : s.detections) out.push_back(Detection<T>{d.box.template cast<T>(), d.class_id, T(d.confidence)});
-  return out;
-}
-
-/// The scene's frame as a front end would pass it (no 3-D points).
-template <class T>
-CullingFrame<T, std::vector<Vec2<T>>> frame_of(const test::CullingScene<T>& s, const std::vector<Detection<T>>& dets) {
-  CullingFrame<T, std::vector<Vec2<T>>> frame;
-  frame.keypoints = &s.keypoints;
-  frame.prev_keypoints = &s.prev_keypoints;
-  frame.track_valid = s.track_valid;
-  frame.detections = &dets;
-  frame.depth = s.depth_view();
-  frame.camera = s.camera;
-  frame.cam_from_world = &s.cam_from_world;
-  return frame;
-}
+using test::detections_of;
+using test::frame_of;  // the scene's frame as a front end would pass it (no 3-D points)
 
 /// A W x H camera with its principal point at the image centre (hand-drawn depth scenes).
 template <class T>
