@@ -105,8 +105,8 @@ for s in order:
 md.append("")
 md.append("Cells: median ATE RMSE in cm over the family's motions x seeds (in brackets: change against the recommended"
           " preset). sum: over the families; better / worse: families where the change exceeds 2 %. Precision / recall:"
-          " dynamic labels pooled over every family's runs. recommended-no_<x>: the preset with <x> switched back off"
-          " (dynamic_vo --list says what each undoes).")
+          " dynamic labels pooled over every family's runs. `recommended-no_<x>`: the preset with `<x>` switched back off"
+          " (`dynamic_vo --list` says what each undoes).")
 with open(f"{out}/ablation.md", "w") as f:
     f.write("\n".join(md) + "\n")
 with open(f"{out}/ablation.csv", "w", newline="") as f:

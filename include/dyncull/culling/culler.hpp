@@ -7,10 +7,12 @@
 /// and gets a keep mask, labels, reasons and a status naming any input the configuration lacked.
 ///
 /// API:
+/// @code
 ///   Culler<float> culler(camera);                        // PinholeCamera, no default intrinsics
 ///   CullerFrame<float> f;  f.keypoints = points_view(keys);  f.descriptors = ...;  f.depth_m = ...;
 ///   f.detections = &boxes;  f.cam_from_world = &predicted;  // each optional, see Culler::inputs()
 ///   const CullerResult& r = culler.cull(f);               // r.keep[i]: 1 = static, parallel to keys
+/// @endcode
 #pragma once
 
 #include "dyncull/core/camera.hpp"
