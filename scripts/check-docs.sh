@@ -60,5 +60,18 @@ if [[ $link_status -ne 0 ]]; then
   status=1
 fi
 
-if [[ $status -eq 0 ]]; then echo "check-docs: no development history, all relative links resolve"; fi
+# The README's integration is the snippet of examples/front_end.cpp (which ctest runs), word for word.
+if ! python3 - <<'PY'
+import sys
+src = open("examples/front_end.cpp").read()
+snippet = src.split("// --- README snippet begins ---\n")[1].split("// --- README snippet ends ---")[0]
+lines = [l[2:] if l.startswith("  ") else l for l in snippet.rstrip().split("\n")]
+sys.exit(0 if "\n".join(lines).strip() in open("README.md").read() else 1)
+PY
+then
+  echo "README.md: its integration snippet differs from the one in examples/front_end.cpp" >&2
+  status=1
+fi
+
+if [[ $status -eq 0 ]]; then echo "check-docs: no development history, all relative links resolve, README snippet current"; fi
 exit $status
