@@ -65,6 +65,34 @@ TYPED_TEST(BoxRule, WalkingPersonDynamicTvOverrideChairCandidate) {
   EXPECT_EQ(r.num_low_boxes, 1u);
 }
 
+// A result and scratch reused from a larger frame with an invalid box give what a fresh call gives.
+TYPED_TEST(BoxRule, OutParameterFormMatchesAFreshResultWhenReused) {
+  using T = TypeParam;
+  const Box<T> person{T(100), T(50), T(220), T(400)};
+  const Box<T> tv{T(200), T(100), T(330), T(200)};
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  const std::vector<Detection<T>> first = {{person, kPerson, T(0.9)}, {Box<T>{nan, T(0), T(1), T(1)}, kPerson, T(1)}};
+  const std::vector<Detection<T>> second = {{person, kPerson, T(0.9)}, {tv, kTv, T(0.9)}};
+  const std::vector<Vec2<T>> many = grid_in(Box<T>{T(0), T(0), T(640), T(480)}, 20, 15);
+  const std::vector<Vec2<T>> few = {{T(150), T(300)}, {T(210), T(150)}, {T(600), T(20)}};
+  BoxRuleResult<T> out;
+  BoxRuleScratch<T> scratch;
+  apply_box_rule(many, first, MotionLevelTable::coco80(), BoxRuleOptions<T>{}, &out, &scratch);
+  ASSERT_FALSE(out.reason.empty());  // the invalid box is reported
+  apply_box_rule(few, second, MotionLevelTable::coco80(), BoxRuleOptions<T>{}, &out, &scratch);
+  const BoxRuleResult<T> fresh = apply_box_rule(few, second, MotionLevelTable::coco80(), BoxRuleOptions<T>{});
+  EXPECT_EQ(out.status, fresh.status);
+  EXPECT_EQ(out.reason, fresh.reason);
+  EXPECT_EQ(out.labels, fresh.labels);
+  EXPECT_EQ(out.reasons, fresh.reasons);
+  EXPECT_EQ(out.box_index, fresh.box_index);
+  EXPECT_EQ(out.num_dynamic, fresh.num_dynamic);
+  EXPECT_EQ(out.num_static, fresh.num_static);
+  EXPECT_EQ(out.num_low_override, fresh.num_low_override);
+  EXPECT_EQ(out.num_high_boxes, fresh.num_high_boxes);
+  EXPECT_EQ(out.num_low_boxes, fresh.num_low_boxes);
+}
+
 TYPED_TEST(BoxRule, OptionsChangeTheOutcomeAsDocumented) {
   using T = TypeParam;
   const std::vector<Detection<T>> dets = {{Box<T>{T(0), T(0), T(100), T(100)}, kPerson, T(1)},

@@ -55,6 +55,38 @@ TYPED_TEST(BoxTrackerT, MissedDetectionIsCarriedForwardThenDropped) {
   EXPECT_EQ(r.track_id[0], 1);
 }
 
+// One result reused over a sequence (tracks, misses, drops, an invalid box) reads as fresh results do.
+TYPED_TEST(BoxTrackerT, OutParameterFormMatchesFreshResultsOverASequence) {
+  using T = TypeParam;
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  const std::vector<std::vector<Detection<T>>> frames = {
+      {person_at(T(100)), person_at(T(400))},
+      {person_at(T(106)), Detection<T>{Box<T>{nan, T(0), T(1), T(1)}, 0, T(1)}},
+      {},
+      {},
+      {},
+      {person_at(T(300))}};
+  BoxTracker<T> reused, fresh;
+  BoxTrackerResult<T> out;
+  for (const auto& dets : frames) {
+    reused.update(dets, 640, 480, &out);
+    const BoxTrackerResult<T> want = fresh.update(dets, 640, 480);
+    EXPECT_EQ(out.status, want.status);
+    EXPECT_EQ(out.reason, want.reason);
+    ASSERT_EQ(out.boxes.size(), want.boxes.size());
+    for (std::size_t i = 0; i < out.boxes.size(); ++i) EXPECT_EQ(out.boxes[i].box.x0, want.boxes[i].box.x0);
+    EXPECT_EQ(out.carried, want.carried);
+    EXPECT_EQ(out.track_id, want.track_id);
+    EXPECT_EQ(out.num_matched, want.num_matched);
+    EXPECT_EQ(out.num_new, want.num_new);
+    EXPECT_EQ(out.num_carried, want.num_carried);
+    EXPECT_EQ(out.num_dropped, want.num_dropped);
+  }
+  reused.update({}, 0, 480, &out);
+  EXPECT_EQ(out.status, Status::InvalidInput);
+  EXPECT_TRUE(out.boxes.empty());
+}
+
 TYPED_TEST(BoxTrackerT, RedetectionContinuesTheTrack) {
   using T = TypeParam;
   BoxTracker<T> tracker;

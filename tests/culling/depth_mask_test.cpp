@@ -224,6 +224,40 @@ TYPED_TEST(DepthMask, PointLabelsAgreeWithTheRaster) {
   EXPECT_EQ(a.labels, b.labels);
 }
 
+// A result and scratch reused from a larger frame with a bad box give what a fresh call gives.
+TYPED_TEST(DepthMask, OutParameterFormMatchesAFreshResultWhenReused) {
+  using Raw = TypeParam;
+  Scene<Raw> s;
+  s.fill(4.0);
+  s.person(60, 60, 18, 40, 2.5);
+  s.person(95, 60, 18, 40, 1.2);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Box<double>> first = {{38, 15, 82, 105}, {73, 15, 117, 105}, {nan, 0, 1, 1}};
+  const std::vector<Box<double>> second = {{73, 15, 117, 105}};
+  std::vector<Vec2<float>> many;
+  for (int v = 0; v < H; v += 4)
+    for (int u = 0; u < W; u += 4) many.emplace_back(float(u), float(v));
+  const std::vector<Vec2<float>> few = {Vec2<float>(60, 60), Vec2<float>(100, 60), Vec2<float>(40, 17)};
+  DepthMaskResult out;
+  DepthMaskScratch scratch;
+  depth_mask(s.view(), first, many, DepthMaskOptions{}, &out, &scratch);
+  ASSERT_FALSE(out.reason.empty());  // the bad box is reported
+  depth_mask(s.view(), second, few, DepthMaskOptions{}, &out, &scratch);
+  const DepthMaskResult fresh = depth_mask(s.view(), second, few, DepthMaskOptions{});
+  EXPECT_EQ(out.status, fresh.status);
+  EXPECT_EQ(out.reason, fresh.reason);
+  ASSERT_EQ(out.boxes.size(), fresh.boxes.size());
+  EXPECT_EQ(out.boxes[0].d_c_m, fresh.boxes[0].d_c_m);
+  EXPECT_EQ(out.labels, fresh.labels);
+  EXPECT_EQ(out.reasons, fresh.reasons);
+  EXPECT_EQ(out.box_index, fresh.box_index);
+  EXPECT_EQ(out.box_bits, fresh.box_bits);
+  EXPECT_EQ(out.num_dynamic, fresh.num_dynamic);
+  EXPECT_EQ(out.num_static, fresh.num_static);
+  EXPECT_EQ(out.num_in_boxes, fresh.num_in_boxes);
+  EXPECT_EQ(out.num_mask_pixels, fresh.num_mask_pixels);
+}
+
 // Two people, the near one's box overlapping the far one's: box_bits names every box whose own mask
 // holds a point, box_index the first.
 TYPED_TEST(DepthMask, OverlappingBoxesReportEveryMaskHoldingAPoint) {

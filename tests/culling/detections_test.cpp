@@ -135,6 +135,36 @@ TYPED_TEST(Detections, PixelBoxesAreFilteredTheSameWay) {
   EXPECT_EQ(r.rejections[2], BoxRejection::NonPositiveSize);
 }
 
+// A result reused from a frame with rejections, then from a bad image size, gives what a fresh call gives.
+TYPED_TEST(Detections, OutParameterFormMatchesAFreshResultWhenReused) {
+  using T = TypeParam;
+  DetectionOptions<T> o;
+  o.box_padding_px = T(0);
+  const std::vector<Detection<T>> first = {{Box<T>{T(-50), T(10), T(100), T(500)}, 0, T(0.9)},
+                                           {Box<T>{T(700), T(10), T(800), T(50)}, 0, T(0.9)},
+                                           {Box<T>{T(10), T(10), T(5), T(50)}, 0, T(0.9)}};
+  const std::vector<Detection<T>> second = {{Box<T>{T(20), T(30), T(200), T(300)}, 0, T(0.9)}};
+  DetectionsResult<T> out;
+  filter_detections(first, 640, 480, o, &out);
+  ASSERT_FALSE(out.reason.empty());
+  filter_detections(first, 0, 480, o, &out);
+  ASSERT_EQ(out.status, Status::InvalidInput);
+  for (int w : {640, 0}) {
+    filter_detections(second, w, 480, o, &out);
+    const DetectionsResult<T> fresh = filter_detections(second, w, 480, o);
+    EXPECT_EQ(out.status, fresh.status);
+    EXPECT_EQ(out.reason, fresh.reason);
+    ASSERT_EQ(out.detections.size(), fresh.detections.size());
+    for (std::size_t i = 0; i < out.detections.size(); ++i) EXPECT_EQ(out.detections[i].box.x1, fresh.detections[i].box.x1);
+    EXPECT_EQ(out.source_index, fresh.source_index);
+    EXPECT_EQ(out.rejections, fresh.rejections);
+    EXPECT_EQ(out.num_input, fresh.num_input);
+    EXPECT_EQ(out.num_kept, fresh.num_kept);
+    EXPECT_EQ(out.num_outside, fresh.num_outside);
+    EXPECT_EQ(out.num_invalid, fresh.num_invalid);
+  }
+}
+
 // Negative padding shrinks boxes (for detectors that draw them loose); a box it empties is dropped
 // as NonPositiveSize, one it moves off the image as OutsideImage, and neither is counted as kept.
 TYPED_TEST(Detections, NegativePaddingThatInvertsABoxDropsIt) {

@@ -149,6 +149,41 @@ TYPED_TEST(DynamicProbability, FallbackWhenTooFewStaticFeatures) {
   EXPECT_EQ(f.count(r, kStillPerson, FeatureLabel::Dynamic), 0u);
 }
 
+// A result and scratch reused after a fallback frame and a bad frame give what a fresh call gives.
+TYPED_TEST(DynamicProbability, OutParameterFormMatchesAFreshResultWhenReused) {
+  using T = TypeParam;
+  Random rng(5);
+  Frame<T> fallback, f;
+  fallback.add(rng, 3, Box<double>{0, 0, 640, 480}, MotionLevel::Ignore, {1, 1}, 0.1, kBackground);
+  fallback.add(rng, 80, Box<double>{100, 100, 500, 400}, MotionLevel::High, {9, 1}, 0.1, kWalkingPerson);
+  f.add(rng, 100, Box<double>{0, 0, 640, 480}, MotionLevel::Ignore, {2, 1}, 0.3, kBackground);
+  f.add(rng, 20, Box<double>{300, 100, 400, 400}, MotionLevel::High, {8, 1}, 0.3, kWalkingPerson);
+  const DynamicProbabilityOptions<T> o;
+  DynamicProbabilityResult<T> out;
+  DynamicProbabilityScratch<T> scratch;
+  dynamic_probability(fallback.prev, fallback.curr, fallback.levels, o, EgoMotion<T>{}, nullptr, nullptr, &out,
+                      &scratch);
+  ASSERT_TRUE(out.used_fallback);
+  dynamic_probability(f.prev, fallback.curr, f.levels, o, EgoMotion<T>{}, nullptr, nullptr, &out, &scratch);
+  ASSERT_EQ(out.status, Status::InvalidInput);
+  dynamic_probability(f.prev, f.curr, f.levels, o, EgoMotion<T>{}, nullptr, nullptr, &out, &scratch);
+  const DynamicProbabilityResult<T> fresh = dynamic_probability(f.prev, f.curr, f.levels, o);
+  EXPECT_EQ(out.status, fresh.status);
+  EXPECT_EQ(out.reason, fresh.reason);
+  EXPECT_EQ(out.used_fallback, fresh.used_fallback);
+  EXPECT_EQ(out.labels, fresh.labels);
+  EXPECT_EQ(out.reasons, fresh.reasons);
+  EXPECT_EQ(out.probability, fresh.probability);
+  EXPECT_EQ(out.moving, fresh.moving);
+  EXPECT_EQ(out.temporal, fresh.temporal);
+  EXPECT_EQ(out.reference_flow, fresh.reference_flow);
+  EXPECT_EQ(out.motion_threshold_px, fresh.motion_threshold_px);
+  EXPECT_EQ(out.num_reference, fresh.num_reference);
+  EXPECT_EQ(out.num_masked, fresh.num_masked);
+  EXPECT_EQ(out.num_dynamic, fresh.num_dynamic);
+  EXPECT_EQ(out.num_no_flow, fresh.num_no_flow);
+}
+
 TYPED_TEST(DynamicProbability, BadInputIsReportedNotCrashed) {
   using T = TypeParam;
   std::vector<Vec2<T>> a(5, Vec2<T>::Zero()), b(4, Vec2<T>::Zero());

@@ -126,15 +126,28 @@ void mark_points(const T* xs, const T* ys, std::size_t n, const std::vector<Box<
 }
 }  // namespace detail
 
-/// Applies the box rule to every point. Boxes of Ignore-level classes take no part; invalid
-/// (non-finite or inverted) boxes, and high-level boxes a negative high_padding_px empties, are
-/// skipped and counted in `reason`. Options failing BoxRuleOptions::validate give InvalidInput with
-/// every point Static (None): nothing is decided.
-template <class Points, class Dets, class T = detail::detection_scalar_t<Dets>>
-BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, const MotionLevelTable& levels,
-                                const BoxRuleOptions<T>& options = {}) {
+/// Scratch of apply_box_rule kept by a caller that runs it every frame (no allocation once warm).
+template <class T>
+struct BoxRuleScratch {
+  std::vector<Box<T>> boxes;          ///< effective boxes (padded / shrunk)
+  std::vector<std::uint8_t> bits;     ///< level bit of each effective box
+  std::vector<std::int32_t> source;   ///< detection index of each effective box
+  std::vector<T> xs, ys;              ///< points as structure of arrays
+  std::vector<std::uint8_t> flags;    ///< membership and non-finite bits per point
+};
+
+/// Applies the box rule to every point, writing into `*out` and reusing its and `*scratch`'s
+/// buffers. Boxes of Ignore-level classes take no part; invalid (non-finite or inverted) boxes, and
+/// high-level boxes a negative high_padding_px empties, are skipped and counted in `reason`. Options
+/// failing BoxRuleOptions::validate give InvalidInput with every point Static (None): nothing is decided.
+template <class Points, class Dets, class T>
+void apply_box_rule(const Points& points, const Dets& detections, const MotionLevelTable& levels,
+                    const BoxRuleOptions<T>& options, BoxRuleResult<T>* out, BoxRuleScratch<T>* scratch) {
   static_assert(is_point_container_v<Points>, "apply_box_rule: points must be a container of points");
-  BoxRuleResult<T> r;
+  BoxRuleResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.num_static = r.num_candidate = r.num_dynamic = r.num_low_override = r.num_non_finite = 0;
+  r.num_high_boxes = r.num_medium_boxes = r.num_low_boxes = 0;
   const std::size_t n = points.size();
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
@@ -142,13 +155,16 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
   if (options.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
     r.num_static = n;
-    return r;
+    return;
   }
 
   // Effective boxes (padded / shrunk) with their level bit; detection index kept for box_index.
-  std::vector<Box<T>> boxes;
-  std::vector<std::uint8_t> bits;
-  std::vector<std::int32_t> source;
+  std::vector<Box<T>>& boxes = scratch->boxes;
+  std::vector<std::uint8_t>& bits = scratch->bits;
+  std::vector<std::int32_t>& source = scratch->source;
+  boxes.clear();
+  bits.clear();
+  source.clear();
   boxes.reserve(detections.size());
   std::size_t skipped = 0;
   for (std::size_t b = 0; b < detections.size(); ++b) {
@@ -181,20 +197,27 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
     bits.push_back(bit);
     source.push_back(static_cast<std::int32_t>(b));
   }
-  if (skipped) r.reason = std::to_string(skipped) + " invalid box(es) skipped";
+  if (skipped) {
+    r.reason.assign(std::to_string(skipped));
+    r.reason += " invalid box(es) skipped";
+  }
 
   // NaN / Inf coordinates compare false against every finite bound: never inside a box; they are
   // flagged here (x * 0 is NaN only for non-finite x) and labelled by the decision table.
   // Scratch arrays are left uninitialised: every element is written before it is read.
-  const std::unique_ptr<T[]> xs(new T[n]), ys(new T[n]);
-  const std::unique_ptr<std::uint8_t[]> flags(new std::uint8_t[n]);
+  scratch->xs.resize(n);
+  scratch->ys.resize(n);
+  scratch->flags.resize(n);
+  T* const xs = scratch->xs.data();
+  T* const ys = scratch->ys.data();
+  std::uint8_t* const flags = scratch->flags.data();
   for (std::size_t i = 0; i < n; ++i) {
     const T x = point_x<T>(points[i]), y = point_y<T>(points[i]);
     xs[i] = x;
     ys[i] = y;
     flags[i] = (x * T(0) + y * T(0) == T(0)) ? std::uint8_t(0) : detail::kNonFinite;
   }
-  detail::mark_points(xs.get(), ys.get(), n, boxes, bits, flags.get());
+  detail::mark_points(xs, ys, n, boxes, bits, flags);
 
   // Decision table over the three membership bits and the non-finite bit.
   FeatureLabel label_of[16];
@@ -252,6 +275,15 @@ BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, co
   r.num_low_override = num_override;
   r.num_non_finite = num_bad;
   r.num_static = n - r.num_dynamic - r.num_candidate;
+}
+
+/// The same rule returning a fresh result (allocates; apply_box_rule with an out-parameter reuses buffers).
+template <class Points, class Dets, class T = detail::detection_scalar_t<Dets>>
+BoxRuleResult<T> apply_box_rule(const Points& points, const Dets& detections, const MotionLevelTable& levels,
+                                const BoxRuleOptions<T>& options = {}) {
+  BoxRuleResult<T> r;
+  BoxRuleScratch<T> scratch;
+  apply_box_rule(points, detections, levels, options, &r, &scratch);
   return r;
 }
 

@@ -82,31 +82,36 @@ class BoxTracker {
 
   /// Feeds one frame's detections (already filtered, pixel boxes). Invalid boxes are ignored
   /// (counted in `reason`); a bad image size or options failing BoxTrackerOptions::validate fail
-  /// with InvalidInput and leave the state as is.
-  BoxTrackerResult<T> update(const std::vector<Detection<T>>& detections, int width, int height) {
-    BoxTrackerResult<T> r;
+  /// with InvalidInput and leave the state as is. Writes into `*out`, reusing its buffers and the
+  /// tracker's own scratch (no allocation once warm).
+  void update(const std::vector<Detection<T>>& detections, int width, int height, BoxTrackerResult<T>* out) {
+    BoxTrackerResult<T>& r = *out;
+    r.status = Status::Ok;
+    r.reason.clear();
+    r.boxes.clear();
+    r.carried.clear();
+    r.track_id.clear();
+    r.num_matched = r.num_new = r.num_carried = r.num_dropped = 0;
     if (width <= 0 || height <= 0) {
       r.status = Status::InvalidInput;
-      r.reason = "image size must be positive";
-      return r;
+      r.reason.assign("image size must be positive");
+      return;
     }
     if (options_.validate(&r.reason) != Status::Ok) {
       r.status = Status::InvalidInput;
-      return r;
+      return;
     }
     // Predicted boxes of the existing tracks.
-    std::vector<Box<T>> predicted(tracks_.size());
+    std::vector<Box<T>>& predicted = predicted_;
+    predicted.resize(tracks_.size());
     for (std::size_t t = 0; t < tracks_.size(); ++t) {
       const Box<T>& b = tracks_[t].detection.box;
       const Vec2<T>& v = tracks_[t].velocity;
       predicted[t] = Box<T>{b.x0 + v.x(), b.y0 + v.y(), b.x1 + v.x(), b.y1 + v.y()};
     }
     // Greedy association by IoU, best pairs first (a handful of boxes: O(n^2 log n) is nothing).
-    struct Pair {
-      T iou;
-      std::size_t det, track;
-    };
-    std::vector<Pair> pairs;
+    std::vector<Pair>& pairs = pairs_;
+    pairs.clear();
     std::size_t invalid = 0;
     for (std::size_t d = 0; d < detections.size(); ++d) {
       if (!detections[d].box.valid()) {
@@ -122,15 +127,18 @@ class BoxTracker {
     std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
       return a.iou > b.iou || (a.iou == b.iou && (a.det < b.det || (a.det == b.det && a.track < b.track)));
     });
-    std::vector<std::int64_t> det_track(detections.size(), -1);
-    std::vector<std::uint8_t> track_used(tracks_.size(), 0);
+    std::vector<std::int64_t>& det_track = det_track_;
+    std::vector<std::uint8_t>& track_used = track_used_;
+    det_track.assign(detections.size(), -1);
+    track_used.assign(tracks_.size(), 0);
     for (const Pair& p : pairs) {
       if (det_track[p.det] >= 0 || track_used[p.track]) continue;
       det_track[p.det] = static_cast<std::int64_t>(p.track);
       track_used[p.track] = 1;
     }
 
-    std::vector<TrackedBox<T>> next;
+    std::vector<TrackedBox<T>>& next = next_;
+    next.clear();
     next.reserve(tracks_.size() + detections.size());
     for (std::size_t d = 0; d < detections.size(); ++d) {
       if (!detections[d].box.valid()) continue;
@@ -177,7 +185,16 @@ class BoxTracker {
       next.push_back(tb);
     }
     tracks_.swap(next);
-    if (invalid) r.reason = std::to_string(invalid) + " invalid detection(s) ignored";
+    if (invalid) {
+      r.reason.assign(std::to_string(invalid));
+      r.reason += " invalid detection(s) ignored";
+    }
+  }
+
+  /// The same update returning a fresh result (allocates; the out-parameter form reuses buffers).
+  BoxTrackerResult<T> update(const std::vector<Detection<T>>& detections, int width, int height) {
+    BoxTrackerResult<T> r;
+    update(detections, width, height, &r);
     return r;
   }
 
@@ -188,9 +205,19 @@ class BoxTracker {
   }
 
  private:
+  struct Pair {
+    T iou;
+    std::size_t det, track;
+  };
   BoxTrackerOptions<T> options_;
   std::vector<TrackedBox<T>> tracks_;
   std::int64_t next_id_ = 0;
+  // Scratch of update(), kept so a tracker run every frame does not allocate once warm.
+  std::vector<Box<T>> predicted_;
+  std::vector<Pair> pairs_;
+  std::vector<std::int64_t> det_track_;
+  std::vector<std::uint8_t> track_used_;
+  std::vector<TrackedBox<T>> next_;
 };
 
 }  // namespace dyncull

@@ -209,6 +209,14 @@ struct DepthBand {
   bool none = true;
 };
 
+}  // namespace detail
+
+/// Scratch of depth_mask kept by a caller that runs it every frame.
+struct DepthMaskScratch {
+  std::vector<detail::DepthBand> bands;  ///< per box, its depth band
+};
+
+namespace detail {
 template <class Raw>
 struct RawRange {
   double lo = 0, hi = 0;  ///< valid raw values: lo <= r <= hi
@@ -943,11 +951,17 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
 /// Non-finite points are Dynamic (InvalidInput). Bad boxes are reported per box; the call fails
 /// only when the depth image is missing (Skipped), or the mask has the wrong size, the depth view or
 /// the options do not pass their validate() (InvalidInput; every point then stays Static).
+/// This form writes into `*result` and reuses its and `*scratch`'s buffers (no allocation once warm,
+/// apart from the per-box reason texts of boxes the plain rule does not fit).
 template <class Raw, class Boxes, class Points>
-DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& points,
-                           const DepthMaskOptions& options, MaskView out = {}) {
+void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& points, const DepthMaskOptions& options,
+                DepthMaskResult* result, DepthMaskScratch* scratch, MaskView out = {}) {
   static_assert(is_point_container_v<Points>, "depth_mask: points must be a container of points");
-  DepthMaskResult r;
+  DepthMaskResult& r = *result;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.boxes.clear();
+  r.num_static = r.num_candidate = r.num_dynamic = r.num_in_boxes = r.num_mask_pixels = 0;
   const std::size_t n = points.size();
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
@@ -955,17 +969,18 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
   r.box_bits.assign(n, 0u);
   if (depth.empty()) {
     r.status = Status::Skipped;
-    r.reason = "no depth image";
-    return r;
+    r.reason.assign("no depth image");
+    return;
   }
   if (!out.empty() && (out.width != depth.width || out.height != depth.height)) {
     r.status = Status::InvalidInput;
-    r.reason = "mask size differs from the depth image";
-    return r;
+    r.reason.assign("mask size differs from the depth image");
+    return;
   }
-  if (!detail::depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) return r;
+  if (!detail::depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) return;
   const auto range = detail::valid_raw_range(depth);
-  std::vector<detail::DepthBand> bands(boxes.size());
+  std::vector<detail::DepthBand>& bands = scratch->bands;
+  bands.assign(boxes.size(), detail::DepthBand{});
   r.boxes.reserve(boxes.size());
   std::size_t bad = 0;
   for (std::size_t b = 0; b < boxes.size(); ++b) {
@@ -990,7 +1005,12 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
       r.num_mask_pixels += info.num_mask_pixels;
     }
   }
-  if (bad) r.reason = std::to_string(bad) + " of " + std::to_string(boxes.size()) + " boxes skipped";
+  if (bad) {
+    r.reason.assign(std::to_string(bad));
+    r.reason += " of ";
+    r.reason += std::to_string(boxes.size());
+    r.reason += " boxes skipped";
+  }
 
   for (std::size_t i = 0; i < n; ++i) {
     using S = typename PointTraits<container_point_t<Points>>::Scalar;
@@ -1028,6 +1048,15 @@ DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, cons
     r.num_candidate += r.labels[i] == FeatureLabel::Candidate;
   }
   r.num_static = n - r.num_dynamic - r.num_candidate;
+}
+
+/// The same masks and labels in a fresh result (allocates; the out-parameter form reuses buffers).
+template <class Raw, class Boxes, class Points>
+DepthMaskResult depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& points,
+                           const DepthMaskOptions& options, MaskView out = {}) {
+  DepthMaskResult r;
+  DepthMaskScratch scratch;
+  depth_mask(depth, boxes, points, options, &r, &scratch, out);
   return r;
 }
 

@@ -230,19 +230,25 @@ DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>& boxes
 }
 
 /// Same checks, padding and clipping for boxes already in pixels (e.g. after the detector's own
-/// post-processing), and the same InvalidInput cases.
+/// post-processing), and the same InvalidInput cases; writes into `*out`, reusing its buffers.
 template <class T>
-DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, int width, int height,
-                                      const DetectionOptions<T>& options = {}) {
-  DetectionsResult<T> r;
+void filter_detections(const std::vector<Detection<T>>& boxes, int width, int height,
+                       const DetectionOptions<T>& options, DetectionsResult<T>* out) {
+  DetectionsResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.detections.clear();
+  r.source_index.clear();
+  r.rejections.clear();
+  r.num_kept = r.num_invalid = r.num_outside = r.num_low_confidence = 0;
   r.num_input = boxes.size();
   if (width <= 0 || height <= 0) {
     detail::finish(&r, width, height);
-    return r;
+    return;
   }
   if (options.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
-    return r;
+    return;
   }
   r.rejections.reserve(boxes.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) {
@@ -256,6 +262,14 @@ DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, in
     }
   }
   detail::finish(&r, width, height);
+}
+
+/// The same filter returning a fresh result (allocates; the out-parameter form reuses buffers).
+template <class T>
+DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& boxes, int width, int height,
+                                      const DetectionOptions<T>& options = {}) {
+  DetectionsResult<T> r;
+  filter_detections(boxes, width, height, options, &r);
   return r;
 }
 

@@ -161,6 +161,15 @@ struct DynamicProbabilityResult {
   std::size_t num_masked = 0, num_dynamic = 0, num_no_flow = 0;
 };
 
+/// Scratch of dynamic_probability kept by a caller that runs it every frame.
+template <class T>
+struct DynamicProbabilityScratch {
+  std::vector<Vec2<T>> flow;
+  std::vector<std::uint8_t> has_flow;
+  std::vector<std::size_t> ref;  ///< reference features of eq. 4
+  std::vector<T> u, v, res;      ///< medians' working copies
+};
+
 namespace detail {
 template <class T>
 T median_in_place(std::vector<T>& v) {
@@ -174,16 +183,22 @@ T median_in_place(std::vector<T>& v) {
 /// Dynamic probability of every feature. prev_points[i] -> curr_points[i] is feature i's LK flow
 /// (non-finite = lost track: M = 0). `levels` has one entry per feature. `track_ids` (optional, one
 /// per feature, negative = untracked) with `store` gives K and is updated with this frame's M and
-/// decisions (call store->begin_frame() before each frame).
+/// decisions (call store->begin_frame() before each frame). Writes into `*out`, reusing its and
+/// `*scratch`'s buffers (no allocation once warm).
 template <class T, class Prev, class Curr>
-DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const Curr& curr_points,
-                                                const std::vector<MotionLevel>& levels,
-                                                const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego = {},
-                                                TrackStateStore* store = nullptr,
-                                                const std::vector<std::int64_t>* track_ids = nullptr) {
+void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const std::vector<MotionLevel>& levels,
+                         const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego, TrackStateStore* store,
+                         const std::vector<std::int64_t>* track_ids, DynamicProbabilityResult<T>* out,
+                         DynamicProbabilityScratch<T>* scratch) {
   static_assert(is_point_container_v<Prev> && is_point_container_v<Curr>,
                 "dynamic_probability: points must be containers of points");
-  DynamicProbabilityResult<T> r;
+  DynamicProbabilityResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.reference_flow = Vec2<T>::Zero();
+  r.motion_threshold_px = T(0);
+  r.num_reference = r.num_masked = r.num_dynamic = r.num_no_flow = 0;
+  r.used_fallback = false;
   const std::size_t n = curr_points.size();
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
@@ -193,32 +208,33 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
   r.temporal.assign(n, 0);
   if (prev_points.size() != n || levels.size() != n || (track_ids && track_ids->size() != n)) {
     r.status = Status::InvalidInput;
-    r.reason = "prev_points, curr_points, levels (and track_ids) must have the same size";
-    return r;
+    r.reason.assign("prev_points, curr_points, levels (and track_ids) must have the same size");
+    return;
   }
-  std::string why;
-  if (o.validate(&why) != Status::Ok) {
+  if (o.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
-    r.reason = "invalid options: " + why;
-    return r;
+    r.reason.insert(0, "invalid options: ");
+    return;
   }
   if (static_cast<int>(ego.model) > 2) {
     r.status = Status::InvalidInput;
-    r.reason = "ego.model must be MeanFlow, Fundamental or Homography";
-    return r;
+    r.reason.assign("ego.model must be MeanFlow, Fundamental or Homography");
+    return;
   }
   if (!ego.matrix.allFinite()) {
     r.status = Status::NonFinite;
-    r.reason = "ego-motion matrix is not finite";
-    return r;
+    r.reason.assign("ego-motion matrix is not finite");
+    return;
   }
   auto is_reference = [&](MotionLevel l) {
     return l == MotionLevel::Ignore || (o.low_level_in_reference && l == MotionLevel::Low);
   };
 
   // Residual of each feature against the camera-motion model (MeanFlow: the raw flow for now).
-  std::vector<Vec2<T>> flow(n, Vec2<T>::Zero());
-  std::vector<std::uint8_t> has_flow(n, 0);
+  std::vector<Vec2<T>>& flow = scratch->flow;
+  std::vector<std::uint8_t>& has_flow = scratch->has_flow;
+  flow.assign(n, Vec2<T>::Zero());
+  has_flow.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2<T> p1 = to_vec2<T>(prev_points[i]), p2 = to_vec2<T>(curr_points[i]);
     if (!p1.allFinite() || !p2.allFinite()) continue;
@@ -235,7 +251,8 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
                              : std::numeric_limits<T>::infinity();
     }
   }
-  std::vector<std::size_t> ref;
+  std::vector<std::size_t>& ref = scratch->ref;
+  ref.clear();
   ref.reserve(n);
   for (std::size_t i = 0; i < n; ++i)
     if (has_flow[i] && is_reference(levels[i])) ref.push_back(i);
@@ -248,7 +265,10 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
   r.num_reference = ref.size();
 
   if (ego.model == FlowModel::MeanFlow && !ref.empty()) {
-    std::vector<T> u, v;
+    std::vector<T>& u = scratch->u;
+    std::vector<T>& v = scratch->v;
+    u.clear();
+    v.clear();
     u.reserve(ref.size());
     v.reserve(ref.size());
     for (std::size_t i : ref) {
@@ -274,7 +294,8 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
   if (r.used_fallback || ref.empty()) {
     r.motion_threshold_px = o.fallback_motion_threshold_px;
   } else {
-    std::vector<T> res;
+    std::vector<T>& res = scratch->res;
+    res.clear();
     res.reserve(ref.size());
     for (std::size_t i : ref) res.push_back(r.residual_px[i]);
     const T med = detail::median_in_place(res);
@@ -327,6 +348,18 @@ DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const C
   r.num_no_flow = num_no_flow;
   r.num_masked = num_masked;
   r.num_dynamic = num_dynamic;
+}
+
+/// The same probability in a fresh result (allocates; the out-parameter form reuses buffers).
+template <class T, class Prev, class Curr>
+DynamicProbabilityResult<T> dynamic_probability(const Prev& prev_points, const Curr& curr_points,
+                                                const std::vector<MotionLevel>& levels,
+                                                const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego = {},
+                                                TrackStateStore* store = nullptr,
+                                                const std::vector<std::int64_t>* track_ids = nullptr) {
+  DynamicProbabilityResult<T> r;
+  DynamicProbabilityScratch<T> scratch;
+  dynamic_probability(prev_points, curr_points, levels, o, ego, store, track_ids, &r, &scratch);
   return r;
 }
 

@@ -17,7 +17,8 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
   s.boxes.clear();
   if (frame.detections) {
     if (options.use_detection_filter) {
-      DetectionsResult<T> d = filter_detections(*frame.detections, W, H, options.detections);
+      DetectionsResult<T>& d = s.filtered;
+      filter_detections(*frame.detections, W, H, options.detections, &d);
       r->detections.status = d.status;
       r->detections.reason = d.reason;
       if (d.ok()) s.boxes = d.detections;
@@ -41,7 +42,8 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
     }
     s.boxes.resize(kept);
     tracker->set_options(options.tracker);
-    BoxTrackerResult<T> t = tracker->update(s.boxes, W, H);
+    BoxTrackerResult<T>& t = s.tracked;
+    tracker->update(s.boxes, W, H, &t);
     r->tracker.status = t.status;
     r->tracker.reason = t.reason;
     s.box_track_id.assign(s.boxes.size(), -1);

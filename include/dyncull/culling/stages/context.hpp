@@ -24,12 +24,15 @@ struct BoxRegions {
   std::vector<Detection<T>> boxes, dyn_boxes, untracked_boxes;
   std::vector<std::int32_t> dyn_box_source;
   std::vector<std::int64_t> box_track_id, dyn_box_track_id;  ///< box-tracker id per box (-1: none)
+  DetectionsResult<T> filtered;  ///< the detection filter's result, reused between frames
+  BoxTrackerResult<T> tracked;   ///< the box tracker's result, reused between frames
 };
 
 /// Per-feature semantic evidence: the box rule's labels limited to the objects' depth bands (000 eq. 1-2).
 template <class T>
 struct SemanticEvidence {
   BoxRuleResult<T> rule;  ///< the box rule's own result (box index per feature)
+  BoxRuleScratch<T> rule_scratch;
   bool rule_ok = false;
   std::vector<FeatureLabel> labels;
   std::vector<CullReason> reasons;
@@ -37,6 +40,8 @@ struct SemanticEvidence {
   std::vector<std::uint32_t> object_box_bits;  ///< per feature: the dynamic boxes whose depth mask holds it
   bool masks = false;                          ///< the depth masks ran (in_object, object_box_bits valid)
   std::vector<Detection<T>> shelter_boxes;     ///< scratch of the low-level shelter check
+  DepthMaskResult mask, shelter_mask;         ///< the depth masks' results (the shelter check's: scratch)
+  DepthMaskScratch mask_scratch;
 };
 
 /// 000 eq. 3-5 over the features of the object masks: the semantic labels with the probability's decisions.
@@ -47,6 +52,8 @@ struct ProbabilityEvidence {
   std::vector<CullReason> reasons;
   std::vector<MotionLevel> levels;
   std::vector<Vec2<T>> prev;
+  DynamicProbabilityResult<T> result;  ///< the probability's own result, reused between frames
+  DynamicProbabilityScratch<T> scratch;
 };
 
 /// Per-feature geometric evidence: the epipolar (003 eq. 3) and/or reprojection labels, combined, with

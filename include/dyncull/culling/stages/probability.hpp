@@ -41,8 +41,9 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
     ego.matrix = geometric.moving.F;
   }
   if (frame.track_ids) track_states->begin_frame();
-  const DynamicProbabilityResult<T> pr = dynamic_probability(p.prev, kp, p.levels, options.probability, ego,
-                                                             frame.track_ids ? track_states : nullptr, frame.track_ids);
+  DynamicProbabilityResult<T>& pr = p.result;
+  dynamic_probability(p.prev, kp, p.levels, options.probability, ego, frame.track_ids ? track_states : nullptr,
+                      frame.track_ids, &pr, &p.scratch);
   r->probability.status = pr.status;
   r->probability.reason = pr.reason;
   if (!pr.ok()) return;

@@ -18,12 +18,14 @@ namespace detail {
 /// dynamic-class object's depth mask holds lose the shelter when their depth is nearer that object's d_c
 /// than the d_c of every low-level box holding them. `combined` lists the dynamic-class boxes, then the
 /// low-level ones (scratch); their depth is planned again with occluded_centre_search so a TV's depth is
-/// not read off the walker in front of its centre. Returns how many features lost the shelter.
+/// not read off the walker in front of its centre (into `planned`, scratch too). Returns how many
+/// features lost the shelter.
 template <class T, class Keypoints, class Raw>
 std::size_t unshelter_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, const DepthMaskResult& dm,
                                const std::vector<Detection<T>>& dyn_boxes, const std::vector<Detection<T>>& boxes,
                                const MotionLevelTable& levels, DepthMaskOptions depth_options,
-                               std::vector<Detection<T>>* combined, std::vector<std::uint32_t>* bits,
+                               std::vector<Detection<T>>* combined, DepthMaskResult* planned_out,
+                               DepthMaskScratch* scratch, std::vector<std::uint32_t>* bits,
                                std::vector<FeatureLabel>* labels, std::vector<CullReason>* reasons,
                                std::vector<std::uint8_t>* in_dyn_box) {
   const std::size_t n = bits->size();
@@ -37,7 +39,9 @@ std::size_t unshelter_by_depth(const Keypoints& kp, const DepthView<Raw>& depth,
   if (combined->size() == nd) return 0;
   depth_options.occluded_centre_search = true;
   // Only the per-box depths are needed: no points.
-  const DepthMaskResult planned = depth_mask(depth, *combined, std::vector<Vec2<T>>{}, depth_options);
+  const std::vector<Vec2<T>> no_points;
+  depth_mask(depth, *combined, no_points, depth_options, planned_out, scratch);
+  const DepthMaskResult& planned = *planned_out;
   if (!planned.ok() || planned.boxes.size() != combined->size()) return 0;
   std::size_t changed = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -149,7 +153,7 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
   s.rule_ok = false;
   s.masks = false;
   if (options.use_box_rule) {
-    s.rule = apply_box_rule(kp, regions.boxes, options.levels, options.box_rule);
+    apply_box_rule(kp, regions.boxes, options.levels, options.box_rule, &s.rule, &s.rule_scratch);
     r->box_rule.status = s.rule.status;
     r->box_rule.reason = s.rule.reason;
     if (s.rule.ok()) {
@@ -172,7 +176,8 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
     lacks_input(&r->depth_mask, "no depth given");
     return;
   }
-  const DepthMaskResult dm = depth_mask(frame.depth, regions.dyn_boxes, kp, options.depth_mask);
+  DepthMaskResult& dm = s.mask;
+  depth_mask(frame.depth, regions.dyn_boxes, kp, options.depth_mask, &dm, &s.mask_scratch);
   r->depth_mask.status = dm.status;
   r->depth_mask.reason = dm.reason;
   if (!dm.ok()) return;
@@ -181,7 +186,8 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
   s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
   if (options.low_override_by_depth && options.use_box_rule)
     r->unsheltered = unshelter_by_depth(kp, frame.depth, dm, regions.dyn_boxes, regions.boxes, options.levels,
-                                        options.depth_mask, &s.shelter_boxes, &s.object_box_bits, &s.labels,
+                                        options.depth_mask, &s.shelter_boxes, &s.shelter_mask, &s.mask_scratch,
+                                        &s.object_box_bits, &s.labels,
                                         &s.reasons, &s.in_dyn_box);
   if (options.assign_overlaps_by_depth && options.use_box_rule)
     assign_overlaps_by_depth(kp, frame.depth, dm, regions.dyn_boxes, options.levels, &s.object_box_bits, &s.labels,
