@@ -53,7 +53,7 @@ void BM_CoherentMotion_Cells(benchmark::State& state) {
   const CoherentMotionOptions<float> o;
   for (auto _ : state) {
     std::copy(d.reprojection.labels.begin(), d.reprojection.labels.end(), labels.begin());
-    flag_coherent_cells(d.scene.keypoints, d.reprojection.residual_vec.data(), d.boxes, d.reprojection.inlier_noise_px, o,
+    flag_coherent_cells(d.scene.keypoints, d.reprojection.residual_vec, d.boxes, d.reprojection.inlier_noise_px, o,
                         labels.data(), &r);
     benchmark::DoNotOptimize(labels.data());
   }

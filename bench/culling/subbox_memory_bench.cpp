@@ -32,7 +32,7 @@ void BM_SubBoxMemory_Frame(benchmark::State& state) {
     ++frame;
     for (std::size_t k = 0; k < kTracks / 20; ++k) ids[(frame * 37 + k * 19) % kTracks] = next_id++;
     memory.recall(boxes, 3, frame, 15, &cells);
-    memory.update_tracks(ids, geometric.data(), frame, 15, &eligible);
+    memory.update_tracks(ids, geometric, frame, 15, &eligible);
     memory.remember(boxes, votes, options, frame, 15);
     benchmark::DoNotOptimize(eligible.data());
     benchmark::DoNotOptimize(cells.data());
@@ -67,7 +67,7 @@ void BM_SubBoxMemory_LastVoteFrame(benchmark::State& state) {
     ++frame;
     memory.remember_states(ids, votes, options, frame, 2);
     memory.recall_states(ids, 3, frame + 1, 2, &states);
-    apply_subbox_states(points, geometric.data(), boxes, states, options, &out);
+    apply_subbox_states(points, geometric, boxes, states, options, &out);
     benchmark::DoNotOptimize(out.labels.data());
   }
   state.counters["dynamic"] = double(out.num_dynamic);

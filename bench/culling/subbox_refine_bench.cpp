@@ -55,7 +55,7 @@ void BM_SubBox_Vote_Dyncull(benchmark::State& state) {
   if (state.range(0) == 1) o.whole_box_spare_min_points = 6;
   SubBoxResult<float> r;
   for (auto _ : state) {
-    refine_subboxes(d.scene.keypoints, d.geometric.data(), d.boxes, o, &r);
+    refine_subboxes(d.scene.keypoints, d.geometric, d.boxes, o, &r);
     benchmark::DoNotOptimize(r.labels.data());
   }
   std::vector<std::uint8_t> pred(r.labels.size());
@@ -103,7 +103,7 @@ BENCHMARK(BM_SubBox_Vote_Floor)->Unit(benchmark::kMicrosecond);
 // The raster mask of Algorithm 1: dynamic cells (whole cells: no object mask) dilated by 15 px.
 void BM_SubBox_Mask_Dyncull(benchmark::State& state) {
   const Data& d = data();
-  const auto r = refine_subboxes(d.scene.keypoints, d.geometric.data(), d.boxes, SubBoxOptions<float>{});
+  const auto r = refine_subboxes(d.scene.keypoints, d.geometric, d.boxes, SubBoxOptions<float>{});
   Mask mask(d.scene.width, d.scene.height);
   std::vector<std::uint16_t> scratch;
   std::size_t set = 0;
@@ -120,7 +120,7 @@ BENCHMARK(BM_SubBox_Mask_Dyncull)->Unit(benchmark::kMicrosecond);
 // whole image (what the forks do), same pixels set.
 void BM_SubBox_Mask_PeerCvDilate(benchmark::State& state) {
   const Data& d = data();
-  const auto r = refine_subboxes(d.scene.keypoints, d.geometric.data(), d.boxes, SubBoxOptions<float>{});
+  const auto r = refine_subboxes(d.scene.keypoints, d.geometric, d.boxes, SubBoxOptions<float>{});
   SubBoxOptions<float> undilated;
   undilated.dilation_radius_px = 0;
   Mask cells(d.scene.width, d.scene.height);

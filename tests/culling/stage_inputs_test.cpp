@@ -190,7 +190,7 @@ TYPED_TEST(StageInputsTest, SubBoxMaskUsesTheGridOfTheVote) {
   SubBoxOptions<T> vote;
   vote.grid = 3;
   vote.dilation_radius_px = 0;
-  const SubBoxResult<T> r = refine_subboxes(points, labels.data(), boxes, vote);
+  const SubBoxResult<T> r = refine_subboxes(points, labels, boxes, vote);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.grid, 3);
   Mask expected(100, 100), mask(100, 100);
@@ -209,7 +209,7 @@ TYPED_TEST(StageInputsTest, SubBoxMaskOfAnInconsistentResultSetsNothing) {
   std::vector<FeatureLabel> labels;
   centre_cell_scene(&points, &labels);
   const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(90), T(90)}};
-  SubBoxResult<T> r = refine_subboxes(points, labels.data(), boxes, SubBoxOptions<T>{});
+  SubBoxResult<T> r = refine_subboxes(points, labels, boxes, SubBoxOptions<T>{});
   ASSERT_TRUE(r.ok()) << r.reason;
   r.cells.resize(2);  // not grid * grid per box
   Mask mask(100, 100, 7);
@@ -230,7 +230,7 @@ TYPED_TEST(StageInputsTest, SubBoxOptionsNameTheBadField) {
   expect_names_field(o, "sigma1");
   std::vector<Vec2<T>> points(3, Vec2<T>(T(1), T(1)));
   std::vector<FeatureLabel> labels(3, FeatureLabel::Dynamic);
-  const auto r = refine_subboxes(points, labels.data(), std::vector<Box<T>>{}, o);
+  const auto r = refine_subboxes(points, labels, std::vector<Box<T>>{}, o);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_NE(r.reason.find("sigma1"), std::string::npos) << r.reason;
 }
@@ -249,7 +249,7 @@ TYPED_TEST(StageInputsTest, SubBoxCellsOfAHugeFiniteBox) {
   const std::vector<FeatureLabel> labels(points.size(), FeatureLabel::Dynamic);
   SubBoxOptions<T> o;
   o.min_points = 1;
-  const SubBoxResult<T> r = refine_subboxes(points, labels.data(), boxes, o);
+  const SubBoxResult<T> r = refine_subboxes(points, labels, boxes, o);
   ASSERT_TRUE(r.ok()) << r.reason;
   Mask mask(64, 48);
   std::vector<std::uint16_t> scratch;
@@ -292,7 +292,7 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     o.dilation_radius_px = maybe_wild_int(rng, 3);
     std::vector<std::uint8_t> in_object(n);
     for (auto& f : in_object) f = static_cast<std::uint8_t>(rng.index(2));
-    const SubBoxResult<T> r = refine_subboxes(points, geo.data(), boxes, o, in_object);
+    const SubBoxResult<T> r = refine_subboxes(points, geo, boxes, o, in_object);
     if (!r.ok()) {
       EXPECT_FALSE(r.reason.empty()) << trial;
       continue;
@@ -311,7 +311,7 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     EXPECT_LE(subbox_mask(r, boxes, o, ConstMaskView{}, mask.view(), &scratch), 100u * 80u) << trial;
     std::vector<std::uint8_t> states(r.cells.size(), 2);
     SubBoxResult<T> applied;
-    apply_subbox_states(points, geo.data(), boxes, states, o, &applied);
+    apply_subbox_states(points, geo, boxes, states, o, &applied);
     EXPECT_TRUE(applied.ok()) << applied.reason;
   }
   EXPECT_GT(checked, 30u) << "trials that reached the output checks";
@@ -592,7 +592,7 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
     o.min_noise_px = maybe_wild(rng, T(0.2));
     o.min_median_px = maybe_wild(rng, T(0.5));
     CoherentMotionResult<T> r;
-    flag_coherent_cells(points, residuals.data(), boxes, wild<T>(rng, 0, 2), o, labels.data(), &r);
+    flag_coherent_cells(points, residuals, boxes, wild<T>(rng, 0, 2), o, labels.data(), &r);
     if (r.status != Status::Ok && r.status != Status::Skipped) {
       EXPECT_FALSE(r.reason.empty()) << trial;
       continue;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace dyncull {
@@ -71,24 +72,24 @@ TEST(SubBoxMemory, RememberedCellsCullRecentlyFlaggedAndYoungTracksOnly) {
   const std::vector<std::int64_t> tracks = {100, 200};
   // Frame 1: track 100 flagged, 200 not; both are new (young) anyway.
   std::vector<FeatureLabel> geo = {FeatureLabel::Dynamic, FeatureLabel::Static};
-  memory.update_tracks(tracks, geo.data(), 1, 15, &eligible);
+  memory.update_tracks(tracks, geo, 1, 15, &eligible);
   EXPECT_EQ(eligible, (std::vector<std::uint8_t>{1, 1}));
   geo = {FeatureLabel::Static, FeatureLabel::Candidate};
   for (std::uint64_t f = 2; f <= 16; ++f) {
-    memory.update_tracks(tracks, geo.data(), f, 15, &eligible);
+    memory.update_tracks(tracks, geo, f, 15, &eligible);
     EXPECT_EQ(eligible, (std::vector<std::uint8_t>{1, 1})) << "frame " << f;
   }
   // Frame 17: 100's flag and 200's first sighting are 16 frames back, out of the window.
   geo = {FeatureLabel::Static, FeatureLabel::Dynamic};
-  memory.update_tracks(tracks, geo.data(), 17, 15, &eligible);
+  memory.update_tracks(tracks, geo, 17, 15, &eligible);
   EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 1})) << "200 is flagged now";
   geo = {FeatureLabel::Static, FeatureLabel::Static};
-  memory.update_tracks(tracks, geo.data(), 32, 15, &eligible);
+  memory.update_tracks(tracks, geo, 32, 15, &eligible);
   EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 1}));
-  memory.update_tracks(tracks, geo.data(), 33, 15, &eligible);
+  memory.update_tracks(tracks, geo, 33, 15, &eligible);
   EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 0}));
   // A new track is eligible at once; one unseen for longer than the window is forgotten.
-  memory.update_tracks({300}, geo.data(), 49, 15, &eligible);
+  memory.update_tracks({300}, std::vector<FeatureLabel>{FeatureLabel::Static}, 49, 15, &eligible);
   EXPECT_EQ(eligible, (std::vector<std::uint8_t>{1}));
   EXPECT_EQ(memory.num_tracks(), 1u);
   // Without geometric labels nothing is flagged, and a new memory is empty.
@@ -101,6 +102,23 @@ TEST(SubBoxMemory, RememberedCellsCullRecentlyFlaggedAndYoungTracksOnly) {
 
 // The refinement applies remembered cells to eligible features in the object only, and they neither merge
 // nor count towards the whole-box rule.
+// Given geometric labels hold one per track: a short array is named with both sizes, nothing is read or
+// recorded, and no track is eligible.
+TEST(SubBoxMemory, ShortGeometricLabelsAreInvalidInputAndNotRead) {
+  SubBoxMemory memory;
+  std::vector<std::uint8_t> eligible;
+  const std::vector<std::int64_t> tracks = {100, 200, 300};
+  const std::vector<FeatureLabel> short_geo = {FeatureLabel::Dynamic};
+  std::string reason;
+  EXPECT_EQ(memory.update_tracks(tracks, short_geo, 1, 15, &eligible, &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "geometric has 1 entries for 3 tracks");
+  EXPECT_EQ(eligible, (std::vector<std::uint8_t>{0, 0, 0}));
+  EXPECT_EQ(memory.num_tracks(), 0u);
+  const std::vector<FeatureLabel> geo(3, FeatureLabel::Static);
+  EXPECT_EQ(memory.update_tracks(tracks, geo, 1, 15, &eligible, &reason), Status::Ok);
+  EXPECT_EQ(memory.num_tracks(), 3u);
+}
+
 TEST(SubBoxMemory, RefinementAppliesRememberedCellsToEligibleFeaturesInTheObject) {
   const std::vector<Box<float>> boxes = {{0, 0, 90, 90}};
   // Cell 0 (top left) holds features 0-2, cell 4 (centre) features 3-5; all geometric-static.
@@ -111,7 +129,7 @@ TEST(SubBoxMemory, RefinementAppliesRememberedCellsToEligibleFeaturesInTheObject
   const std::vector<std::uint8_t> eligible = {1, 0, 1, 1, 1, 1};
   const std::vector<std::uint8_t> in_object = {1, 1, 0, 1, 1, 1};
   SubBoxResult<float> r;
-  refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<float>{}, &r, in_object, nullptr, extra,
+  refine_subboxes(pts, geo, boxes, SubBoxOptions<float>{}, &r, in_object, nullptr, extra,
                   eligible);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
@@ -179,7 +197,7 @@ TEST(SubBoxMemory, ApplyingStatesKeepsStaticCellsAndCullsTheObjectElsewhere) {
   const std::vector<std::uint8_t> in_object = {1, 1, 1, 0, 1, 1, 1};
   SubBoxOptions<float> options;
   SubBoxResult<float> r;
-  apply_subbox_states(pts, geo.data(), boxes, states, options, &r, in_object);
+  apply_subbox_states(pts, geo, boxes, states, options, &r, in_object);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_invalid_boxes, 1u);
   EXPECT_EQ(r.labels[0], FeatureLabel::Static) << "static cell, although flagged itself";
@@ -196,10 +214,10 @@ TEST(SubBoxMemory, ApplyingStatesKeepsStaticCellsAndCullsTheObjectElsewhere) {
   EXPECT_EQ(r.votes[0].num_dynamic_cells, 8);
   EXPECT_EQ(r.dyn_count[4] + r.static_count[4], 0u) << "nothing was voted";
   options.keep_geometric_outside_boxes = false;
-  apply_subbox_states(pts, geo.data(), boxes, states, options, &r, in_object);
+  apply_subbox_states(pts, geo, boxes, states, options, &r, in_object);
   EXPECT_EQ(r.labels[6], FeatureLabel::Static);
   options.grid = 9;
-  apply_subbox_states(pts, geo.data(), boxes, states, options, &r);
+  apply_subbox_states(pts, geo, boxes, states, options, &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.labels.size(), pts.size());
 }

@@ -58,7 +58,7 @@ TYPED_TEST(SubBoxTest, SittingPersonKeepsStaticLegsAndCullsTheMovingUpperBody) {
   const auto geo = noisy_geometric_labels(s);
   const auto boxes = person_boxes(s);
   ASSERT_EQ(boxes.size(), 1u);
-  const auto r = refine_subboxes(s.keypoints, geo.data(), boxes, SubBoxOptions<T>{});
+  const auto r = refine_subboxes(s.keypoints, geo, boxes, SubBoxOptions<T>{});
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_FALSE(r.votes[0].whole_box);
   // Top row dynamic, bottom two rows static (003 Figure 8: a seated person moving the upper body).
@@ -90,7 +90,7 @@ TYPED_TEST(SubBoxTest, PaperMergeRuleCullsTheWholeSittingPerson) {
   const auto geo = noisy_geometric_labels(s);
   SubBoxOptions<T> paper;
   paper.merge_ratio = T(0);
-  const auto r = refine_subboxes(s.keypoints, geo.data(), person_boxes(s), paper);
+  const auto r = refine_subboxes(s.keypoints, geo, person_boxes(s), paper);
   ASSERT_TRUE(r.ok());
   EXPECT_TRUE(r.votes[0].whole_box);
   EXPECT_EQ(r.votes[0].num_merged_cells, 3);
@@ -103,7 +103,7 @@ TYPED_TEST(SubBoxTest, WalkingPersonBecomesAWholeDynamicBox) {
   config.tv = false;
   const auto s = test::make_culling_scene<T>(config);
   const auto geo = noisy_geometric_labels(s);
-  const auto r = refine_subboxes(s.keypoints, geo.data(), person_boxes(s), SubBoxOptions<T>{});
+  const auto r = refine_subboxes(s.keypoints, geo, person_boxes(s), SubBoxOptions<T>{});
   ASSERT_TRUE(r.ok());
   EXPECT_TRUE(r.votes[0].whole_box);
   EXPECT_EQ(r.num_whole_boxes, 1u);
@@ -118,7 +118,7 @@ TYPED_TEST(SubBoxTest, WalkingPersonBecomesAWholeDynamicBox) {
   // Outside boxes the geometric label stands (chair and the 8 % false flags on the room).
   SubBoxOptions<T> only_boxes;
   only_boxes.keep_geometric_outside_boxes = false;
-  const auto q = refine_subboxes(s.keypoints, geo.data(), person_boxes(s), only_boxes);
+  const auto q = refine_subboxes(s.keypoints, geo, person_boxes(s), only_boxes);
   EXPECT_LT(q.num_dynamic, r.num_dynamic);
 }
 
@@ -131,7 +131,7 @@ TYPED_TEST(SubBoxTest, EmptyAndInvalidBoxesAndObjectMask) {
   std::vector<Box<T>> boxes{Box<T>{T(100), T(100), T(200), T(200)},                 // empty: no features
                             Box<T>{T(0), T(0), T(29), T(29)},                       // both in cell 0
                             Box<T>{Constants<T>::nan(), T(0), T(1), T(1)}};          // invalid
-  const auto r = refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<T>{});
+  const auto r = refine_subboxes(pts, geo, boxes, SubBoxOptions<T>{});
   EXPECT_TRUE(r.ok());
   EXPECT_EQ(r.num_invalid_boxes, 1u);
   EXPECT_FALSE(r.reason.empty());
@@ -148,16 +148,16 @@ TYPED_TEST(SubBoxTest, EmptyAndInvalidBoxesAndObjectMask) {
   // 8-neighbour merging also takes the diagonal cell 4.
   SubBoxOptions<T> eight;
   eight.merge_8_neighbours = true;
-  EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, eight).votes[1].num_dynamic_cells, 4);
+  EXPECT_EQ(refine_subboxes(pts, geo, boxes, eight).votes[1].num_dynamic_cells, 4);
   // Object-mask flags: a feature in a dynamic cell but outside the object mask stays static.
   const std::vector<std::uint8_t> in_mask{0, 1, 1, 1, 1};
-  const auto m = refine_subboxes(pts, geo.data(), boxes, SubBoxOptions<T>{}, in_mask);
+  const auto m = refine_subboxes(pts, geo, boxes, SubBoxOptions<T>{}, in_mask);
   EXPECT_EQ(m.labels[0], FeatureLabel::Static);
   EXPECT_EQ(m.labels[1], FeatureLabel::Dynamic);
   // Invalid options.
   SubBoxOptions<T> bad;
   bad.grid = 0;
-  EXPECT_EQ(refine_subboxes(pts, geo.data(), boxes, bad).status, Status::InvalidInput);
+  EXPECT_EQ(refine_subboxes(pts, geo, boxes, bad).status, Status::InvalidInput);
 }
 
 // With static_needs_evidence a cell stays static only on a clear static vote: empty cells and split
@@ -173,12 +173,12 @@ TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
   add(T(65), T(65), 1, 0);  // cell 8: one labelled feature, no evidence
   const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(90), T(90)}};
   SubBoxOptions<T> o;
-  const auto plain = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto plain = refine_subboxes(pts, geo, boxes, o);
   ASSERT_TRUE(plain.ok());
   for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(plain.labels[i], FeatureLabel::Static) << i;
   o.static_needs_evidence = true;
   o.static_max_dynamic_ratio = T(0.2);
-  const auto r = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto r = refine_subboxes(pts, geo, boxes, o);
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r.votes[0].whole_box) << "7 assumed cells do not count towards sigma2";
   EXPECT_EQ(r.votes[0].num_merged_cells, 0);
@@ -192,11 +192,11 @@ TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
   EXPECT_EQ(r.cells[4], 1) << "no features at all: the box rule stands";
   // Unanimity required: cell 2's single flag now makes it dynamic too.
   o.static_max_dynamic_ratio = T(0);
-  const auto strict = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto strict = refine_subboxes(pts, geo, boxes, o);
   for (std::size_t i = 5; i < 10; ++i) EXPECT_EQ(strict.labels[i], FeatureLabel::Dynamic) << i;
   for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(strict.labels[i], FeatureLabel::Static) << i;
   o.static_max_dynamic_ratio = Constants<T>::nan();
-  const auto bad = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto bad = refine_subboxes(pts, geo, boxes, o);
   EXPECT_EQ(bad.status, Status::InvalidInput);
   EXPECT_NE(bad.reason.find("static_max_dynamic_ratio"), std::string::npos) << bad.reason;
 }
@@ -217,7 +217,7 @@ TYPED_TEST(SubBoxTest, WholeBoxRuleSparesClearlyStaticCells) {
   const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(90), T(90)}};
   SubBoxOptions<T> o;
   o.static_needs_evidence = true;
-  const auto paper = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto paper = refine_subboxes(pts, geo, boxes, o);
   ASSERT_TRUE(paper.ok()) << paper.reason;
   EXPECT_TRUE(paper.votes[0].whole_box);
   EXPECT_EQ(paper.votes[0].num_spared_cells, 0);
@@ -225,7 +225,7 @@ TYPED_TEST(SubBoxTest, WholeBoxRuleSparesClearlyStaticCells) {
 
   o.whole_box_spare_min_points = 6;
   o.whole_box_spare_max_ratio = T(0.1);
-  const auto r = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto r = refine_subboxes(pts, geo, boxes, o);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_TRUE(r.votes[0].whole_box);
   EXPECT_EQ(r.votes[0].num_spared_cells, 1);
@@ -239,13 +239,13 @@ TYPED_TEST(SubBoxTest, WholeBoxRuleSparesClearlyStaticCells) {
   // Below sigma2 the option changes nothing: cell 7's 25 % and cell 8's three votes stay as voted.
   std::vector<FeatureLabel> calm = geo;
   for (std::size_t i = 10; i < 30; ++i) calm[i] = FeatureLabel::Static;  // cells 2-5 now static
-  const auto few = refine_subboxes(pts, calm.data(), boxes, o);
+  const auto few = refine_subboxes(pts, calm, boxes, o);
   ASSERT_TRUE(few.ok());
   EXPECT_FALSE(few.votes[0].whole_box);
   EXPECT_EQ(few.votes[0].num_spared_cells, 0);
 
   o.whole_box_spare_max_ratio = Constants<T>::nan();
-  const auto bad = refine_subboxes(pts, geo.data(), boxes, o);
+  const auto bad = refine_subboxes(pts, geo, boxes, o);
   EXPECT_EQ(bad.status, Status::InvalidInput);
   EXPECT_NE(bad.reason.find("whole_box_spare_max_ratio"), std::string::npos) << bad.reason;
 }
@@ -277,14 +277,14 @@ TYPED_TEST(SubBoxTest, OverlappingBoxesActOnTheirOwnObjectsOnly) {
 
   // One object flag for all boxes (the chair is in its own box's mask): the overlap is culled.
   SubBoxOptions<T> o;
-  const auto flat = refine_subboxes(pts, geo.data(), boxes, o, in_any);
+  const auto flat = refine_subboxes(pts, geo, boxes, o, in_any);
   ASSERT_TRUE(flat.ok());
   EXPECT_EQ(flat.labels[chair0], FeatureLabel::Dynamic);
   EXPECT_EQ(flat.static_count[8], 2u);  // the chair votes in the walker's cell
 
   // Per-box bits: the chair keeps its features; the walker is still dynamic everywhere.
   o.object_mask_votes_only = true;
-  const auto own = refine_subboxes(pts, geo.data(), boxes, o, in_any, bits);
+  const auto own = refine_subboxes(pts, geo, boxes, o, in_any, bits);
   ASSERT_TRUE(own.ok());
   for (std::size_t i = 0; i < pts.size(); ++i)
     EXPECT_EQ(own.labels[i], i < chair0 ? FeatureLabel::Dynamic : FeatureLabel::Static) << "feature " << i;
@@ -306,7 +306,7 @@ TYPED_TEST(SubBoxTest, RasterMaskIsObjectMaskInDynamicCellsDilated) {
   SubBoxOptions<T> opt;
   opt.merge_ratio = T(2);  // static neighbours with evidence are never merged: one dynamic cell
   opt.dilation_radius_px = 3;
-  const auto r = refine_subboxes(pts, geo.data(), boxes, opt);
+  const auto r = refine_subboxes(pts, geo, boxes, opt);
   ASSERT_EQ(r.votes[0].num_dynamic_cells, 1);
   Mask out(W, H);
   std::vector<std::uint16_t> scratch;
@@ -382,26 +382,55 @@ TYPED_TEST(SubBoxTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
     for (FeatureLabel l : r.labels) EXPECT_EQ(l, FeatureLabel::Static);
   };
   SubBoxResult<T> r;
-  refine_subboxes(pts, geo.data(), boxes, o, &r, one, bits);
+  refine_subboxes(pts, geo, boxes, o, &r, one, bits);
   expect_invalid(r, "in_object_mask has 1 entries for 3 points");
-  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, one_bits);
+  refine_subboxes(pts, geo, boxes, o, &r, flags, one_bits);
   expect_invalid(r, "object_box_bits has 1 entries for 3 points");
-  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, bits, few_cells, flags);
+  refine_subboxes(pts, geo, boxes, o, &r, flags, bits, few_cells, flags);
   expect_invalid(r, "extra_dynamic_cells has 9 entries for 18 cells (boxes x grid x grid)");
-  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, bits, cells, one);
+  refine_subboxes(pts, geo, boxes, o, &r, flags, bits, cells, one);
   expect_invalid(r, "extra_eligible has 1 entries for 3 points");
-  refine_subboxes(pts, geo.data(), boxes, o, &r, flags, bits, cells, flags);
+  refine_subboxes(pts, geo, boxes, o, &r, flags, bits, cells, flags);
   EXPECT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);
 
-  apply_subbox_states(pts, geo.data(), boxes, few_cells, o, &r);
+  apply_subbox_states(pts, geo, boxes, few_cells, o, &r);
   expect_invalid(r, "states has 9 entries for 18 cells (boxes x grid x grid)");
-  apply_subbox_states(pts, geo.data(), boxes, nullptr, o, &r);
+  apply_subbox_states(pts, geo, boxes, nullptr, o, &r);
   expect_invalid(r, "states has 0 entries for 18 cells (boxes x grid x grid)");
-  apply_subbox_states(pts, geo.data(), boxes, cells, o, &r, one);
+  apply_subbox_states(pts, geo, boxes, cells, o, &r, one);
   expect_invalid(r, "in_object_mask has 1 entries for 3 points");
-  apply_subbox_states(pts, geo.data(), boxes, cells, o, &r, flags, bits);
+  apply_subbox_states(pts, geo, boxes, cells, o, &r, flags, bits);
   EXPECT_TRUE(r.ok()) << r.reason;
+}
+
+// The geometric labels are required, one per point, by every entry point: a short array is named with
+// both sizes and no label is read (every feature Static).
+TYPED_TEST(SubBoxTest, ShortGeometricLabelsAreInvalidInputAndNotRead) {
+  using T = TypeParam;
+  const std::vector<Vec2<T>> pts{Vec2<T>(3, 3), Vec2<T>(5, 4), Vec2<T>(105, 105)};
+  const std::vector<FeatureLabel> short_geo{FeatureLabel::Dynamic};
+  const std::vector<Box<T>> boxes{Box<T>{T(100), T(100), T(200), T(200)}, Box<T>{T(0), T(0), T(29), T(29)}};
+  const SubBoxOptions<T> o;
+  const std::vector<std::uint8_t> cells(18, 1);
+  auto expect_invalid = [&](const SubBoxResult<T>& r, const std::string& reason) {
+    EXPECT_EQ(r.status, Status::InvalidInput);
+    EXPECT_EQ(r.reason, reason);
+    ASSERT_EQ(r.labels.size(), pts.size());
+    for (FeatureLabel l : r.labels) EXPECT_EQ(l, FeatureLabel::Static);
+    EXPECT_TRUE(r.cells.empty());
+  };
+  const std::string reason = "geometric has 1 entries for 3 points";
+  SubBoxResult<T> r;
+  refine_subboxes(pts, short_geo, boxes, o, &r);
+  expect_invalid(r, reason);
+  expect_invalid(refine_subboxes(pts, short_geo, boxes, o), reason);
+  apply_subbox_states(pts, short_geo, boxes, cells, o, &r);
+  expect_invalid(r, reason);
+  refine_subboxes(pts, nullptr, boxes, o, &r);
+  expect_invalid(r, "geometric is required (3 points)");
+  apply_subbox_states(pts, nullptr, boxes, cells, o, &r);
+  expect_invalid(r, "geometric is required (3 points)");
 }
 
 }  // namespace

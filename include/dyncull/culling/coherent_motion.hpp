@@ -70,16 +70,27 @@ struct CoherentMotionResult {
   std::vector<T> scratch_u, scratch_v;
 };
 
+namespace detail {
+/// T stays deduced from the other parameters, so a std::vector<Vec2<T>> converts to the view.
+template <class X>
+struct NonDeducedHolder {
+  using type = X;
+};
+template <class X>
+using NonDeduced = typename NonDeducedHolder<X>::type;
+}  // namespace detail
+
 /// Flags the cells of each box whose features' residual vectors share a significant median, and turns
 /// their Static labels Dynamic (Candidate labels, features without evidence, stay). residuals[i]: measured
 /// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
 /// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: min_noise_px).
 /// in_object_mask / object_box_bits as in refine_subboxes: a box's cells hold only its object's features.
-/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged). residuals and labels are
-/// raw pointers that must hold points.size() entries; a given flag view whose size is not points.size()
-/// gives InvalidInput naming it (nothing read).
+/// eligible: optional per feature, 0 = takes no part (neither tested nor flagged). residuals (required)
+/// and a given flag view whose size is not points.size() give InvalidInput naming it and both sizes
+/// (nothing read). labels is a raw pointer that must hold points.size() entries.
 template <class T, class Points, class Boxes>
-void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const Boxes& boxes, T noise_px,
+void flag_coherent_cells(const Points& points, detail::NonDeduced<ArrayView<Vec2<T>>> residuals, const Boxes& boxes,
+                         T noise_px,
                          const CoherentMotionOptions<T>& options, FeatureLabel* labels, CoherentMotionResult<T>* out,
                          FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
                          FlagView eligible = nullptr) {
@@ -98,7 +109,13 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
     r.reason = "invalid options: " + why;
     return;
   }
-  if (!detail::flags_fit(in_object_mask, n, "in_object_mask", "points", &why) ||
+  if (!residuals.given) {
+    r.status = Status::InvalidInput;
+    r.reason = "residuals is required (" + std::to_string(n) + " points)";
+    return;
+  }
+  if (!detail::flags_fit(residuals, n, "residuals", "points", &why) ||
+      !detail::flags_fit(in_object_mask, n, "in_object_mask", "points", &why) ||
       !detail::flags_fit(object_box_bits, n, "object_box_bits", "points", &why) ||
       !detail::flags_fit(eligible, n, "eligible", "points", &why)) {
     r.status = Status::InvalidInput;
@@ -112,9 +129,9 @@ void flag_coherent_cells(const Points& points, const Vec2<T>* residuals, const B
     r.reason = n == 0 ? "no features" : "no boxes";
     return;
   }
-  if (!residuals || !labels) {
+  if (!labels) {
     r.status = Status::InvalidInput;
-    r.reason = "residuals and labels are required";
+    r.reason = "labels is required";
     return;
   }
   r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, options.min_noise_px) : options.min_noise_px;

@@ -6,12 +6,15 @@
 /// person's sway turning round) and its new corners, which have no history, are kept too.
 #pragma once
 
+#include "dyncull/core/flags.hpp"
+#include "dyncull/core/status.hpp"
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -25,22 +28,27 @@ class SubBoxMemory {
   /// Flags, per feature, the tracks a remembered cell may cull: flagged dynamic by the geometric check, or
   /// first seen, in this frame or one of the `frames` frames before it.
   /// Records this frame's geometric flags and forgets tracks unseen for more than `frames` frames.
-  void update_tracks(const std::vector<std::int64_t>& track_ids, const FeatureLabel* geometric, std::uint64_t frame,
-                     int frames, std::vector<std::uint8_t>* eligible) {
+  /// geometric: optional (not given: no track is flagged); given with a size other than track_ids.size():
+  /// InvalidInput with `reason` naming it and both sizes, nothing recorded and no track eligible.
+  Status update_tracks(const std::vector<std::int64_t>& track_ids, ArrayView<FeatureLabel> geometric,
+                       std::uint64_t frame, int frames, std::vector<std::uint8_t>* eligible,
+                       std::string* reason = nullptr) {
     const std::size_t n = track_ids.size();
     eligible->assign(n, 0);
+    if (!detail::flags_fit(geometric, n, "geometric", "tracks", reason)) return Status::InvalidInput;
     const auto window = static_cast<std::uint64_t>(std::max(frames, 0));
     for (std::size_t i = 0; i < n; ++i) {
       TrackHistory& h = tracks_[track_ids[i]];
       if (h.first_seen == 0) h.first_seen = frame;
       h.last_seen = frame;
-      if (geometric && geometric[i] == FeatureLabel::Dynamic) h.last_flagged = frame;
+      if (geometric.given && geometric[i] == FeatureLabel::Dynamic) h.last_flagged = frame;
       const bool flagged = h.last_flagged != 0 && frame - h.last_flagged <= window;
       const bool young = frame - h.first_seen <= window;
       (*eligible)[i] = flagged || young;
     }
     for (auto it = tracks_.begin(); it != tracks_.end();)
       it = frame - it->second.last_seen > window ? tracks_.erase(it) : std::next(it);
+    return Status::Ok;
   }
 
   /// Cells (per box grid*grid, box-major like SubBoxResult::cells) that a vote of the last `frames`

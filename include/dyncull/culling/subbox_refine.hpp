@@ -202,6 +202,21 @@ bool subbox_inputs_fit(std::size_t n, std::size_t cells, FlagView in_object_mask
   return false;
 }
 
+/// The required geometric labels hold n entries; else InvalidInput into the result started by
+/// subbox_begin, naming them and both sizes (nothing read).
+template <class T>
+bool subbox_geometric_fits(ArrayView<FeatureLabel> geometric, std::size_t n, SubBoxResult<T>* r) {
+  std::string why;
+  if (geometric.holds(n)) return true;
+  r->status = Status::InvalidInput;
+  if (geometric.given) flags_fit(geometric, n, "geometric", "points", &why);
+  r->reason = geometric.given ? why : "geometric is required (" + std::to_string(n) + " points)";
+  r->votes.clear();
+  r->cells.clear();
+  r->grid = 0;
+  return false;
+}
+
 /// Zeroed per-box votes and per-cell buffers for nb boxes of grid*grid cells; returns grid*grid.
 template <class T>
 std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
@@ -216,9 +231,9 @@ std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
 
 /// Feature labels from r.cells (Algorithm 1's last step): dynamic inside any dynamic cell (and the
 /// object mask if given), static inside boxes otherwise. Fills labels, reasons and the counts of a result
-/// started by subbox_begin.
+/// started by subbox_begin; the caller has checked every view against the points (subbox_geometric_fits).
 template <class T, class Points, class Boxes>
-void subbox_label_features(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                            const SubBoxOptions<T>& options, SubBoxResult<T>* out, FlagView in_object_mask,
                            BoxBitsView object_box_bits, FlagView extra_dynamic_cells, FlagView extra_eligible) {
   SubBoxResult<T>& r = *out;
@@ -262,7 +277,8 @@ void subbox_label_features(const Points& points, const FeatureLabel* geometric, 
 
 /// Runs Algorithm 1 on every box, writing into `out` (buffers reused across frames).
 /// points: the features; geometric: their geometric labels (Dynamic / Static; Candidate = unlabelled,
-/// not counted); boxes: container of Box<T> or Detection<T> (the boxes to refine, e.g. person boxes);
+/// not counted; required, one per point); boxes: container of Box<T> or Detection<T> (the boxes to
+/// refine, e.g. person boxes);
 /// in_object_mask: optional per-feature flag (object mask of 000 §3.3): a feature in a dynamic sub-box
 /// is Dynamic only if also in the object mask, as the paper keeps "the mask" inside dynamic sub-boxes.
 /// object_box_bits: optional per-feature bit set (bit b: in box b's own object mask, as
@@ -275,7 +291,7 @@ void subbox_label_features(const Points& points, const FeatureLabel* geometric, 
 /// or a given view whose size is not points.size() (boxes.size() * grid * grid for extra_dynamic_cells),
 /// give InvalidInput (every feature Static, the view and both sizes named).
 template <class T, class Points, class Boxes>
-void refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
                      FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
                      FlagView extra_dynamic_cells = nullptr, FlagView extra_eligible = nullptr) {
@@ -287,7 +303,8 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
   const std::size_t cells = nb * static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
-  if (!detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, extra_dynamic_cells, extra_eligible, &r))
+  if (!detail::subbox_geometric_fits(geometric, n, &r) ||
+      !detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, extra_dynamic_cells, extra_eligible, &r))
     return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
 
@@ -370,7 +387,7 @@ void refine_subboxes(const Points& points, const FeatureLabel* geometric, const 
 
 /// Convenience overload returning a fresh result.
 template <class T, class Points, class Boxes>
-SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geometric, const Boxes& boxes,
+SubBoxResult<T> refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                                 const SubBoxOptions<T>& options = {}, FlagView in_object_mask = nullptr,
                                 BoxBitsView object_box_bits = nullptr) {
   SubBoxResult<T> r;
@@ -382,10 +399,11 @@ SubBoxResult<T> refine_subboxes(const Points& points, const FeatureLabel* geomet
 /// earlier frame): per box grid*grid states, box-major, 0 = static with evidence, 1 = dynamic, 2 =
 /// unknown; unknown cells act as dynamic (inside the object mask, as voted ones), so a box without a
 /// remembered vote falls back to the box rule. The counts in `out` stay zero: nothing was voted.
-/// `states` must hold boxes.size() * grid * grid entries and the given per-feature views points.size():
+/// `states` must hold boxes.size() * grid * grid entries, geometric (required) and the given per-feature
+/// views points.size():
 /// else InvalidInput (every feature Static, the view and both sizes named).
 template <class T, class Points, class Boxes>
-void apply_subbox_states(const Points& points, const FeatureLabel* geometric, const Boxes& boxes, FlagView states,
+void apply_subbox_states(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes, FlagView states,
                          const SubBoxOptions<T>& options, SubBoxResult<T>* out, FlagView in_object_mask = nullptr,
                          BoxBitsView object_box_bits = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::apply_subbox_states: points must hold points (see PointTraits)");
@@ -405,7 +423,9 @@ void apply_subbox_states(const Points& points, const FeatureLabel* geometric, co
     r.grid = 0;
     return;
   }
-  if (!detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, nullptr, nullptr, &r)) return;
+  if (!detail::subbox_geometric_fits(geometric, n, &r) ||
+      !detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, nullptr, nullptr, &r))
+    return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
   for (std::size_t b = 0; b < nb; ++b) {
     if (!detail::subbox_as_box(boxes[b]).valid()) {

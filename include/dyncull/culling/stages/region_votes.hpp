@@ -42,7 +42,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
                                           options.min_evidence_frames, &v.remembered_cells)
             : 0;
     if (recalled > 0) {
-      apply_subbox_states(kp, geometric.labels.data(), regions.dyn_boxes, v.remembered_cells, options.subbox,
+      apply_subbox_states(kp, geometric.labels, regions.dyn_boxes, v.remembered_cells, options.subbox,
                           &v.subbox, in_object, box_bits);
       r->subbox.status = v.subbox.status;
       r->subbox.num_dynamic = v.subbox.num_dynamic;
@@ -58,7 +58,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
     r->subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
                        "its evidence inside the boxes is not trusted";
   } else {
-    const FeatureLabel* evidence = geometric.labels.data();
+    ArrayView<FeatureLabel> evidence = geometric.labels;
     if (options.use_coherent_motion) {
       if (!r->reprojection.ran() || geometric.reprojection.residual_vec.size() != n) {
         r->coherent_motion.reason = "needs the reprojection check's residuals (use_reprojection, points_3d)";
@@ -70,8 +70,8 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
         for (std::size_t i = 0; i < n; ++i) v.coherent_eligible[i] = semantic_labels[i] == FeatureLabel::Dynamic;
         v.evidence.assign(geometric.labels.begin(), geometric.labels.end());
         v.coherent_ran = true;
-        evidence = v.evidence.data();
-        flag_coherent_cells(kp, geometric.reprojection.residual_vec.data(), regions.dyn_boxes,
+        evidence = v.evidence;
+        flag_coherent_cells(kp, geometric.reprojection.residual_vec, regions.dyn_boxes,
                             geometric.reprojection.inlier_noise_px, co, v.evidence.data(), &v.coherent, in_object,
                             box_bits, v.coherent_eligible);
         r->coherent_motion.status = v.coherent.status;
