@@ -183,13 +183,21 @@ template <class T>
 void finish(DetectionsResult<T>* r, int width, int height) {
   if (width <= 0 || height <= 0) {
     r->status = Status::InvalidInput;
-    r->reason = "image size must be positive";
+    r->reason.assign("image size must be positive");
     return;
   }
   if (r->num_kept < r->num_input) {
-    r->reason = std::to_string(r->num_input - r->num_kept) + " of " + std::to_string(r->num_input) +
-                " boxes rejected (" + std::to_string(r->num_invalid) + " invalid, " + std::to_string(r->num_outside) +
-                " outside, " + std::to_string(r->num_low_confidence) + " low confidence)";
+    std::string& why = r->reason;  // built in place: a reused result keeps the string's capacity
+    why.assign(std::to_string(r->num_input - r->num_kept));
+    why += " of ";
+    why += std::to_string(r->num_input);
+    why += " boxes rejected (";
+    why += std::to_string(r->num_invalid);
+    why += " invalid, ";
+    why += std::to_string(r->num_outside);
+    why += " outside, ";
+    why += std::to_string(r->num_low_confidence);
+    why += " low confidence)";
   }
 }
 }  // namespace detail

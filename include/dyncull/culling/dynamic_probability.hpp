@@ -305,8 +305,11 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
     r.motion_threshold_px = std::isfinite(t) ? std::max(o.min_motion_threshold_px, t) : o.min_motion_threshold_px;
   }
   if (r.used_fallback) {
-    r.reason = "only " + std::to_string(r.num_reference) + " features with flow as reference (fewer than " +
-               std::to_string(o.min_reference_features) + " outside masks): fallback threshold used";
+    r.reason.assign("only ");  // built in place: a reused result keeps the string's capacity
+    r.reason += std::to_string(r.num_reference);
+    r.reason += " features with flow as reference (fewer than ";
+    r.reason += std::to_string(o.min_reference_features);
+    r.reason += " outside masks): fallback threshold used";
   }
 
   // Locals and raw pointers: stores through `r` would otherwise alias every read of `r`.

@@ -115,7 +115,9 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
     ++r->history_kept;
   }
   r->static_history.status = Status::Ok;
-  r->static_history.reason = std::to_string(r->history_kept) + " feature(s) kept static by their history";
+  // Built in place: the report's string keeps its capacity from frame to frame.
+  r->static_history.reason.assign(std::to_string(r->history_kept));
+  r->static_history.reason += " feature(s) kept static by their history";
 }
 
 /// Minimum-survivor guard: below max(min_survivor_fraction * n, min_survivors) static features, first
@@ -146,9 +148,18 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
       ++r->guard_restored;
     }
     r->guard = soften_enough ? GuardAction::Softened : GuardAction::Undone;
-    r->reason = std::string("survivor guard ") + to_string(r->guard) + ": " + std::to_string(survivors) +
-                " static features of " + std::to_string(n) + " were below " + std::to_string(need) + ", " +
-                std::to_string(r->guard_restored) + " restored";
+    std::string& why = r->reason;
+    why.assign("survivor guard ");
+    why += to_string(r->guard);
+    why += ": ";
+    why += std::to_string(survivors);
+    why += " static features of ";
+    why += std::to_string(n);
+    why += " were below ";
+    why += std::to_string(need);
+    why += ", ";
+    why += std::to_string(r->guard_restored);
+    why += " restored";
     survivors = count_static();
   }
   r->num_static = survivors;
