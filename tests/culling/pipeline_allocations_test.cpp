@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdio>
@@ -74,7 +75,7 @@ std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& opt
   return counts;
 }
 
-TEST(PipelineAllocations, CountedPerFrameAfterWarmUp) {
+TEST(PipelineAllocations, PerFrameAfterWarmUpStayWithinEachPresetsBound) {
   std::vector<Frame> seq;
   for (int k = 0; k < 3; ++k) {
     test::SceneConfig config;
@@ -85,19 +86,27 @@ TEST(PipelineAllocations, CountedPerFrameAfterWarmUp) {
     for (std::size_t i = 0; i < f.scene.size(); ++i) f.ids.push_back(static_cast<std::int64_t>(i));
     seq.push_back(std::move(f));
   }
+  // Bounds at what the pipeline reaches, on keyframes (frame 0 stores one in a ring not yet full) and
+  // between them; the allocations left are listed in docs/design.md (the geometric checks' solvers).
   struct Named {
     const char* name;
     PipelineOptions<float> options;
+    std::size_t on_keyframe, between_keyframes;
   };
-  const Named all[] = {{"recommended", presets::recommended<float>()}, {"dld_slam", presets::dld_slam<float>()},
-                       {"rtd_slam", presets::rtd_slam<float>()},       {"zhu_2024", presets::zhu_2024<float>()},
-                       {"dfd_slam", presets::dfd_slam<float>()},       {"zhang_2023", presets::zhang_2023<float>()}};
+  const Named all[] = {
+      {"recommended", presets::recommended<float>(), 85, 63}, {"dld_slam", presets::dld_slam<float>(), 28, 0},
+      {"rtd_slam", presets::rtd_slam<float>(), 23, 1},         {"zhu_2024", presets::zhu_2024<float>(), 22, 0},
+      {"dfd_slam", presets::dfd_slam<float>(), 73, 51},        {"zhang_2023", presets::zhang_2023<float>(), 22, 0}};
   for (const Named& p : all) {
     const std::vector<std::size_t> counts = allocations_per_frame(p.options, seq, 3);
     std::size_t most = 0;
     for (std::size_t c : counts) most = std::max(most, c);
-    std::printf("%-12s allocations per frame after warm-up: at most %zu\n", p.name, most);
+    std::printf("%-12s allocations per frame after warm-up: at most %zu (frames:", p.name, most);
+    for (std::size_t c : counts) std::printf(" %zu", c);
+    std::printf(")\n");
     RecordProperty(p.name, static_cast<int>(most));
+    EXPECT_LE(counts[0], p.on_keyframe) << p.name;
+    for (std::size_t k = 1; k < counts.size(); ++k) EXPECT_LE(counts[k], p.between_keyframes) << p.name << " frame " << k;
   }
 }
 
