@@ -247,7 +247,8 @@ TYPED_TEST(CombineStageTest, SurvivorGuardSoftensThenUndoes) {
 TYPED_TEST(CombineStageTest, TraceShowsWhatEachStageSaw) {
   using T = TypeParam;
   auto w = evidence<T>();
-  PipelineResult<T> r = combined(PipelineOptions<T>{}, w);
+  const PipelineOptions<T> defaults;  // named: g++ -O3 warns (maybe-uninitialized) on the temporary
+  PipelineResult<T> r = combined(defaults, w);
   w.semantic.in_object[1] = 0;
   w.history_kept[6] = 1;
   detail::trace_features(w, &r);
