@@ -57,7 +57,8 @@ struct Frame {
 /// Allocations of each frame after `warmup` frames of the same sequence replayed (same sizes each round).
 std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& options, const std::vector<Frame>& seq,
                                                int warmup_rounds) {
-  PipelineState<float> state;
+  // Two keyframe slots: the ring is full, and its slots' buffers reused, before the counted round.
+  PipelineState<float> state(2);
   std::vector<std::size_t> counts;
   for (int round = 0; round <= warmup_rounds; ++round) {
     for (std::size_t k = 0; k < seq.size(); ++k) {
@@ -86,17 +87,17 @@ TEST(PipelineAllocations, PerFrameAfterWarmUpStayWithinEachPresetsBound) {
     for (std::size_t i = 0; i < f.scene.size(); ++i) f.ids.push_back(static_cast<std::int64_t>(i));
     seq.push_back(std::move(f));
   }
-  // Bounds at what the pipeline reaches, on keyframes (frame 0 stores one in a ring not yet full) and
-  // between them; the allocations left are listed in docs/design.md (the geometric checks' solvers).
+  // Bounds at what the pipeline reaches; the allocations left are listed in docs/design.md (the geometric
+  // checks' solvers, new ids in the track store, and the frame's reason when a stage lacks an input).
+  // dld_slam's are the ids frame 0 has and frame 2 lacks: 6 with g++, 8 with clang (the scene's sampling).
   struct Named {
     const char* name;
     PipelineOptions<float> options;
-    std::size_t on_keyframe, between_keyframes;
+    std::size_t most_allowed;
   };
-  const Named all[] = {
-      {"recommended", presets::recommended<float>(), 85, 63}, {"dld_slam", presets::dld_slam<float>(), 28, 0},
-      {"rtd_slam", presets::rtd_slam<float>(), 23, 1},         {"zhu_2024", presets::zhu_2024<float>(), 22, 0},
-      {"dfd_slam", presets::dfd_slam<float>(), 73, 51},        {"zhang_2023", presets::zhang_2023<float>(), 22, 0}};
+  const Named all[] = {{"recommended", presets::recommended<float>(), 63}, {"dld_slam", presets::dld_slam<float>(), 8},
+                       {"rtd_slam", presets::rtd_slam<float>(), 1},       {"zhu_2024", presets::zhu_2024<float>(), 0},
+                       {"dfd_slam", presets::dfd_slam<float>(), 51},      {"zhang_2023", presets::zhang_2023<float>(), 0}};
   for (const Named& p : all) {
     const std::vector<std::size_t> counts = allocations_per_frame(p.options, seq, 3);
     std::size_t most = 0;
@@ -105,8 +106,7 @@ TEST(PipelineAllocations, PerFrameAfterWarmUpStayWithinEachPresetsBound) {
     for (std::size_t c : counts) std::printf(" %zu", c);
     std::printf(")\n");
     RecordProperty(p.name, static_cast<int>(most));
-    EXPECT_LE(counts[0], p.on_keyframe) << p.name;
-    for (std::size_t k = 1; k < counts.size(); ++k) EXPECT_LE(counts[k], p.between_keyframes) << p.name << " frame " << k;
+    for (std::size_t k = 0; k < counts.size(); ++k) EXPECT_LE(counts[k], p.most_allowed) << p.name << " frame " << k;
   }
 }
 
