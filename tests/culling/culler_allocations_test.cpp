@@ -1,46 +1,19 @@
 // Counts the heap allocations Culler::cull makes per frame after warm-up (a counting global operator new in
 // this executable only): none of its own (matching, keyframe store, evidence arrays) with a pipeline that
 // allocates nothing, and the recommended preset's total recorded.
-// g++ cannot see that every operator new of this file is malloc and pairs it with a sized delete.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-
 #include "dyncull/culling/culler.hpp"
 
 #include "dyncull/core/random.hpp"
 
+#include "support/counting_allocator.hpp"
+
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
-#include <new>
 #include <vector>
-
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return ::operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return ::operator new(size, tag); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace dyncull {
 namespace {
@@ -99,9 +72,9 @@ std::vector<std::size_t> allocations_per_frame(const CullerOptions<float>& optio
       f.depth_m = DepthView<float>{v.depth.data(), 640, 480, 0, 1.f, 0.f, 1e30f};
       f.detections = &v.detections;
       f.cam_from_world = &v.pose;
-      const std::size_t before = g_allocations.load();
+      const std::size_t before = test::allocations();
       *last_status = culler.cull(f).status;
-      if (round == warmup_rounds) counts.push_back(g_allocations.load() - before);
+      if (round == warmup_rounds) counts.push_back(test::allocations() - before);
     }
   }
   return counts;

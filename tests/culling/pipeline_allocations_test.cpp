@@ -1,49 +1,20 @@
 // Counts the heap allocations cull_frame makes per frame after warm-up, for the recommended preset and
 // each paper's, on a synthetic sequence (a counting global operator new in this executable only).
-// g++ cannot see that every operator new of this file is malloc and pairs it with a sized delete.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
 #include "support/culling_frames.hpp"
 #include "support/culling_scenes.hpp"
 
+#include "support/counting_allocator.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
-#include <new>
 #include <vector>
-
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return ::operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-// The nothrow forms too (std::stable_sort's temporary buffer uses them): under AddressSanitizer they would
-// otherwise come from its allocator and be freed by the delete above.
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return ::operator new(size, tag); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace dyncull {
 namespace {
@@ -68,9 +39,9 @@ std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& opt
       frame.points_3d = &f.scene.prev_points_world;
       frame.is_keyframe = k == 0;
       frame.evidence_frames = 2;
-      const std::size_t before = g_allocations.load();
+      const std::size_t before = test::allocations();
       cull_frame(frame, options, &state);
-      if (round == warmup_rounds) counts.push_back(g_allocations.load() - before);
+      if (round == warmup_rounds) counts.push_back(test::allocations() - before);
     }
   }
   return counts;
