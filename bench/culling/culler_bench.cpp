@@ -14,27 +14,16 @@
 #include <opencv2/features2d.hpp>
 #endif
 
+#include "culling/cpu_time.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <vector>
 
-#if defined(__unix__)
-#include <time.h>
-#endif
-
 namespace {
 
-/// CPU seconds of the calling thread: the ratio stays meaningful on a loaded machine.
-double cpu_seconds() {
-#if defined(__unix__) && defined(CLOCK_THREAD_CPUTIME_ID)
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-#else
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-#endif
-}
+using dyncull::bench::cpu_seconds;
 
 #ifdef DYNCULL_HAS_OPENCV
 using dyncull::Vec2;

@@ -17,6 +17,8 @@
 #include <opencv2/video/tracking.hpp>
 #endif
 
+#include "culling/cpu_time.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -24,23 +26,9 @@
 #include <limits>
 #include <vector>
 
-#if defined(__unix__)
-#include <time.h>
-#endif
-
 namespace {
 
-/// CPU seconds of the calling thread: ratios stay meaningful on a loaded machine (every peer runs on
-/// one thread). Wall time where the clock is missing.
-double cpu_seconds() {
-#if defined(__unix__) && defined(CLOCK_THREAD_CPUTIME_ID)
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-#else
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-#endif
-}
+using dyncull::bench::cpu_seconds;
 
 using dyncull::Vec2;
 using dyncull::Vec3;
