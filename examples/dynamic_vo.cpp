@@ -1,7 +1,7 @@
 /// @file dynamic_vo.cpp
 /// dynamic_vo: RGB-D visual odometry (ORB + LK, PnP-RANSAC against the keyframe's depth) run with
 /// every dyncull culling preset and with no culling, on the synthetic walking sequences or a TUM
-/// directory; prints ATE (000 eq. 6-7), the improvement (m - n) / m (002 eq. 7) and label quality.
+/// directory; prints ATE (DLD-SLAM eq. 6-7), the improvement (m - n) / m (Zhu et al. 2024 eq. 7) and label quality.
 /// --family / --scene pick the scene (sim/families.hpp, sim/scene_keys.hpp); --suite runs every family.
 
 #include "dyncull/sim/families.hpp"

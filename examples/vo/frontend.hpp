@@ -1,7 +1,7 @@
 /// @file frontend.hpp
 /// RGB-D visual odometry front end of the dynamic_vo demo: ORB corners spread over a grid, pyramidal
-/// LK tracking frame to frame, 3-D points from the keyframe's depth (002 eq. 5-6), PnP-RANSAC on the
-/// features the culling kept (002 §2), motion-only refinement on the inliers, constant-velocity fallback.
+/// LK tracking frame to frame, 3-D points from the keyframe's depth (Zhu et al. 2024 eq. 5-6), PnP-RANSAC on the
+/// features the culling kept (Zhu et al. 2024 §2), motion-only refinement on the inliers, constant-velocity fallback.
 #pragma once
 
 #include "dyncull/core/camera.hpp"

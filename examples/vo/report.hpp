@@ -1,6 +1,6 @@
 /// @file report.hpp
 /// Outputs of the dynamic_vo demo: per-feature label counts against the sim's per-pixel motion truth
-/// (precision / recall of the dynamic labels, 000 eq. 6-7 style tables), a top-view trajectory plot
+/// (precision / recall of the dynamic labels, DLD-SLAM eq. 6-7 style tables), a top-view trajectory plot
 /// and frames with kept / culled features drawn (PNG through OpenCV).
 #pragma once
 
@@ -86,7 +86,7 @@ inline void count_labels(const std::vector<cv::Point2f>& px, const std::vector<s
 enum class KeptWhy : std::uint8_t {
   NotExplained = 0,       ///< no culling ran, or the oracle
   OutsideBoxes,           ///< in no high- or medium-level box (detector miss, box too small)
-  OutsideObjectBand,      ///< in a box but outside its object's depth band (000 mask)
+  OutsideObjectBand,      ///< in a box but outside its object's depth band (DLD-SLAM mask)
   CandidateNotFlagged,    ///< medium-level candidate its own evidence did not flag
   NoGeometricEvidence,    ///< in the object, without a geometric label (no track / point, depth edge)
   NotFlagged,             ///< in the object, the geometric check said static, and so did its sub-box

@@ -192,7 +192,7 @@ struct DetectionLineErrors {
 };
 
 /// YOLO text ("class cx cy w h [conf]" normalised per line) -> pixel detections through dyncull's
-/// conversion (001 eq. 1-2) and filter; malformed lines go to `errors` as `file`:line (line numbers
+/// conversion (RTD-SLAM eq. 1-2) and filter; malformed lines go to `errors` as `file`:line (line numbers
 /// counted from `first_line`).
 inline void yolo_text_to_detections(std::string_view text, int width, int height, const std::string& file,
                                     int first_line, std::vector<Detection<float>>* out, DetectionLineErrors* errors) {

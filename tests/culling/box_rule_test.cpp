@@ -100,7 +100,7 @@ TYPED_TEST(BoxRule, OptionsChangeTheOutcomeAsDocumented) {
                                           {Box<T>{T(300), T(0), T(400), T(100)}, kChair, T(1)}};
   const std::vector<Vec2<T>> pts = {{T(50), T(50)}, {T(93), T(50)}, {T(350), T(50)}};
   BoxRuleOptions<T> o;
-  o.high_as_candidate = true;   // 001 §III.D: everything boxed goes to geometry
+  o.high_as_candidate = true;   // RTD-SLAM §III.D: everything boxed goes to geometry
   o.medium_as_candidate = false;
   o.low_shrink_px = T(5);       // the tv box no longer shelters x = 93
   const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80(), o);

@@ -1,4 +1,4 @@
-// Depth mask on one real TUM frame (fr3_walking_xyz, two people): the plain 000 rule must
+// Depth mask on one real TUM frame (fr3_walking_xyz, two people): the plain DLD-SLAM rule must
 // reproduce the independently computed expected_mask_rule.json exactly; the robust variant is
 // compared with the whole box and the plain rule against the Mask R-CNN person mask.
 #include "dyncull/culling/depth_mask.hpp"
@@ -134,7 +134,7 @@ TEST_F(RealFrame, RobustMaskBeatsWholeBoxAndPlainRule) {
   for (int k = 0; k < 2; ++k) {
     Counts nearest;
     for (const MissingDepth policy : {MissingDepth::Nearest, MissingDepth::InMask}) {
-      DepthMaskOptions o;  // defaults: robust, Seed000 form, eps 0.3 m, MissingDepth::Nearest
+      DepthMaskOptions o;  // defaults: robust, DldSlam form, eps 0.3 m, MissingDepth::Nearest
       o.missing_depth = policy;
       Mask mask;
       const DepthMaskBoxInfo info = run(boxes[k], o, &mask);

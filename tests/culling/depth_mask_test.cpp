@@ -90,7 +90,7 @@ TYPED_TEST(DepthMask, PlainRuleSeparatesPersonFromWall) {
       }
 }
 
-// A chair 0.9 m in front of a person, inside the person's box: 000's one-sided band (everything nearer
+// A chair 0.9 m in front of a person, inside the person's box: DLD-SLAM's one-sided band (everything nearer
 // than d_c + eps) takes the chair in; near_margin_m = 0.5 leaves it out and keeps the person whole.
 TYPED_TEST(DepthMask, NearMarginLeavesOutWhatStandsInFrontOfTheObject) {
   using Raw = TypeParam;
@@ -134,7 +134,7 @@ TYPED_TEST(DepthMask, NearMarginLeavesOutWhatStandsInFrontOfTheObject) {
   EXPECT_TRUE(plain.test(80, 90));
 }
 
-// A seated person (3.3 m) half hidden by a walker (1.5 m) standing over its box centre: 000's centre
+// A seated person (3.3 m) half hidden by a walker (1.5 m) standing over its box centre: DLD-SLAM's centre
 // sample measures the walker, and the seated person's band ("closer than d_c + eps") leaves the seated
 // person out. occluded_centre_search re-estimates that box's d_c from its pixels outside the walker's box.
 TYPED_TEST(DepthMask, OccludedCentreIsReestimatedOutsideTheOccludersBox) {
@@ -542,7 +542,7 @@ TYPED_TEST(DepthMask, DynamicVinsThresholdForm) {
 }
 
 TEST(DepthMaskRaw, ThresholdIsComparedInRawUnits) {
-  // 000 in TUM raw units: eps 0.3 m = 1500, strict "<": the pixel at exactly d_c + eps is out.
+  // DLD-SLAM in TUM raw units: eps 0.3 m = 1500, strict "<": the pixel at exactly d_c + eps is out.
   std::vector<std::uint16_t> d(W * H, 20000);
   for (int v = 40; v <= 80; ++v)
     for (int u = 60; u <= 100; ++u) d[v * W + u] = 10000;

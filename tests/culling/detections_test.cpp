@@ -22,7 +22,7 @@ T tol() {
 
 TYPED_TEST(Detections, NormalisedCentreSizeToCorners) {
   using T = TypeParam;
-  // 001 eq. 1-2: X1 = (x - w/2) W, X2 = (x + w/2) W, Y1 = (y - h/2) H, Y2 = (y + h/2) H.
+  // RTD-SLAM eq. 1-2: X1 = (x - w/2) W, X2 = (x + w/2) W, Y1 = (y - h/2) H, Y2 = (y + h/2) H.
   const Box<T> b = yolo_to_pixel_box(YoloBox<T>{0, T(0.5), T(0.5), T(0.2), T(0.4)}, 640, 480);
   EXPECT_NEAR(b.x0, T(256), tol<T>());
   EXPECT_NEAR(b.x1, T(384), tol<T>());

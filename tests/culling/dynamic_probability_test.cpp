@@ -1,4 +1,4 @@
-// 000 §3.4 on synthetic flow with known truth: a still and a walking person, a pushed chair, a tv
+// DLD-SLAM §3.4 on synthetic flow with known truth: a still and a walking person, a pushed chair, a tv
 // with a flow glitch, a person that stops, and camera motions where each flow model wins.
 #include "dyncull/culling/dynamic_probability.hpp"
 #include "dyncull/core/box.hpp"

@@ -57,7 +57,7 @@ TEST(MotionLevels, CustomTableAndScores) {
   t.set("human", MotionLevel::High);
   EXPECT_EQ(t.level(0), MotionLevel::High);
   EXPECT_EQ(t.level(1), MotionLevel::Low);
-  // S of 000 eq. 3 as Algorithm 1 defines it.
+  // S of DLD-SLAM eq. 3 as Algorithm 1 defines it.
   EXPECT_EQ(motion_level_score(MotionLevel::High), 1.0);
   EXPECT_EQ(motion_level_score(MotionLevel::Medium), 0.5);
   EXPECT_EQ(motion_level_score(MotionLevel::Low), 0.0);

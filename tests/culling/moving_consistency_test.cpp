@@ -1,4 +1,4 @@
-// Tests of the moving-consistency (epipolar) check, seed 003 §3.2, on ray-cast scenes with known motion.
+// Tests of the moving-consistency (epipolar) check, DFD-SLAM §3.2, on ray-cast scenes with known motion.
 #include "dyncull/culling/moving_consistency.hpp"
 
 #include "support/culling_scenes.hpp"

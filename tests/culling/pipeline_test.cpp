@@ -87,7 +87,7 @@ TYPED_TEST(PipelineTest, RecommendedPresetCullsMoversAndKeepsStillParts) {
   EXPECT_EQ(r.guard, GuardAction::None);
   EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
   EXPECT_GT(dynamic_rate(s, r, SceneKind::SittingUpper), 0.9);
-  EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2);  // 003 Figure 8: still legs kept
+  EXPECT_LT(dynamic_rate(s, r, SceneKind::SittingLower), 0.2);  // DFD-SLAM Figure 8: still legs kept
   // Medium level, verified by geometry. Measured 0.68: a chair is mostly edges, and flags within 8 px of
   // a depth edge are not evidence in this preset (0.84-0.91 without; EpipolarFlagsAtDepthEdgesAreNotEvidence).
   EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.6);
@@ -434,7 +434,7 @@ TYPED_TEST(PipelineTest, PaperPresetsReproduceTheirRules) {
   const auto s = test::make_culling_scene<T>(config);
   const auto dets = detections_of(s);
   {
-    // 002: person boxes culled whole (legs too), tv shelters what it overlaps, chair kept.
+    // Zhu et al. 2024: person boxes culled whole (legs too), tv shelters what it overlaps, chair kept.
     PipelineState<T> st;
     const auto& r = run(s, dets, presets::zhu_2024<T>(), &st, config);
     EXPECT_GT(dynamic_rate(s, r, SceneKind::WalkingPerson), 0.95);
@@ -444,14 +444,14 @@ TYPED_TEST(PipelineTest, PaperPresetsReproduceTheirRules) {
     EXPECT_FALSE(r.moving_consistency.enabled);
   }
   {
-    // 004: medium-level (chair) culled like high-level.
+    // Zhang et al. 2023: medium-level (chair) culled like high-level.
     PipelineState<T> st;
     const auto& r = run(s, dets, presets::zhang_2023<T>(), &st, config);
     EXPECT_GT(dynamic_rate(s, r, SceneKind::Chair), 0.95);
     EXPECT_LT(dynamic_rate(s, r, SceneKind::Tv), 0.05);
   }
   {
-    // 003: F on all tracks, 1 px, literal merge. At this small baseline the F-RANSAC objective admits
+    // DFD-SLAM: F on all tracks, 1 px, literal merge. At this small baseline the F-RANSAC objective admits
     // models that absorb the movers, so the walking person's recall depends on which model RANSAC
     // returns (0.37 and 1.0 measured with two versions of ransac.hpp); only the room is asserted.
     PipelineState<T> st;
@@ -460,7 +460,7 @@ TYPED_TEST(PipelineTest, PaperPresetsReproduceTheirRules) {
     EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.1);
   }
   {
-    // 000: depth mask + probability; a walking person (S = 1, M = 1) is dynamic.
+    // DLD-SLAM: depth mask + probability; a walking person (S = 1, M = 1) is dynamic.
     PipelineState<T> st;
     const auto& r = run(s, dets, presets::dld_slam<T>(), &st, config);
     EXPECT_TRUE(r.probability.ran()) << r.probability.reason;
@@ -468,7 +468,7 @@ TYPED_TEST(PipelineTest, PaperPresetsReproduceTheirRules) {
     EXPECT_LT(dynamic_rate(s, r, SceneKind::Room), 0.05);
   }
   {
-    // 001: box culling plus the multi-view check, which verifies the pushed chair.
+    // RTD-SLAM: box culling plus the multi-view check, which verifies the pushed chair.
     PipelineState<T> st;
     const auto& r = run(s, dets, presets::rtd_slam<T>(), &st, config);
     EXPECT_TRUE(r.multiview.ran()) << r.multiview.reason;
@@ -681,7 +681,7 @@ TYPED_TEST(PipelineTest, HighLevelMarginGivesNearTiesToThePerson) {
   EXPECT_EQ(chair_share(1.9f, 0.15), 1.0) << "0.6 m in front: the chair";
 }
 
-// A walker passing in front of a TV, covering the TV box's centre: 002/004's rule shelters the walker's
+// A walker passing in front of a TV, covering the TV box's centre: Zhu et al. 2024 / Zhang et al. 2023's rule shelters the walker's
 // features inside the TV box. With low_override_by_depth they lose the shelter (the TV's depth, re-read
 // from its pixels beside the walker, is 1.5 m behind them) and are culled; the TV's own features stay
 // static. A TV at the walker's depth keeps sheltering them.
@@ -738,7 +738,7 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
   const std::vector<float> behind = scene(3.5f), level = scene(2.0f);
   std::vector<double> d;
   rates(behind, o, &d);
-  EXPECT_EQ(d[0], 0.0) << "premise: the TV box shelters the walker (002 Table 2)";
+  EXPECT_EQ(d[0], 0.0) << "premise: the TV box shelters the walker (Zhu et al. 2024 Table 2)";
   EXPECT_EQ(d[1], 1.0);
   EXPECT_EQ(unsheltered, 0u);
   o.low_override_by_depth = true;
@@ -778,7 +778,7 @@ TYPED_TEST(PipelineTest, TrackerCarriesMoversNotLowLevelBoxes) {
   std::vector<Detection<T>> both = {person, tv}, none;
   frame.detections = &both;
   const PipelineResult<T>& first = cull_frame(frame, o, &state);
-  EXPECT_EQ(first.reasons[0], CullReason::None) << "in the TV box: sheltered (002 Table 2)";
+  EXPECT_EQ(first.reasons[0], CullReason::None) << "in the TV box: sheltered (Zhu et al. 2024 Table 2)";
   EXPECT_EQ(first.labels[1], FeatureLabel::Dynamic);
   frame.detections = &none;  // both missed in the next frame
   const PipelineResult<T>& second = cull_frame(frame, o, &state);

@@ -65,12 +65,12 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);
   EXPECT_EQ(o.min_survivors, 30u);
   EXPECT_FLOAT_EQ(o.detections.box_padding_px, 5.f);
-  EXPECT_DOUBLE_EQ(o.depth_mask.eps_m, 0.5);  // 000's range is 0.3-0.5 m; see the test below
+  EXPECT_DOUBLE_EQ(o.depth_mask.eps_m, 0.5);  // DLD-SLAM's range is 0.3-0.5 m; see the test below
   EXPECT_EQ(o.static_history.min_frames, 6);  // docs/results.md
   EXPECT_FLOAT_EQ(o.static_history.max_residual_px, 0.8f);
 }
 
-// The recommended preset's object band reaches 0.5 m behind the centre depth (000's eps range is 0.3-0.5 m):
+// The recommended preset's object band reaches 0.5 m behind the centre depth (DLD-SLAM's eps range is 0.3-0.5 m):
 // the far side of a close, oblique walker 0.4 m behind its torso is in the object; the background is not.
 TEST(Presets, RecommendedBandTakesInTheFarSideOfACloseWalker) {
   const int w = 100, h = 100;

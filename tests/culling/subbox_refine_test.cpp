@@ -1,4 +1,4 @@
-// Tests of the 3x3 sub-box refinement (seed 003 Algorithm 1) with geometric labels of known error rates.
+// Tests of the 3x3 sub-box refinement (DFD-SLAM Algorithm 1) with geometric labels of known error rates.
 #include "dyncull/culling/subbox_refine.hpp"
 
 #include "support/culling_scenes.hpp"
@@ -61,7 +61,7 @@ TYPED_TEST(SubBoxTest, SittingPersonKeepsStaticLegsAndCullsTheMovingUpperBody) {
   const auto r = refine_subboxes(s.keypoints, geo, boxes, SubBoxOptions<T>{});
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_FALSE(r.votes[0].whole_box);
-  // Top row dynamic, bottom two rows static (003 Figure 8: a seated person moving the upper body).
+  // Top row dynamic, bottom two rows static (DFD-SLAM Figure 8: a seated person moving the upper body).
   for (int c = 0; c < 9; ++c) EXPECT_EQ(r.cells[static_cast<std::size_t>(c)], c < 3 ? 1 : 0) << "cell " << c;
   std::size_t legs = 0, legs_static = 0, upper = 0, upper_dyn = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {

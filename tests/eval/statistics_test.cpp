@@ -106,7 +106,7 @@ TYPED_TEST(StatisticsTest, HugeFiniteValuesGiveFiniteStatistics) {
 }
 
 TEST(ImprovementRate, ReproducesPaperTable) {
-  // 002 Table 4, walking_xyz ATE RMSE: ORB-SLAM3 0.6459 m, theirs 0.1290 m -> "80.02 %". The paper
+  // Zhu et al. 2024 Table 4, walking_xyz ATE RMSE: ORB-SLAM3 0.6459 m, theirs 0.1290 m -> "80.02 %". The paper
   // truncates to two decimals (the exact rate is 80.0279 %), so compare the truncated percentage.
   auto truncated_percent = [](double rate) { return std::floor(rate * 1e4) / 100.0; };
   EXPECT_NEAR(truncated_percent(improvement_rate(0.6459, 0.1290)), 80.02, 1e-9);

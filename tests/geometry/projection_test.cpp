@@ -83,7 +83,7 @@ TYPED_TEST(ProjectionTest, DepthToPointsUsesFyAndMask) {
     const T tol = T(1e-6);
     EXPECT_NEAR(p.z(), zt, tol);
     EXPECT_NEAR(p.x(), (T(u) - T(3.5)) * zt / T(500), tol);
-    EXPECT_NEAR(p.y(), (T(v) - T(2.5)) * zt / T(400), tol);  // fy, not fx (002 eq. 6 typo)
+    EXPECT_NEAR(p.y(), (T(v) - T(2.5)) * zt / T(400), tol);  // fy, not fx (Zhu et al. 2024 eq. 6 typo)
   }
   // Stride 2 samples pixels (0, 2, 4, 6) x (0, 2, 4); none of them is missing or masked.
   const auto sparse = dyncull::depth_to_points(view, cam, dyncull::ConstMaskView{}, 2);

@@ -1,6 +1,6 @@
 /// @file pose_refinement.hpp
 /// Ceres (>= 2.1) motion-only pose refinement: the pixel reprojection error of geometry/pnp.hpp
-/// (ALGORITHMS.md §8) with an optional Huber loss, rotation on ceres::EigenQuaternionManifold.
+/// (Zhu et al. 2024 §2) with an optional Huber loss, rotation on ceres::EigenQuaternionManifold.
 #pragma once
 
 #include "dyncull/core/camera.hpp"

@@ -1,6 +1,6 @@
 /// @file box_rule.hpp
-/// Semantic box rule (002 Table 2, 004 Algorithm 1): a feature is dynamic only if it lies in a
-/// high-level box and in no low-level box; medium-level boxes give candidates (001 §III.D).
+/// Semantic box rule (Zhu et al. 2024 Table 2, Zhang et al. 2023 Algorithm 1): a feature is dynamic only if it lies in a
+/// high-level box and in no low-level box; medium-level boxes give candidates (RTD-SLAM §III.D).
 ///
 /// API (for the pipeline):
 ///   BoxRuleResult r = apply_box_rule(points, detections, MotionLevelTable::coco80(), BoxRuleOptions<T>{});
@@ -38,10 +38,10 @@ struct BoxRuleOptions {
   T low_shrink_px = T(0);
   /// Features in a medium-level box (and no low/high box) become Candidate; false: Static.
   bool medium_as_candidate = true;
-  /// 001 §III.D sends every boxed feature to geometric verification: when true, features in a
+  /// RTD-SLAM §III.D sends every boxed feature to geometric verification: when true, features in a
   /// high-level box become Candidate instead of Dynamic.
   bool high_as_candidate = false;
-  /// Whether a low-level box also shelters medium-level features (consistent with 002 Table 2).
+  /// Whether a low-level box also shelters medium-level features (consistent with Zhu et al. 2024 Table 2).
   bool low_overrides_medium = true;
 
   /// Ok, or InvalidInput naming the first bad field: both paddings finite. Negative values are

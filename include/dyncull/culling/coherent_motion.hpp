@@ -1,5 +1,6 @@
 /// @file coherent_motion.hpp
-/// Cell-level motion evidence for 003's sub-box vote (Algorithm 1; our extension): the features of one
+/// Cell-level motion evidence for the sub-box vote of DFD-SLAM (Qian et al. 2024,
+/// Algorithm 1; our extension): the features of one
 /// sub-box of an object move together, so the median of their reprojection residual vectors becomes
 /// significant well before any single residual passes its threshold (a seated person's sway). A cell whose
 /// median residual exceeds `sigmas` standard errors of a median is flagged as a whole (docs/algorithms.md).

@@ -1,5 +1,5 @@
 /// @file depth_mask.hpp
-/// Depth-threshold object mask inside a detection box (000 §3.3, eq. 1-2): d_max = max of the four
+/// Depth-threshold object mask inside a detection box (DLD-SLAM, Yu et al. 2024, §3.3 eq. 1-2): d_max = max of the four
 /// corner depths, d_c = centre depth; if d_max - d_c > eps the mask is the box pixels with valid depth
 /// below d_c + eps. Plain rule exactly as published, plus a robust variant (patch statistics,
 /// histogram fallback, missing depth) and the Dynamic-VINS threshold form.
@@ -37,7 +37,7 @@
 
 namespace dyncull {
 
-/// Plain: 000 eq. 1-2 on single pixels (corner and integer centre pixels, raw units, strict
+/// Plain: DLD-SLAM eq. 1-2 on single pixels (corner and integer centre pixels, raw units, strict
 /// inequalities); when the rule does not apply the mask is empty and features in the box are
 /// Candidates. Robust: patch estimates, missing-depth pixels decided by their nearest measured pixel
 /// (MissingDepth), histogram fallback.
@@ -49,10 +49,10 @@ enum class DepthMaskMode : std::uint8_t { Plain = 0, Robust = 1 };
 /// the border band and the shadows beside a person go with the wall they lie on, not with the person.
 enum class MissingDepth : std::uint8_t { Nearest = 0, InMask = 1, OutOfMask = 2 };
 
-/// Seed000: threshold d_c + eps iff d_max - d_c > eps. DynamicVins (HITSZ-NRSL/Dynamic-VINS
+/// DldSlam: threshold d_c + eps iff d_max - d_c > eps. DynamicVins (HITSZ-NRSL/Dynamic-VINS
 /// setSemanticMask): both valid: midpoint (d_c + d_max)/2 if d_max - d_c > eps, else d_c + eps;
 /// only the corner valid: d_max; neither valid: whole box.
-enum class DepthThresholdForm : std::uint8_t { Seed000 = 0, DynamicVins = 1 };
+enum class DepthThresholdForm : std::uint8_t { DldSlam = 0, DynamicVins = 1 };
 
 /// What produced a box's mask.
 enum class DepthMaskOutcome : std::uint8_t {
@@ -76,8 +76,8 @@ constexpr const char* to_string(DepthMaskOutcome o) noexcept {
 
 struct DepthMaskOptions {
   DepthMaskMode mode = DepthMaskMode::Robust;
-  DepthThresholdForm form = DepthThresholdForm::Seed000;
-  /// eps of 000 eq. 2 in metres (paper: empirical, 0.3-0.5 m indoors; 0.3 m fits TUM best).
+  DepthThresholdForm form = DepthThresholdForm::DldSlam;
+  /// eps of DLD-SLAM eq. 2 in metres (paper: empirical, 0.3-0.5 m indoors; 0.3 m fits TUM best).
   double eps_m = 0.3;
   /// eps of the Dynamic-VINS form (their 1000 mm).
   double dynamic_vins_eps_m = 1.0;
@@ -110,8 +110,8 @@ struct DepthMaskOptions {
   double max_object_depth_extent_m = 1.5;
   /// Below this fraction of box pixels with depth the whole box is masked.
   double min_valid_fraction = 0.05;
-  /// Two-sided band (robust mode, Seed000 form): when > 0, pixels nearer than d_c - near_margin_m are
-  /// left out too. 000's band is one-sided (everything in front of the object is masked), which
+  /// Two-sided band (robust mode, DldSlam form): when > 0, pixels nearer than d_c - near_margin_m are
+  /// left out too. DLD-SLAM's band is one-sided (everything in front of the object is masked), which
   /// takes in a chair or the floor between the camera and a person; 0 (default) keeps the paper's rule.
   double near_margin_m = 0.0;
   /// Occluded centre (robust mode, several boxes): when box b's centre lies in another box a and b's
@@ -119,7 +119,7 @@ struct DepthMaskOptions {
   /// band would leave b's own object out. Then b's d_c is re-estimated from b's pixels outside a: if
   /// fewer than occluded_centre_max_fraction of them lie within eps of d_c, d_c becomes the fullest bin
   /// of the nearest window of 3 histogram bins behind the occluder that holds at least
-  /// occluded_cluster_fraction of them. false (default): 000's centre sample.
+  /// occluded_cluster_fraction of them. false (default): DLD-SLAM's centre sample.
   bool occluded_centre_search = false;
   double occluded_centre_max_fraction = 0.15;
   double occluded_cluster_fraction = 0.15;
@@ -134,7 +134,7 @@ struct DepthMaskOptions {
     using detail::finite_in;
     using detail::invalid_option;
     if (static_cast<int>(mode) > 1) return invalid_option(reason, "mode", "must be Plain or Robust");
-    if (static_cast<int>(form) > 1) return invalid_option(reason, "form", "must be Seed000 or DynamicVins");
+    if (static_cast<int>(form) > 1) return invalid_option(reason, "form", "must be DldSlam or DynamicVins");
     if (static_cast<int>(missing_depth) > 2)
       return invalid_option(reason, "missing_depth", "must be Nearest, InMask or OutOfMask");
     if (!finite_in(eps_m, 0, 1e4)) return invalid_option(reason, "eps_m", "must be finite and in [0, 1e4] m");
@@ -701,7 +701,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
   const PixelRect& rc = info.rect;
   const double upm = static_cast<double>(v.units_per_metre);
   const int x0 = rc.c0, y0 = rc.r0, x1 = rc.c1 - 1, y1 = rc.r1 - 1;
-  const int cu = (x0 + x1) / 2, cv = (y0 + y1) / 2;  // integer centre, as 000's reference code
+  const int cu = (x0 + x1) / 2, cv = (y0 + y1) / 2;  // integer centre, as DLD-SLAM's reference code
   const bool robust = o.mode == DepthMaskMode::Robust;
 
   double corner[4], dc;
@@ -988,7 +988,7 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
     if (!r.boxes.back().ok()) ++bad;
   }
   if (options.occluded_centre_search && options.mode == DepthMaskMode::Robust &&
-      options.form == DepthThresholdForm::Seed000) {
+      options.form == DepthThresholdForm::DldSlam) {
     for (std::size_t b = 0; b < r.boxes.size(); ++b) {
       if (!r.boxes[b].ok() || r.boxes[b].outcome == DepthMaskOutcome::WholeBox) continue;
       for (std::size_t a = 0; a < r.boxes.size(); ++a) {

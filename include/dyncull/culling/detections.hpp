@@ -1,6 +1,7 @@
 /// @file detections.hpp
 /// Detector output -> pixel boxes: YOLO normalised (cx, cy, w, h) to corners X1 = (x - w/2) W,
-/// X2 = (x + w/2) W, Y1 = (y - h/2) H, Y2 = (y + h/2) H (001 eq. 1-2, 004 eq. 1), undoing a letterbox.
+/// X2 = (x + w/2) W, Y1 = (y - h/2) H, Y2 = (y + h/2) H (RTD-SLAM, Gao et al. 2024,
+/// eq. 1-2; Zhang et al. 2023 eq. 1), undoing a letterbox.
 ///
 /// API:
 ///   Box<T> yolo_to_pixel_box(const YoloBox<T>&, int width, int height, const Letterbox<T>& = {});

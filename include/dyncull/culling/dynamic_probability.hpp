@@ -1,5 +1,5 @@
 /// @file dynamic_probability.hpp
-/// Per-feature dynamic probability (000 §3.4, eq. 3-5, Algorithm 1): P = a1 S + a2 M + a3 K, dynamic
+/// Per-feature dynamic probability (DLD-SLAM, Yu et al. 2024, §3.4 eq. 3-5, Algorithm 1): P = a1 S + a2 M + a3 K, dynamic
 /// iff P >= threshold. S from the motion level, M from LK flow against the static features' flow
 /// (eq. 4-5, adaptive threshold defined here), K from a caller-owned per-track state store.
 ///
@@ -31,8 +31,8 @@ namespace dyncull {
 
 /// How a feature's flow is compared with the camera's own motion.
 enum class FlowModel : std::uint8_t {
-  MeanFlow = 0,     ///< 000 eq. 4-5: |flow - reference flow| (right for small rotation, shallow scenes)
-  Fundamental = 1,  ///< ego-motion compensated: distance of p_curr to the epipolar line F p_prev (003 eq. 3)
+  MeanFlow = 0,     ///< DLD-SLAM eq. 4-5: |flow - reference flow| (right for small rotation, shallow scenes)
+  Fundamental = 1,  ///< ego-motion compensated: distance of p_curr to the epipolar line F p_prev (DFD-SLAM eq. 3)
   Homography = 2,   ///< ego-motion compensated for pure rotation / planar scenes: |p_curr - H p_prev|
 };
 

@@ -1,6 +1,6 @@
 /// @file labels.hpp
 /// Per-feature labels and cull reasons shared by every culling stage (semantic and geometric).
-/// Three-valued labels follow 001 §III.D: medium-level objects are sent to geometric verification.
+/// Three-valued labels follow RTD-SLAM (Gao et al. 2024) §III.D: medium-level objects are sent to geometric verification.
 #pragma once
 
 #include <cstdint>
@@ -14,11 +14,11 @@ enum class FeatureLabel : std::uint8_t { Static = 0, Candidate = 1, Dynamic = 2 
 enum class CullReason : std::uint8_t {
   None = 0,
   HighLevelBox,       ///< inside a high-motion-level box (person, animal) and no low-level box
-  LowLevelOverride,   ///< inside a high-level box but also inside a low-level box: kept (002 Table 2)
+  LowLevelOverride,   ///< inside a high-level box but also inside a low-level box: kept (Zhu et al. 2024 Table 2)
   MediumLevelBox,     ///< inside a medium-level box only: candidate for geometric verification
-  DepthMask,          ///< inside the depth-threshold object mask (000 §3.3)
-  Probability,        ///< dynamic probability above threshold (000 §3.4)
-  Epipolar,           ///< epipolar distance above threshold (003 eq. 3)
+  DepthMask,          ///< inside the depth-threshold object mask (DLD-SLAM §3.3)
+  Probability,        ///< dynamic probability above threshold (DLD-SLAM §3.4)
+  Epipolar,           ///< epipolar distance above threshold (DFD-SLAM eq. 3)
   SubBox,             ///< sub-box refinement marked it (geometric stage)
   MultiView,          ///< multi-view depth/angle check (geometric stage)
   SurvivorGuardUndo,  ///< culling undone because too few static features would remain

@@ -1,11 +1,12 @@
 /// @file motion_levels.hpp
-/// Class id -> motion level table (001 §III.B, 004 Algorithm 1, 000 §3.4 sets D / H / S): high =
+/// Class id -> motion level table (RTD-SLAM, Gao et al. 2024, §III.B;
+/// Zhang et al. 2023 Algorithm 1; DLD-SLAM, Yu et al. 2024, §3.4 sets D / H / S): high =
 /// moves by itself, medium = easily moved, low = treated as static. Default: the full COCO-80 table.
 ///
 /// API (used by box_rule.hpp, dynamic_probability.hpp and the pipeline):
 ///   MotionLevelTable t = MotionLevelTable::coco80();
 ///   t.level(class_id) -> MotionLevel;  t.set(id, level);  t.set("chair", MotionLevel::Low);
-///   motion_level_score(level) -> S of 000 eq. 3 (1 / 0.5 / 0).
+///   motion_level_score(level) -> S of DLD-SLAM eq. 3 (1 / 0.5 / 0).
 #pragma once
 
 #include <cstddef>
@@ -17,7 +18,7 @@
 namespace dyncull {
 
 /// Ignore: the class takes no part in culling (unknown ids, or classes a user switched off). It is
-/// distinct from Low, because a low-level box *protects* the features inside it (002 Table 2).
+/// distinct from Low, because a low-level box *protects* the features inside it (Zhu et al. 2024 Table 2).
 enum class MotionLevel : std::uint8_t { Ignore = 0, Low = 1, Medium = 2, High = 3 };
 
 constexpr const char* to_string(MotionLevel level) noexcept {
@@ -30,7 +31,7 @@ constexpr const char* to_string(MotionLevel level) noexcept {
   return "unknown";
 }
 
-/// S of 000 eq. 3 as Algorithm 1 defines it: 1 high, 0.5 medium, 0 low (the text's "1 for static"
+/// S of DLD-SLAM eq. 3 as Algorithm 1 defines it: 1 high, 0.5 medium, 0 low (the text's "1 for static"
 /// contradicts Algorithm 1; Algorithm 1 is followed). Ignore scores 0 like Low.
 template <class T = double>
 constexpr T motion_level_score(MotionLevel level) noexcept {

@@ -1,5 +1,5 @@
 /// @file moving_consistency.hpp
-/// Moving-consistency check (seed 003 §3.2 eq. 1-3, DS-SLAM): F by RANSAC on the tracked features, then
+/// Moving-consistency check (DFD-SLAM, Qian et al. 2024, §3.2 eq. 1-3; DS-SLAM): F by RANSAC on the tracked features, then
 /// each track's distance D = |p2^T F p1| / sqrt(X^2 + Y^2) to its epipolar line; D above a threshold = dynamic.
 #pragma once
 

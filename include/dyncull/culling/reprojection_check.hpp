@@ -1,7 +1,7 @@
 /// @file reprojection_check.hpp
 /// RGB-D moving-consistency check: the camera pose is fitted by PnP-RANSAC on tracks outside the
 /// dynamic boxes (SG-SLAM's fit subset), and a track is dynamic when its 3-D point reprojects far from it.
-/// It is the depth counterpart of the epipolar check (003 eq. 3): the epipolar distance only sees the
+/// It is the depth counterpart of the epipolar check (DFD-SLAM, Qian et al. 2024, eq. 3): the epipolar distance only sees the
 /// motion across the epipolar line, the reprojection residual all of it in the image, and the optional
 /// depth residual (measured against predicted depth) the motion along the viewing ray (docs/algorithms.md).
 #pragma once

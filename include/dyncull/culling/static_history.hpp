@@ -1,7 +1,8 @@
 /// @file static_history.hpp
-/// Per-track static history (our extension, in the spirit of 000's last-frame state K, eq. 3): a track whose
+/// Per-track static history (our extension, in the spirit of the last-frame state K of DLD-SLAM,
+/// Yu et al. 2024, eq. 3): a track whose
 /// own reprojection residual stayed small and unflagged over its last few evaluated frames is still, whatever
-/// the box rule (002/004) or the sub-box vote (003 Algorithm 1) says about the region it lies in.
+/// the box rule (Zhu et al. 2024 / Zhang et al. 2023) or the sub-box vote (DFD-SLAM Algorithm 1) says about the region it lies in.
 #pragma once
 
 #include "dyncull/core/flags.hpp"
@@ -22,7 +23,7 @@ namespace dyncull {
 template <class T>
 struct StaticHistoryOptions {
   /// Evaluated frames in a row, up to and including the current one, in which the track's own check said
-  /// Static with a residual below max_residual_px. 0 = off. A seated person's still legs share 003's cells
+  /// Static with a residual below max_residual_px. 0 = off. A seated person's still legs share DFD-SLAM's cells
   /// with its swaying upper body: one frame's residual does not separate the two (the sway pauses, so a
   /// moving track is often under any per-frame threshold), a few frames in a row mostly do.
   int min_frames = 0;

@@ -1,5 +1,5 @@
 /// @file subbox_refine.hpp
-/// Sub-box refinement (seed 003 Algorithm 1): each detection box is split into 3 x 3 sub-boxes voted
+/// Sub-box refinement (DFD-SLAM, Qian et al. 2024, Algorithm 1): each detection box is split into 3 x 3 sub-boxes voted
 /// dynamic or static by the geometric labels inside them (ratio = dyn / (dyn + static) vs sigma1).
 #pragma once
 
@@ -279,7 +279,7 @@ void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometr
 /// points: the features; geometric: their geometric labels (Dynamic / Static; Candidate = unlabelled,
 /// not counted; required, one per point); boxes: container of Box<T> or Detection<T> (the boxes to
 /// refine, e.g. person boxes);
-/// in_object_mask: optional per-feature flag (object mask of 000 §3.3): a feature in a dynamic sub-box
+/// in_object_mask: optional per-feature flag (object mask of DLD-SLAM §3.3): a feature in a dynamic sub-box
 /// is Dynamic only if also in the object mask, as the paper keeps "the mask" inside dynamic sub-boxes.
 /// object_box_bits: optional per-feature bit set (bit b: in box b's own object mask, as
 /// DepthMaskResult::box_bits): box b then acts only on its own object's features, so a chair that a

@@ -1,5 +1,6 @@
 /// @file ate.hpp
-/// Absolute trajectory error as TUM evaluate_ate.py (000 eq. 6-7, 004 eq. 9-10): associate stamps,
+/// Absolute trajectory error as TUM evaluate_ate.py (DLD-SLAM, Yu et al. 2024, eq. 6-7;
+/// Zhang et al. 2023 eq. 9-10): associate stamps,
 /// align the estimate's positions onto the ground truth's (SE(3), or Sim(3) for monocular), then
 /// summarise the per-pose position errors.
 #pragma once

@@ -120,7 +120,7 @@ auto compute_statistics(const Container& values)
   return compute_statistics(values.data(), static_cast<std::size_t>(values.size()));
 }
 
-/// Improvement rate of 002 eq. 7 / 004 eq. 11: (m - n) / m, with m the baseline's error and n ours
+/// Improvement rate of Zhu et al. 2024 eq. 7 / Zhang et al. 2023 eq. 11: (m - n) / m, with m the baseline's error and n ours
 /// (0.8 = 80 % lower error). NaN when m is zero or either value is not finite: no rate exists then.
 template <class T>
 T improvement_rate(T baseline_m, T ours_n) {

@@ -1,6 +1,6 @@
 /// @file pnp.hpp
-/// Camera pose from 3-D world points and their pixels (ALGORITHMS.md §8, seed 002 §2 eq. 4-6): Lambda Twist
-/// P3P (Persson & Nordberg, ECCV 2018) as the minimal solver, DLT on normalised coordinates for all points,
+/// Camera pose from 3-D world points and their pixels (Zhu et al. 2024 §2 eq. 4-6): Lambda Twist P3P
+/// (Persson & Nordberg, ECCV 2018) as the minimal solver, DLT on normalised coordinates for all points,
 /// Levenberg-Marquardt on SE(3) of the pixel reprojection error (optional Huber loss), and PnP-RANSAC via ransac().
 #pragma once
 
