@@ -60,3 +60,5 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
 }
 
 }  // namespace dyncull
+
+#include "dyncull/culling/pipeline_extern.hpp"  // instantiations precompiled in dyncull::pipeline

@@ -4,6 +4,7 @@
 /// the 7-point minimal solver (cubic det constraint, up to 3 solutions) and LO-RANSAC on Sampson error (px).
 #pragma once
 
+#include "dyncull/core/precompiled.hpp"
 #include "dyncull/core/random.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
@@ -129,8 +130,30 @@ inline void epipolar_row(double x1, double y1, double x2, double y2, double* a) 
   a[6] = x1, a[7] = y1, a[8] = 1;
 }
 
+// The solvers below have no template parameter: with DYNCULL_PRECOMPILED they are compiled once into
+// dyncull::pipeline (src/geometry/fundamental.cpp) and only declared here; header-only, they are inline.
+using RowsMatrix = Eigen::Matrix<double, 9, Eigen::Dynamic>;
+DYNCULL_SOLVER Mat3<double> enforce_rank2(const Mat3<double>& F);
+DYNCULL_SOLVER Status solve_normal_equations(const Eigen::Matrix<double, 9, 9>& ata, Mat3<double>* F,
+                                             std::string* reason);
+DYNCULL_SOLVER bool nullspace_7x9(double A[7][9], double n1[9], double n2[9]);
+DYNCULL_SOLVER int solve_cubic(double c3, double c2, double c1, double c0, double roots[3]);
+DYNCULL_SOLVER int seven_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
+                                          const std::uint32_t* idx, Mat3<double>* out);
+DYNCULL_SOLVER Mat3<double> denormalise(const Mat3<double>& Fn, const Normaliser& n1, const Normaliser& n2);
+DYNCULL_SOLVER Status eight_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
+                                             const std::uint32_t* idx, std::size_t n, const double* weights,
+                                             RowsMatrix* rows, Mat3<double>* Fn, std::string* reason,
+                                             const Mat3<double>* warm = nullptr);
+DYNCULL_SOLVER bool homography_dlt(const double* x1, const double* y1, const double* x2, const double* y2,
+                                   const std::uint32_t* idx, std::size_t n, Mat3<double>* H);
+DYNCULL_SOLVER bool homography_4point(const double* x1, const double* y1, const double* x2, const double* y2,
+                                      const std::uint32_t* idx, Mat3<double>* H);
+
+#if !defined(DYNCULL_PRECOMPILED) || defined(DYNCULL_FUNDAMENTAL_SOURCE)
+
 /// Closest rank-2 matrix (Frobenius), via SVD with the smallest singular value zeroed.
-inline Mat3<double> enforce_rank2(const Mat3<double>& F) {
+DYNCULL_SOLVER Mat3<double> enforce_rank2(const Mat3<double>& F) {
   Eigen::JacobiSVD<Mat3<double>> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Vec3<double> s = svd.singularValues();
   s[2] = 0;
@@ -139,7 +162,8 @@ inline Mat3<double> enforce_rank2(const Mat3<double>& F) {
 
 /// Smallest-eigenvalue eigenvector of the 9x9 normal matrix, as a 3x3 F (row-major). Fails (Degenerate)
 /// when the null space is at least two-dimensional: the correspondences do not determine F.
-inline Status solve_normal_equations(const Eigen::Matrix<double, 9, 9>& ata, Mat3<double>* F, std::string* reason) {
+DYNCULL_SOLVER Status solve_normal_equations(const Eigen::Matrix<double, 9, 9>& ata, Mat3<double>* F,
+                                             std::string* reason) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> es(ata);
   if (es.info() != Eigen::Success) {
     if (reason) *reason = "eigen-decomposition of the 8-point normal matrix failed";
@@ -162,7 +186,7 @@ inline Status solve_normal_equations(const Eigen::Matrix<double, 9, 9>& ata, Mat
 
 /// Null space of a 7x9 matrix by Gauss-Jordan elimination with full pivoting (no allocation, ~1 us).
 /// Returns false when the rank is below 7.
-inline bool nullspace_7x9(double A[7][9], double n1[9], double n2[9]) {
+DYNCULL_SOLVER bool nullspace_7x9(double A[7][9], double n1[9], double n2[9]) {
   int perm[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
   double scale = 0;
   for (int i = 0; i < 7; ++i)
@@ -203,7 +227,7 @@ inline bool nullspace_7x9(double A[7][9], double n1[9], double n2[9]) {
 }
 
 /// Real roots of c3 x^3 + c2 x^2 + c1 x + c0 (degrades to quadratic / linear); Newton-polished.
-inline int solve_cubic(double c3, double c2, double c1, double c0, double roots[3]) {
+DYNCULL_SOLVER int solve_cubic(double c3, double c2, double c1, double c0, double roots[3]) {
   const double cmax = std::max(std::max(std::abs(c3), std::abs(c2)), std::max(std::abs(c1), std::abs(c0)));
   if (!(cmax > 0) || !std::isfinite(cmax)) return 0;
   int count = 0;
@@ -253,8 +277,8 @@ inline int solve_cubic(double c3, double c2, double c1, double c0, double roots[
 }
 
 /// 7-point solver on normalised coordinates: writes up to 3 normalised F (unit norm), returns the count.
-inline int seven_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
-                                  const std::uint32_t* idx, Mat3<double>* out) {
+DYNCULL_SOLVER int seven_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
+                                          const std::uint32_t* idx, Mat3<double>* out) {
   double A[7][9];
   for (int i = 0; i < 7; ++i) {
     const std::uint32_t k = idx[i];
@@ -289,7 +313,7 @@ inline int seven_point_normalised(const double* x1, const double* y1, const doub
 
 /// Back to pixels: F_px = T2^T F_n T1, unit Frobenius norm, sign fixed so the largest entry is positive
 /// (makes results comparable and deterministic up to numerics).
-inline Mat3<double> denormalise(const Mat3<double>& Fn, const Normaliser& n1, const Normaliser& n2) {
+DYNCULL_SOLVER Mat3<double> denormalise(const Mat3<double>& Fn, const Normaliser& n1, const Normaliser& n2) {
   Mat3<double> F = n2.matrix().transpose() * Fn * n1.matrix();
   const double norm = F.norm();
   if (norm > 0) F /= norm;
@@ -299,8 +323,6 @@ inline Mat3<double> denormalise(const Mat3<double>& Fn, const Normaliser& n1, co
   return F;
 }
 
-using RowsMatrix = Eigen::Matrix<double, 9, Eigen::Dynamic>;
-
 /// Weighted 8-point on normalised coordinates of the selected points (idx == nullptr: all n). `rows` is
 /// scratch (9 x n, grown if needed): the normal matrix is one vectorised product A A^T, 5-10x faster
 /// than n rank-one updates.
@@ -308,10 +330,10 @@ using RowsMatrix = Eigen::Matrix<double, 9, Eigen::Dynamic>;
 /// by three steps of inverse iteration on an LDLT of A^T A (~1 us) instead of a full 9x9 eigen-decomposition
 /// (~10 us, the largest LO cost); the eigen-decomposition remains the fallback and the only path that runs
 /// the rank (degeneracy) test.
-inline Status eight_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
-                                     const std::uint32_t* idx, std::size_t n, const double* weights,
-                                     RowsMatrix* rows, Mat3<double>* Fn, std::string* reason,
-                                     const Mat3<double>* warm = nullptr) {
+DYNCULL_SOLVER Status eight_point_normalised(const double* x1, const double* y1, const double* x2, const double* y2,
+                                             const std::uint32_t* idx, std::size_t n, const double* weights,
+                                             RowsMatrix* rows, Mat3<double>* Fn, std::string* reason,
+                                             const Mat3<double>* warm) {
   if (n < 8) {
     if (reason) *reason = std::to_string(n) + " correspondences, the 8-point algorithm needs 8";
     return Status::TooFewPoints;
@@ -352,8 +374,8 @@ inline Status eight_point_normalised(const double* x1, const double* y1, const d
 }
 
 /// Homography by normalised DLT on selected correspondences (normalised coordinates); false if degenerate.
-inline bool homography_dlt(const double* x1, const double* y1, const double* x2, const double* y2,
-                           const std::uint32_t* idx, std::size_t n, Mat3<double>* H) {
+DYNCULL_SOLVER bool homography_dlt(const double* x1, const double* y1, const double* x2, const double* y2,
+                                   const std::uint32_t* idx, std::size_t n, Mat3<double>* H) {
   if (n < 4) return false;
   Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
   Eigen::Matrix<double, 9, 1> a, b;
@@ -374,8 +396,8 @@ inline bool homography_dlt(const double* x1, const double* y1, const double* x2,
 }
 
 /// Homography through four correspondences (normalised coordinates), h33 = 1; false if singular.
-inline bool homography_4point(const double* x1, const double* y1, const double* x2, const double* y2,
-                              const std::uint32_t* idx, Mat3<double>* H) {
+DYNCULL_SOLVER bool homography_4point(const double* x1, const double* y1, const double* x2, const double* y2,
+                                      const std::uint32_t* idx, Mat3<double>* H) {
   Eigen::Matrix<double, 8, 8> A;
   Eigen::Matrix<double, 8, 1> b;
   for (int i = 0; i < 4; ++i) {
@@ -393,6 +415,8 @@ inline bool homography_4point(const double* x1, const double* y1, const double* 
   *H << h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], 1.0;
   return H->allFinite();
 }
+
+#endif  // solver definitions
 
 }  // namespace detail
 
@@ -726,5 +750,19 @@ FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& po
   }
   return r;
 }
+
+#if defined(DYNCULL_PRECOMPILED)
+// Compiled once into dyncull::pipeline (src/geometry/fundamental.cpp) for the pipeline's point containers.
+extern template FundamentalResult<float> estimate_fundamental_ransac(const std::vector<Vec2<float>>&,
+                                                                     const std::vector<Vec2<float>>&,
+                                                                     const FundamentalOptions<float>&);
+extern template FundamentalResult<double> estimate_fundamental_ransac(const std::vector<Vec2<double>>&,
+                                                                      const std::vector<Vec2<double>>&,
+                                                                      const FundamentalOptions<double>&);
+extern template FundamentalResult<float> fundamental_8point(const std::vector<Vec2<float>>&,
+                                                            const std::vector<Vec2<float>>&);
+extern template FundamentalResult<double> fundamental_8point(const std::vector<Vec2<double>>&,
+                                                             const std::vector<Vec2<double>>&);
+#endif
 
 }  // namespace dyncull

@@ -6,6 +6,7 @@
 
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/flags.hpp"
+#include "dyncull/core/precompiled.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -121,7 +122,8 @@ struct PnpResult {
 /// Lambda Twist P3P. bearings: unit vectors (camera frame) towards world[0..2]. Writes up to 4
 /// cam_from_world poses to `out`, returns their number (0 for degenerate input). Double only:
 /// the cubic/quadratic closed forms lose too many digits in float.
-inline int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> world[3], Rigid3<double> out[4]);
+/// Without a template parameter: compiled once into dyncull::pipeline with DYNCULL_PRECOMPILED.
+DYNCULL_SOLVER int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> world[3], Rigid3<double> out[4]);
 
 /// Pose from >= 6 non-coplanar points by DLT on normalised coordinates (world points centred and
 /// scaled, pixels through K^-1), projected onto SO(3). Degenerate for coplanar points (use solve_pnp).
@@ -396,9 +398,18 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
   return res;
 }
 
+// The P3P pieces below have no template parameter: with DYNCULL_PRECOMPILED they are compiled once into
+// dyncull::pipeline (src/geometry/pnp.cpp) and only declared here; header-only, they are inline.
+DYNCULL_SOLVER void refine_lambdas(double* l, double a12, double a13, double a23, double b12, double b13,
+                                   double b23);
+DYNCULL_SOLVER bool eig3x3_known0(const Mat3<double>& M, Mat3<double>* E, double* sig1, double* sig2);
+
+#if !defined(DYNCULL_PRECOMPILED) || defined(DYNCULL_PNP_SOURCE)
+
 /// Solves lambda_i^2 + lambda_j^2 - 2 b_ij lambda_i lambda_j = a_ij by Gauss-Newton (the paper's
 /// refinement of the depths; 2-3 steps recover the digits the closed forms lose).
-inline void refine_lambdas(double* l, double a12, double a13, double a23, double b12, double b13, double b23) {
+DYNCULL_SOLVER void refine_lambdas(double* l, double a12, double a13, double a23, double b12, double b13,
+                                   double b23) {
   for (int it = 0; it < 3; ++it) {
     const double r1 = l[0] * l[0] + l[1] * l[1] - 2 * b12 * l[0] * l[1] - a12;
     const double r2 = l[0] * l[0] + l[2] * l[2] - 2 * b13 * l[0] * l[2] - a13;
@@ -420,7 +431,7 @@ inline void refine_lambdas(double* l, double a12, double a13, double a23, double
 
 /// Eigen-decomposition of a symmetric 3x3 matrix known to be singular (Lambda Twist's eig3x3known0):
 /// eigenvalues sig1 (largest |.|), sig2 and 0, eigenvectors in E's columns.
-inline bool eig3x3_known0(const Mat3<double>& M, Mat3<double>* E, double* sig1, double* sig2) {
+DYNCULL_SOLVER bool eig3x3_known0(const Mat3<double>& M, Mat3<double>* E, double* sig1, double* sig2) {
   const double p1 = -M.trace();
   const double p0 = -M(0, 1) * M(0, 1) - M(0, 2) * M(0, 2) - M(1, 2) * M(1, 2) + M(0, 0) * (M(1, 1) + M(2, 2)) +
                     M(1, 1) * M(2, 2);
@@ -442,9 +453,12 @@ inline bool eig3x3_known0(const Mat3<double>& M, Mat3<double>* E, double* sig1, 
   return E->allFinite() && std::isfinite(s1) && std::isfinite(s2);
 }
 
+#endif  // solver definitions
+
 }  // namespace detail
 
-inline int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> world[3], Rigid3<double> out[4]) {
+#if !defined(DYNCULL_PRECOMPILED) || defined(DYNCULL_PNP_SOURCE)
+DYNCULL_SOLVER int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> world[3], Rigid3<double> out[4]) {
   const Vec3<double>& x0 = bearings[0];
   const Vec3<double>& x1 = bearings[1];
   const Vec3<double>& x2 = bearings[2];
@@ -540,6 +554,8 @@ inline int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> world[3]
   }
   return count;
 }
+
+#endif  // solver definitions
 
 namespace detail {
 
@@ -882,5 +898,14 @@ PnpResult<T> solve_pnp_ransac(const Points3& world, const Points2& pixels, const
   }
   return res;
 }
+
+#if defined(DYNCULL_PRECOMPILED)
+// Compiled once into dyncull::pipeline (src/geometry/pnp.cpp) for the pipeline's point containers.
+extern template PnpResult<float> solve_pnp_ransac(const std::vector<Vec3<float>>&, const std::vector<Vec2<float>>&,
+                                                  const PinholeCamera<float>&, const PnpOptions<float>&);
+extern template PnpResult<double> solve_pnp_ransac(const std::vector<Vec3<double>>&,
+                                                   const std::vector<Vec2<double>>&, const PinholeCamera<double>&,
+                                                   const PnpOptions<double>&);
+#endif
 
 }  // namespace dyncull
