@@ -178,6 +178,22 @@ TYPED_TEST(CullerTest, OwnPolicyMakesAKeyframeWhenFewKeypointsMatch) {
   EXPECT_TRUE(r.keyframe);
 }
 
+// A front end that has no features yet on its first frame (it detects after tracking) gives the culler an
+// empty first keyframe: the next frame with keypoints must replace it, or a still camera would never get
+// one and every later frame would run on box evidence alone.
+TYPED_TEST(CullerTest, OwnPolicyReplacesAnEmptyKeyframe) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  WallView<T> empty = wall_view<T>(0);
+  empty.keypoints.clear();
+  empty.descriptors.clear();
+  EXPECT_TRUE(culler.cull(empty.frame()).keyframe);
+  EXPECT_TRUE(culler.cull(wall_view<T>(0).frame()).keyframe) << "the keyframe without keypoints stayed";
+  const CullerResult& r = culler.cull(wall_view<T>(0.01).frame());
+  EXPECT_FALSE(r.keyframe);
+  EXPECT_GT(r.matched, wall_view<T>(0.01).keypoints.size() / 2);
+}
+
 TYPED_TEST(CullerTest, HostPolicyFollowsIsKeyframe) {
   using T = TypeParam;
   Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());

@@ -141,7 +141,7 @@ struct CullerInputs {
 
 /// Who decides when the current frame becomes the reference keyframe.
 enum class KeyframePolicy : std::uint8_t {
-  Own = 0,  ///< the culler: pose moved or turned past a threshold, or too few keypoints matched the keyframe
+  Own = 0,  ///< the culler: pose moved or turned far, too few keypoints matched the keyframe, or it has none
   Host,     ///< the host sets CullerFrame::is_keyframe (its own keyframes); the first frame always is one
 };
 
@@ -350,7 +350,11 @@ class Culler {
       const double moved = static_cast<double>(rel.t.norm());
       const double turned = static_cast<double>(rotation_angle(rel.R)) * Constants<double>::rad_to_deg();
       const double base = static_cast<double>(keyframe_px_.size() < n ? keyframe_px_.size() : n);
-      new_keyframe = moved > options_.keyframe_max_translation_m || turned > options_.keyframe_max_rotation_deg ||
+      // A keyframe without keypoints (a front end that detects after its first frame) matches nothing and
+      // the ratio rule cannot see it: the first frame with keypoints replaces it.
+      const bool empty_keyframe = keyframe_px_.empty() && n > 0;
+      new_keyframe = empty_keyframe || moved > options_.keyframe_max_translation_m ||
+                     turned > options_.keyframe_max_rotation_deg ||
                      static_cast<double>(r.matched) < options_.keyframe_min_matched_ratio * base;
     }
 
