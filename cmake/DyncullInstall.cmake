@@ -1,6 +1,9 @@
 include(CMakePackageConfigHelpers)
 
 set(DYNCULL_EXPORT_TARGETS dyncull)
+if(DYNCULL_MASTER_PROJECT)  # otherwise dyncull_pipeline is built only when a target links it
+  list(APPEND DYNCULL_EXPORT_TARGETS dyncull_pipeline)
+endif()
 if(DYNCULL_HAS_OPENCV)
   list(APPEND DYNCULL_EXPORT_TARGETS dyncull_opencv)
 endif()
