@@ -67,26 +67,18 @@ void BM_Pipeline_RecommendedWithPointsAndIds(benchmark::State& state) {
 }
 BENCHMARK(BM_Pipeline_RecommendedWithPointsAndIds)->Unit(benchmark::kMicrosecond);
 
-// With points and the sub-box memory option (15 frames, track ids): the memory's bookkeeping per frame.
-void BM_Pipeline_RecommendedWithPointsAndMemory(benchmark::State& state) {
-  PipelineOptions<float> o = presets::recommended<float>();
-  o.subbox_memory_frames = 15;
-  run_pipeline(state, o, true, true);
-}
-BENCHMARK(BM_Pipeline_RecommendedWithPointsAndMemory)->Unit(benchmark::kMicrosecond);
-
-// The multi-view check (left out of the recommended preset: it only verifies candidates there) on top.
+// The multi-view check (left out of the recommended preset) on top.
 void BM_Pipeline_RecommendedPlusMultiView(benchmark::State& state) {
   PipelineOptions<float> o = presets::recommended<float>();
-  o.use_multiview = true;
+  o.multiview.enabled = true;
   run_pipeline(state, o);
 }
 BENCHMARK(BM_Pipeline_RecommendedPlusMultiView)->Unit(benchmark::kMicrosecond);
 
 void BM_Pipeline_AllStrategies(benchmark::State& state) {
   PipelineOptions<float> o = presets::recommended<float>();
-  o.use_multiview = true;
-  o.use_probability = true;
+  o.multiview.enabled = true;
+  o.probability.enabled = true;
   run_pipeline(state, o);
 }
 BENCHMARK(BM_Pipeline_AllStrategies)->Unit(benchmark::kMicrosecond);
@@ -129,12 +121,12 @@ namespace {
 void BM_Pipeline_RecommendedWithout(benchmark::State& state) {
   dyncull::PipelineOptions<float> o = dyncull::presets::recommended<float>();
   switch (state.range(0)) {
-    case 0: o.assign_overlaps_by_depth = false; break;
-    case 1: o.use_depth_mask = false; break;
-    case 2: o.use_subbox = false; break;
-    case 3: o.use_moving_consistency = false; break;
-    case 4: o.use_box_tracker = false; break;
-    default: o.low_override_by_depth = false; break;
+    case 0: o.depth_mask.assign_overlaps_by_depth = false; break;
+    case 1: o.depth_mask.enabled = false; break;
+    case 2: o.subbox.enabled = false; break;
+    case 3: o.moving_consistency.enabled = false; break;
+    case 4: o.tracker.enabled = false; break;
+    default: o.depth_mask.low_override_by_depth = false; break;
   }
   run_pipeline(state, o);
 }

@@ -27,8 +27,8 @@ enum class Stage { Inputs = 0, Boxes, Semantic, Geometric, Probability, RegionVo
 
 PipelineOptions<float> options_for(Stage stage) {
   PipelineOptions<float> o = presets::recommended<float>();
-  o.use_multiview = true;
-  o.use_probability = stage == Stage::Probability;
+  o.multiview.enabled = true;
+  o.probability.enabled = stage == Stage::Probability;
   return o;
 }
 
@@ -65,7 +65,7 @@ struct StageRun {
                              &state.subbox_memory, &w.votes, &r);
         break;
       case Stage::MultiView:
-        detail::check_against_keyframes(frame, o, w.semantic_labels(), state.keyframes, &w.multiview, &r);
+        detail::check_against_keyframes(frame, o, state.keyframes, &w.multiview, &r);
         break;
       case Stage::Combine:
         detail::combine_evidence(o, w, &r);

@@ -1,7 +1,6 @@
-// Sub-box memory bookkeeping for one frame: 1100 tracks (5 % replaced by new ones each frame, as a front
-// end loses and detects features), 5 tracked boxes; update_tracks + recall + remember. And the short-baseline
-// frame: remember_states + recall_states + apply_subbox_states on 1100 features. There is no peer: the
-// figure to compare with is the pipeline's own cost (pipeline_bench, about 0.25-0.45 ms a frame).
+// The last sub-box vote of 5 tracked boxes kept and recalled for a frame whose baseline is too short to vote:
+// remember_states + recall_states + apply_subbox_states on 1100 features. There is no peer: the figure to
+// compare with is the pipeline's own cost (pipeline_bench, about 0.25-0.45 ms a frame).
 #include "dyncull/culling/subbox_memory.hpp"
 
 #include <benchmark/benchmark.h>
@@ -11,35 +10,6 @@
 
 namespace {
 using namespace dyncull;
-
-void BM_SubBoxMemory_Frame(benchmark::State& state) {
-  constexpr std::size_t kTracks = 1100, kBoxes = 5;
-  std::vector<std::int64_t> ids(kTracks);
-  for (std::size_t i = 0; i < kTracks; ++i) ids[i] = static_cast<std::int64_t>(i);
-  std::vector<FeatureLabel> geometric(kTracks, FeatureLabel::Static);
-  for (std::size_t i = 0; i < kTracks; i += 7) geometric[i] = FeatureLabel::Dynamic;
-  const std::vector<std::int64_t> boxes = {1, 2, 3, 4, 5};
-  SubBoxResult<float> votes;
-  votes.dyn_count.assign(kBoxes * 9, 0);
-  votes.static_count.assign(kBoxes * 9, 3);
-  for (std::size_t b = 0; b < kBoxes; ++b) votes.dyn_count[b * 9] = 5;  // one dynamic cell per box
-  const SubBoxOptions<float> options;
-  SubBoxMemory memory;
-  std::vector<std::uint8_t> eligible, cells;
-  std::uint64_t frame = 0;
-  std::int64_t next_id = static_cast<std::int64_t>(kTracks);
-  for (auto _ : state) {
-    ++frame;
-    for (std::size_t k = 0; k < kTracks / 20; ++k) ids[(frame * 37 + k * 19) % kTracks] = next_id++;
-    memory.recall(boxes, 3, frame, 15, &cells);
-    memory.update_tracks(ids, geometric, frame, 15, &eligible);
-    memory.remember(boxes, votes, options, frame, 15);
-    benchmark::DoNotOptimize(eligible.data());
-    benchmark::DoNotOptimize(cells.data());
-  }
-  state.counters["tracks_remembered"] = double(memory.num_tracks());
-}
-BENCHMARK(BM_SubBoxMemory_Frame)->Unit(benchmark::kMicrosecond);
 
 void BM_SubBoxMemory_LastVoteFrame(benchmark::State& state) {
   constexpr std::size_t kPoints = 1100, kBoxes = 5;

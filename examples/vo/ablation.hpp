@@ -31,37 +31,40 @@ inline std::vector<AblationSwitch> ablation_switches() {
   P defaults;
   const auto missing_depth = defaults.depth_mask.missing_depth;
   const double eps_m = defaults.depth_mask.eps_m;
-  const float epipolar_in_boxes_px = defaults.moving.max_epipolar_distance_in_boxes_px;
+  const float epipolar_in_boxes_px = defaults.moving_consistency.max_epipolar_distance_in_boxes_px;
   const float depth_sigmas = defaults.reprojection.max_depth_residual_sigmas;
-  const bool overlaps = defaults.assign_overlaps_by_depth;
-  const double margin = defaults.overlap_high_level_margin_m;
-  const bool low_override = defaults.low_override_by_depth;
-  const int edge_radius = defaults.edge_evidence_radius_px;
+  const bool overlaps = defaults.depth_mask.assign_overlaps_by_depth;
+  const double margin = defaults.depth_mask.overlap_high_level_margin_m;
+  const bool low_override = defaults.depth_mask.low_override_by_depth;
   const bool mask_votes = defaults.subbox.object_mask_votes_only;
   const bool static_evidence = defaults.subbox.static_needs_evidence;
-  const bool verifies_candidates = defaults.subbox_verifies_candidates;
-  const int min_evidence = defaults.min_evidence_frames;
-  const bool last_vote = defaults.short_baseline_keeps_last_vote;
-  const bool geometric_outside = defaults.cull_geometric_outside_boxes;
+  const bool verifies_candidates = defaults.subbox.verifies_candidates;
+  const int min_evidence = defaults.subbox.min_evidence_frames;
+  const bool last_vote = defaults.subbox.short_baseline_keeps_last_vote;
   std::vector<AblationSwitch> s;
   auto add = [&](const char* name, const char* what, std::function<void(P&)> f) {
     s.push_back(AblationSwitch{name, what, [f](StrategySpec& spec) { f(spec.pipeline); }});
   };
-  // Stages.
-  add("detection_filter", "stage: detection filter (padding, class confidences)",
-      [](P& o) { o.use_detection_filter = false; });
-  add("box_tracker", "stage: box tracker (boxes carried through detector misses)",
-      [](P& o) { o.use_box_tracker = false; });
-  add("box_rule", "stage: box rule (motion levels of the boxes)", [](P& o) { o.use_box_rule = false; });
-  add("depth_mask", "stage: depth mask (box culls limited to the object's depth band)",
-      [](P& o) { o.use_depth_mask = false; });
-  add("moving_consistency", "stage: epipolar moving-consistency check",
-      [](P& o) { o.use_moving_consistency = false; });
-  add("reprojection", "stage: RGB-D reprojection check", [](P& o) { o.use_reprojection = false; });
-  add("subbox", "stage: 3x3 sub-box refinement", [](P& o) { o.use_subbox = false; });
-  add("coherent_motion", "stage: coherent motion of a cell", [](P& o) { o.use_coherent_motion = false; });
-  add("static_history", "stage: static history of a track", [](P& o) { o.static_history.min_frames = 0; });
-  add("survivor_guard", "stage: minimum-survivor guard", [](P& o) { o.survivor_guard = false; });
+  // Stages: each one's `enabled` off.
+  add("detection_filter", "stage: detections.enabled (padding, class confidences)",
+      [](P& o) { o.detections.enabled = false; });
+  add("box_tracker", "stage: tracker.enabled (boxes carried through detector misses)",
+      [](P& o) { o.tracker.enabled = false; });
+  add("box_rule", "stage: box_rule.enabled (motion levels of the boxes)", [](P& o) { o.box_rule.enabled = false; });
+  add("depth_mask", "stage: depth_mask.enabled (box culls limited to the object's depth band)",
+      [](P& o) { o.depth_mask.enabled = false; });
+  add("moving_consistency", "stage: moving_consistency.enabled (epipolar check)",
+      [](P& o) { o.moving_consistency.enabled = false; });
+  add("reprojection", "stage: reprojection.enabled (RGB-D reprojection check)",
+      [](P& o) { o.reprojection.enabled = false; });
+  add("edge_evidence", "stage: edge_evidence.enabled (flags on occlusion edges discounted)",
+      [](P& o) { o.edge_evidence.enabled = false; });
+  add("coherent_motion", "stage: coherent_motion.enabled (coherent motion of a cell)",
+      [](P& o) { o.coherent_motion.enabled = false; });
+  add("subbox", "stage: subbox.enabled (3x3 sub-box refinement)", [](P& o) { o.subbox.enabled = false; });
+  add("static_history", "stage: static_history.enabled (static history of a track)",
+      [](P& o) { o.static_history.enabled = false; });
+  add("survivor_guard", "stage: guard.enabled (minimum-survivor guard)", [](P& o) { o.guard.enabled = false; });
   s.push_back(AblationSwitch{"keyframe_tracks",
                              "evidence against the previous frame instead of the keyframe (no 3-D points)",
                              [](StrategySpec& spec) { spec.tracks_from_keyframe = false; }});
@@ -70,30 +73,26 @@ inline std::vector<AblationSwitch> ablation_switches() {
       [=](P& o) { o.depth_mask.missing_depth = missing_depth; });
   add("depth_band_0.5m", "depth_mask.eps_m back to its default",
       [=](P& o) { o.depth_mask.eps_m = eps_m; });
-  add("epipolar_in_boxes_1px", "moving.max_epipolar_distance_in_boxes_px back to its default",
-      [=](P& o) { o.moving.max_epipolar_distance_in_boxes_px = epipolar_in_boxes_px; });
+  add("epipolar_in_boxes_1px", "moving_consistency.max_epipolar_distance_in_boxes_px back to its default",
+      [=](P& o) { o.moving_consistency.max_epipolar_distance_in_boxes_px = epipolar_in_boxes_px; });
   add("depth_residual", "reprojection.max_depth_residual_sigmas back to its default (no depth comparison)",
       [=](P& o) { o.reprojection.max_depth_residual_sigmas = depth_sigmas; });
-  add("overlaps_by_depth", "assign_overlaps_by_depth back to its default",
-      [=](P& o) { o.assign_overlaps_by_depth = overlaps; });
-  add("overlap_margin", "overlap_high_level_margin_m back to its default",
-      [=](P& o) { o.overlap_high_level_margin_m = margin; });
-  add("low_override_by_depth", "low_override_by_depth back to its default",
-      [=](P& o) { o.low_override_by_depth = low_override; });
-  add("edge_evidence", "edge_evidence_radius_px back to its default",
-      [=](P& o) { o.edge_evidence_radius_px = edge_radius; });
+  add("overlaps_by_depth", "depth_mask.assign_overlaps_by_depth back to its default",
+      [=](P& o) { o.depth_mask.assign_overlaps_by_depth = overlaps; });
+  add("overlap_margin", "depth_mask.overlap_high_level_margin_m back to its default",
+      [=](P& o) { o.depth_mask.overlap_high_level_margin_m = margin; });
+  add("low_override_by_depth", "depth_mask.low_override_by_depth back to its default",
+      [=](P& o) { o.depth_mask.low_override_by_depth = low_override; });
   add("subbox_mask_votes", "subbox.object_mask_votes_only back to its default",
       [=](P& o) { o.subbox.object_mask_votes_only = mask_votes; });
   add("subbox_static_evidence", "subbox.static_needs_evidence back to its default",
       [=](P& o) { o.subbox.static_needs_evidence = static_evidence; });
-  add("candidates_own_evidence", "subbox_verifies_candidates back to its default",
-      [=](P& o) { o.subbox_verifies_candidates = verifies_candidates; });
-  add("min_evidence_frames", "min_evidence_frames back to its default",
-      [=](P& o) { o.min_evidence_frames = min_evidence; });
-  add("short_baseline_vote", "short_baseline_keeps_last_vote back to its default",
-      [=](P& o) { o.short_baseline_keeps_last_vote = last_vote; });
-  add("geometric_only_in_boxes", "cull_geometric_outside_boxes back to its default",
-      [=](P& o) { o.cull_geometric_outside_boxes = geometric_outside; });
+  add("candidates_own_evidence", "subbox.verifies_candidates back to its default",
+      [=](P& o) { o.subbox.verifies_candidates = verifies_candidates; });
+  add("min_evidence_frames", "subbox.min_evidence_frames back to its default",
+      [=](P& o) { o.subbox.min_evidence_frames = min_evidence; });
+  add("short_baseline_vote", "subbox.short_baseline_keeps_last_vote back to its default",
+      [=](P& o) { o.subbox.short_baseline_keeps_last_vote = last_vote; });
   return s;
 }
 

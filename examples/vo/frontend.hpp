@@ -44,7 +44,7 @@ struct FrontEndOptions {
   /// window straddles an occlusion edge tracks the contour (a T-junction), not a 3-D point, and the
   /// epipolar check flags it although its surface is static. A larger radius raises label precision but
   /// leaves fewer corners and a weaker VO, so the default is 1 and the culling discounts flags on depth
-  /// edges instead (PipelineOptions::edge_evidence_radius_px).
+  /// edges instead (PipelineOptions::edge_evidence).
   int depth_edge_radius_px = 1;
   int lk_window_px = 21;              ///< LK window and pyramid depth (dynamic ORB-SLAM forks: 21 px, 3-5 levels)
   int lk_levels = 3;

@@ -84,7 +84,7 @@ TEST(CullerAllocations, NoneOfItsOwnPerFrameAfterWarmUp) {
   const std::vector<View> seq = sequence(10);
   CullerOptions<float> own_only;
   own_only.pipeline = presets::none<float>();  // the pipeline does next to nothing: what is left is the culler's
-  own_only.pipeline.use_detection_filter = false;
+  own_only.pipeline.detections.enabled = false;
   Status status = Status::Ok;
   const std::vector<std::size_t> counts = allocations_per_frame(own_only, seq, 3, &status);
   EXPECT_EQ(status, Status::Ok);

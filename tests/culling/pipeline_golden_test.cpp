@@ -1,5 +1,5 @@
 // Pins the per-feature labels and reasons of every preset on short synthetic sequences (state carried
-// frame to frame: box tracker, sub-box memory, static history, keyframes) to recorded hashes, so that a
+// frame to frame: box tracker, last sub-box votes, static history, keyframes) to recorded hashes, so that a
 // restructuring of the pipeline that is meant to keep its behaviour is checked feature by feature.
 // A deliberate change of behaviour updates the hashes in the same commit, saying why.
 #include "dyncull/culling/pipeline.hpp"
@@ -46,20 +46,16 @@ std::vector<NamedOptions<T>> golden_presets() {
       {"dfd_slam", presets::dfd_slam<T>()},   {"zhang_2023", presets::zhang_2023<T>()},
       {"recommended", presets::recommended<T>()}};
   PipelineOptions<T> o = presets::recommended<T>();
-  o.subbox_memory_frames = 5;
-  o.use_multiview = true;
-  o.multiview_overrides_static = true;
-  out.push_back({"recommended+memory+multiview", o});
+  o.multiview.enabled = true;
+  out.push_back({"recommended+multiview", o});
   o = presets::recommended<T>();
-  o.use_probability = true;
-  o.reprojection_evidence = PipelineOptions<T>::Evidence::Either;
-  o.cull_geometric_outside_boxes = true;
-  o.subbox_verifies_candidates = true;
-  out.push_back({"recommended+probability+either", o});
+  o.probability.enabled = true;
+  o.subbox.verifies_candidates = true;
+  out.push_back({"recommended+probability", o});
   o = presets::dld_slam<T>();
-  o.probability_flow_model = FlowModel::Fundamental;
-  o.use_moving_consistency = true;
-  o.use_box_tracker = true;
+  o.probability.flow_model = FlowModel::Fundamental;
+  o.moving_consistency.enabled = true;
+  o.tracker.enabled = true;
   out.push_back({"dld_slam+fundamental+tracker", o});
   return out;
 }
@@ -147,9 +143,9 @@ const Golden kGolden[] = {
     {"walking", "dfd_slam", 4, 0xf602bd46ab433621ull},
     {"walking", "zhang_2023", 4, 0x58d80cb62d9d3f70ull},
     {"walking", "recommended", 4, 0x3e9f4f1fc0222375ull},
-    {"walking", "recommended+memory+multiview", 4, 0xffcbbfdefb8ede0dull},
-    {"walking", "recommended+probability+either", 4, 0x3c08410a75ffa854ull},
-    {"walking", "dld_slam+fundamental+tracker", 4, 0x436d4bede4b4a4d4ull},
+    {"walking", "recommended+multiview", 4, 0xffcbbfdefb8ede0dull},
+    {"walking", "recommended+probability", 4, 0x0cb5ef9b04788480ull},
+    {"walking", "dld_slam+fundamental+tracker", 4, 0x27e67c45ead4d37dull},
     {"seated", "none", 4, 0x69dc837b4cc728afull},
     {"seated", "dld_slam", 4, 0xf9f057552b93da8dull},
     {"seated", "rtd_slam", 4, 0x1be0a99db4a2a010ull},
@@ -157,9 +153,9 @@ const Golden kGolden[] = {
     {"seated", "dfd_slam", 4, 0x56351946f0f66bfaull},
     {"seated", "zhang_2023", 4, 0xd3f4d06f8a44e25full},
     {"seated", "recommended", 4, 0xe43e51720f58a59bull},
-    {"seated", "recommended+memory+multiview", 4, 0xc4b7b2b08342fdd8ull},
-    {"seated", "recommended+probability+either", 4, 0x60922e8dda600511ull},
-    {"seated", "dld_slam+fundamental+tracker", 4, 0xfa13bed353fdaa83ull},
+    {"seated", "recommended+multiview", 4, 0xc4b7b2b08342fdd8ull},
+    {"seated", "recommended+probability", 4, 0xbc4aa8e80091586cull},
+    {"seated", "dld_slam+fundamental+tracker", 4, 0xaa062c671a913284ull},
     {"slow", "none", 4, 0xdb6cfcccd251d5bbull},
     {"slow", "dld_slam", 4, 0x5cdb057f7568ab2dull},
     {"slow", "rtd_slam", 4, 0x96c79b0f603c0d94ull},
@@ -167,9 +163,9 @@ const Golden kGolden[] = {
     {"slow", "dfd_slam", 4, 0x123e71375096d5abull},
     {"slow", "zhang_2023", 4, 0x58d80cb62d9d3f70ull},
     {"slow", "recommended", 4, 0x1645b1afaf9865c2ull},
-    {"slow", "recommended+memory+multiview", 4, 0xe4bf59ea86b498bfull},
-    {"slow", "recommended+probability+either", 4, 0x623a16df375bf6bcull},
-    {"slow", "dld_slam+fundamental+tracker", 4, 0x849e3a0b96a7a5aeull},
+    {"slow", "recommended+multiview", 4, 0x5113f578f35fce42ull},
+    {"slow", "recommended+probability", 4, 0x0b5641bbc2a3814cull},
+    {"slow", "dld_slam+fundamental+tracker", 4, 0x75fe4de4efa8dd30ull},
     {"all_dynamic", "none", 4, 0x1670cfe1e06684bbull},
     {"all_dynamic", "dld_slam", 4, 0xa116d65eb6b05e0full},
     {"all_dynamic", "rtd_slam", 4, 0x0f53a341d0f1f5b9ull},
@@ -177,9 +173,9 @@ const Golden kGolden[] = {
     {"all_dynamic", "dfd_slam", 4, 0x1670cfe1e06684bbull},
     {"all_dynamic", "zhang_2023", 4, 0x0f53a341d0f1f5b9ull},
     {"all_dynamic", "recommended", 4, 0x2eb6b978c8793a8bull},
-    {"all_dynamic", "recommended+memory+multiview", 4, 0x2eb6b978c8793a8bull},
-    {"all_dynamic", "recommended+probability+either", 4, 0xb1f36903e87a386full},
-    {"all_dynamic", "dld_slam+fundamental+tracker", 4, 0x454beed26611d4c7ull},
+    {"all_dynamic", "recommended+multiview", 4, 0x2eb6b978c8793a8bull},
+    {"all_dynamic", "recommended+probability", 4, 0x1670cfe1e06684bbull},
+    {"all_dynamic", "dld_slam+fundamental+tracker", 4, 0x1670cfe1e06684bbull},
     {"walking", "none", 8, 0xdb6cfcccd251d5bbull},
     {"walking", "dld_slam", 8, 0xb27f6c41a43af634ull},
     {"walking", "rtd_slam", 8, 0x6d64cc2f0c3db000ull},
@@ -187,9 +183,9 @@ const Golden kGolden[] = {
     {"walking", "dfd_slam", 8, 0xf602bd46ab433621ull},
     {"walking", "zhang_2023", 8, 0x58d80cb62d9d3f70ull},
     {"walking", "recommended", 8, 0x3e9f4f1fc0222375ull},
-    {"walking", "recommended+memory+multiview", 8, 0xffcbbfdefb8ede0dull},
-    {"walking", "recommended+probability+either", 8, 0x3c08410a75ffa854ull},
-    {"walking", "dld_slam+fundamental+tracker", 8, 0x436d4bede4b4a4d4ull},
+    {"walking", "recommended+multiview", 8, 0xffcbbfdefb8ede0dull},
+    {"walking", "recommended+probability", 8, 0x0cb5ef9b04788480ull},
+    {"walking", "dld_slam+fundamental+tracker", 8, 0x27e67c45ead4d37dull},
     {"seated", "none", 8, 0x69dc837b4cc728afull},
     {"seated", "dld_slam", 8, 0xf9f057552b93da8dull},
     {"seated", "rtd_slam", 8, 0x1be0a99db4a2a010ull},
@@ -197,9 +193,9 @@ const Golden kGolden[] = {
     {"seated", "dfd_slam", 8, 0x56351946f0f66bfaull},
     {"seated", "zhang_2023", 8, 0xd3f4d06f8a44e25full},
     {"seated", "recommended", 8, 0xe43e51720f58a59bull},
-    {"seated", "recommended+memory+multiview", 8, 0xc4b7b2b08342fdd8ull},
-    {"seated", "recommended+probability+either", 8, 0x60922e8dda600511ull},
-    {"seated", "dld_slam+fundamental+tracker", 8, 0xfa13bed353fdaa83ull},
+    {"seated", "recommended+multiview", 8, 0xc4b7b2b08342fdd8ull},
+    {"seated", "recommended+probability", 8, 0xbc4aa8e80091586cull},
+    {"seated", "dld_slam+fundamental+tracker", 8, 0xaa062c671a913284ull},
     {"slow", "none", 8, 0xdb6cfcccd251d5bbull},
     {"slow", "dld_slam", 8, 0x5cdb057f7568ab2dull},
     {"slow", "rtd_slam", 8, 0x96c79b0f603c0d94ull},
@@ -207,9 +203,9 @@ const Golden kGolden[] = {
     {"slow", "dfd_slam", 8, 0x123e71375096d5abull},
     {"slow", "zhang_2023", 8, 0x58d80cb62d9d3f70ull},
     {"slow", "recommended", 8, 0x1645b1afaf9865c2ull},
-    {"slow", "recommended+memory+multiview", 8, 0xe4bf59ea86b498bfull},
-    {"slow", "recommended+probability+either", 8, 0x623a16df375bf6bcull},
-    {"slow", "dld_slam+fundamental+tracker", 8, 0x849e3a0b96a7a5aeull},
+    {"slow", "recommended+multiview", 8, 0x5113f578f35fce42ull},
+    {"slow", "recommended+probability", 8, 0x0b5641bbc2a3814cull},
+    {"slow", "dld_slam+fundamental+tracker", 8, 0x75fe4de4efa8dd30ull},
     {"all_dynamic", "none", 8, 0x1670cfe1e06684bbull},
     {"all_dynamic", "dld_slam", 8, 0xa116d65eb6b05e0full},
     {"all_dynamic", "rtd_slam", 8, 0x0f53a341d0f1f5b9ull},
@@ -217,9 +213,9 @@ const Golden kGolden[] = {
     {"all_dynamic", "dfd_slam", 8, 0x1670cfe1e06684bbull},
     {"all_dynamic", "zhang_2023", 8, 0x0f53a341d0f1f5b9ull},
     {"all_dynamic", "recommended", 8, 0x2eb6b978c8793a8bull},
-    {"all_dynamic", "recommended+memory+multiview", 8, 0x2eb6b978c8793a8bull},
-    {"all_dynamic", "recommended+probability+either", 8, 0xb1f36903e87a386full},
-    {"all_dynamic", "dld_slam+fundamental+tracker", 8, 0x454beed26611d4c7ull},
+    {"all_dynamic", "recommended+multiview", 8, 0x2eb6b978c8793a8bull},
+    {"all_dynamic", "recommended+probability", 8, 0x1670cfe1e06684bbull},
+    {"all_dynamic", "dld_slam+fundamental+tracker", 8, 0x1670cfe1e06684bbull},
 };
 
 template <class T>

@@ -59,9 +59,9 @@ TYPED_TEST(PipelineInputsTest, NestedReasonNamesTheStageAndTheField) {
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
   EXPECT_EQ(why, "depth_mask.histogram_bin_m must be positive and finite (at least 0.001 m)");
   o = presets::recommended<T>();
-  o.moving.refit_iterations = 1000000;
+  o.moving_consistency.refit_iterations = 1000000;
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_NE(why.find("moving.refit_iterations"), std::string::npos) << why;
+  EXPECT_NE(why.find("moving_consistency.refit_iterations"), std::string::npos) << why;
   o = presets::recommended<T>();
   o.subbox.dilation_radius_px = INT_MAX;
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
@@ -78,13 +78,13 @@ TYPED_TEST(PipelineInputsTest, HugeReferenceKeyframeCountIsInvalidInputNotAnExce
   frame.is_keyframe = true;
   cull_frame(frame, o, &state);  // stores a keyframe
   ASSERT_FALSE(state.keyframes.empty());
-  o.max_reference_keyframes = std::numeric_limits<std::size_t>::max();
+  o.multiview.max_reference_keyframes = std::numeric_limits<std::size_t>::max();
   frame.is_keyframe = false;
   const PipelineResult<T>* r = nullptr;
   EXPECT_NO_THROW(r = &cull_frame(frame, o, &state));
   ASSERT_NE(r, nullptr);
-  expect_nothing_culled(*r, s.size(), "max_reference_keyframes");
-  o.max_reference_keyframes = PipelineOptions<T>::kMaxReferenceKeyframes;
+  expect_nothing_culled(*r, s.size(), "multiview.max_reference_keyframes");
+  o.multiview.max_reference_keyframes = MultiViewStageOptions<T>::kMaxReferenceKeyframes;
   EXPECT_NO_THROW(r = &cull_frame(frame, o, &state));
   EXPECT_TRUE(r->ok()) << r->reason;
 }
@@ -96,10 +96,10 @@ TYPED_TEST(PipelineInputsTest, SurvivorFractionOutOfRangeIsInvalidInputEvenWithT
   for (bool guard : {true, false})
     for (double fraction : {-1.0, std::numeric_limits<double>::quiet_NaN(), 1e30}) {
       PipelineOptions<T> o = presets::recommended<T>();
-      o.survivor_guard = guard;
-      o.min_survivor_fraction = fraction;
+      o.guard.enabled = guard;
+      o.guard.min_fraction = fraction;
       PipelineState<T> state;
-      expect_nothing_culled(cull_frame(frame_of(s, dets), o, &state), s.size(), "min_survivor_fraction");
+      expect_nothing_culled(cull_frame(frame_of(s, dets), o, &state), s.size(), "guard.min_fraction");
     }
 }
 
@@ -107,11 +107,11 @@ TYPED_TEST(PipelineInputsTest, EdgeEvidenceRadiusIsBounded) {
   using T = TypeParam;
   const auto s = test::make_culling_scene<T>();
   const auto dets = detections_of(s);
-  for (int radius : {INT_MAX, 100000000, -1}) {
+  for (int radius : {INT_MAX, 100000000, -1, 0}) {
     PipelineOptions<T> o = presets::recommended<T>();
-    o.edge_evidence_radius_px = radius;
+    o.edge_evidence.radius_px = radius;
     PipelineState<T> state;
-    expect_nothing_culled(cull_frame(frame_of(s, dets), o, &state), s.size(), "edge_evidence_radius_px");
+    expect_nothing_culled(cull_frame(frame_of(s, dets), o, &state), s.size(), "edge_evidence.radius_px");
   }
 }
 
@@ -193,25 +193,25 @@ template <class T>
 std::vector<std::string> expected_missing(const PipelineOptions<T>& o, const std::string& input) {
   std::vector<std::string> out;
   if (input == "detections") {
-    if (o.use_detection_filter) {
-      out.push_back("detection_filter: no detections given");
-    } else if (o.use_box_rule) {
+    if (o.detections.enabled) {
+      out.push_back("detections: no detections given");
+    } else if (o.box_rule.enabled) {
       out.push_back("box_rule: no detections given");
     }
   } else if (input == "depth") {
-    if (o.use_depth_mask) out.push_back("depth_mask: no depth given");
-    if (o.use_multiview) out.push_back("multiview: no depth given");
+    if (o.depth_mask.enabled) out.push_back("depth_mask: no depth given");
+    if (o.multiview.enabled) out.push_back("multiview: no depth given");
   } else if (input == "prev_keypoints") {
-    if (o.use_probability) out.push_back("probability: no prev_keypoints given");
-    if (o.use_moving_consistency) out.push_back("moving_consistency: no prev_keypoints given");
+    if (o.probability.enabled) out.push_back("probability: no prev_keypoints given");
+    if (o.moving_consistency.enabled) out.push_back("moving_consistency: no prev_keypoints given");
   } else if (input == "points_3d") {
-    if (o.use_reprojection) out.push_back("reprojection: no points_3d given");
+    if (o.reprojection.enabled) out.push_back("reprojection: no points_3d given");
   } else if (input == "cam_from_world") {
-    if (o.use_multiview) out.push_back("multiview: no cam_from_world given");
+    if (o.multiview.enabled) out.push_back("multiview: no cam_from_world given");
   } else if (input == "keyframe") {
-    if (o.use_multiview) out.push_back("multiview: no reference keyframe stored yet");
+    if (o.multiview.enabled) out.push_back("multiview: no reference keyframe stored yet");
   } else if (input == "track_ids") {
-    if (o.static_history.min_frames > 0) out.push_back("static_history: no track_ids given");
+    if (o.static_history.enabled) out.push_back("static_history: no track_ids given");
   }
   return out;
 }
@@ -284,8 +284,8 @@ TYPED_TEST(PipelineInputsTest, ADisabledStageIsNotMissingInput) {
   using T = TypeParam;
   const FullFrame<T> full;
   PipelineOptions<T> o = presets::recommended<T>();
-  o.use_moving_consistency = false;
-  o.use_probability = false;
+  o.moving_consistency.enabled = false;
+  o.probability.enabled = false;
   auto frame = full.frame();
   frame.prev_keypoints = nullptr;
   frame.track_valid = nullptr;
@@ -347,13 +347,13 @@ TYPED_TEST(PipelineInputsTest, PropertyRandomFramesGiveAStatusOrDefinedLabels) {
   std::size_t checked = 0, stages_ran = 0;  // frames whose labels were checked; stages that ran in them
   for (int trial = 0; trial < 300; ++trial) {
     PipelineOptions<T> o = bases[rng.index(5)];
-    o.moving.fundamental.ransac.max_iterations = 50;
+    o.moving_consistency.fundamental.ransac.max_iterations = 50;
     o.reprojection.pnp.ransac.max_iterations = 50;
     switch (rng.index(8)) {  // now and then one absurd option
-      case 0: o.min_survivor_fraction = wild<double>(rng, 0, 1); break;
+      case 0: o.guard.min_fraction = wild<double>(rng, 0, 1); break;
       case 1: o.depth_mask.histogram_max_m = wild<double>(rng, 0, 20); break;
       case 2: o.subbox.dilation_radius_px = static_cast<int>(rng.index(4)) * (INT_MAX / 3); break;
-      case 3: o.max_reference_keyframes = rng.index(2) ? std::numeric_limits<std::size_t>::max() : rng.index(5); break;
+      case 3: o.multiview.max_reference_keyframes = rng.index(2) ? std::numeric_limits<std::size_t>::max() : rng.index(5); break;
       case 4: o.multiview.search_radius_px = static_cast<int>(rng.index(3)) * (INT_MAX / 2); break;
       default: break;
     }

@@ -54,9 +54,9 @@ PinholeCamera<T> centred_camera(int W, int H) {
 template <class T>
 PipelineOptions<T> box_rule_and_depth_mask() {
   PipelineOptions<T> o = presets::none<T>();
-  o.use_detection_filter = false;
-  o.use_box_rule = true;
-  o.use_depth_mask = true;
+  o.detections.enabled = false;
+  o.box_rule.enabled = true;
+  o.depth_mask.enabled = true;
   o.depth_mask.mode = DepthMaskMode::Robust;
   return o;
 }
@@ -115,9 +115,8 @@ TYPED_TEST(PipelineTest, GeometricCullsNameTheCheckThatFlaggedThem) {
   const auto dets = detections_of(s);
   auto frame = frame_of(s, dets);
   PipelineOptions<T> o = presets::recommended<T>();
-  o.use_subbox = false;
-  o.cull_geometric_outside_boxes = true;
-  o.survivor_guard = false;
+  o.subbox.enabled = false;  // the candidates (chairs) are then culled on their own flags
+  o.guard.enabled = false;
   frame.points_3d = &s.prev_points_world;
   PipelineState<T> with_points;
   const PipelineResult<T> r = cull_frame(frame, o, &with_points);
@@ -141,9 +140,9 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   auto frame = frame_of(s, dets);
 
   PipelineOptions<T> o = presets::recommended<T>();
-  o.use_reprojection = true;  // on in the preset itself (presets_test)
+  o.reprojection.enabled = true;  // on in the preset itself (presets_test)
   // The preset's coherent-motion stage adds cell flags to these labels (CoherentMotionFlagsASwayTheResidualsMiss).
-  o.use_coherent_motion = false;
+  o.coherent_motion.enabled = false;
   frame.points_3d = &s.prev_points_world;
   PipelineState<T> state;
   const PipelineResult<T> r = cull_frame(frame, o, &state);
@@ -178,23 +177,10 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   ASSERT_TRUE(state_no_depth.result.reprojection.ran()) << state_no_depth.result.reprojection.reason;
   for (std::size_t i = 0; i < s.size(); ++i) EXPECT_TRUE(std::isnan(double(state_no_depth.internals().geometric.reprojection.depth_residual_m[i])));
 
-  // Either: a track is geometric-dynamic when either check flags it, so never fewer flags than Replace.
-  PipelineOptions<T> either = o;
-  either.reprojection_evidence = PipelineOptions<T>::Evidence::Either;
-  PipelineState<T> state_either;
-  const PipelineResult<T> re = cull_frame(frame, either, &state_either);
-  ASSERT_TRUE(re.reprojection.ran());
-  std::size_t flags_replace = 0, flags_either = 0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    flags_replace += state.internals().geometric.labels[i] == FeatureLabel::Dynamic;
-    flags_either += state_either.internals().geometric.labels[i] == FeatureLabel::Dynamic;
-  }
-  EXPECT_GE(flags_either, flags_replace);
-
   // No points: the reprojection check says so and the labels are the epipolar-only preset's. Points of the
   // wrong size: the frame is refused.
   PipelineOptions<T> epipolar_only = o;
-  epipolar_only.use_reprojection = false;
+  epipolar_only.reprojection.enabled = false;
   PipelineState<T> state_epi;
   frame.points_3d = nullptr;
   const std::vector<FeatureLabel> epi_labels = cull_frame(frame, epipolar_only, &state_epi).labels;
@@ -227,14 +213,14 @@ TYPED_TEST(PipelineTest, CoherentMotionFlagsASwayTheResidualsMiss) {
   auto frame = frame_of(s, dets);
   frame.points_3d = &s.prev_points_world;
   PipelineOptions<T> o = presets::recommended<T>();
-  o.use_coherent_motion = false;
+  o.coherent_motion.enabled = false;
   PipelineState<T> plain_state;
   const PipelineResult<T> plain = cull_frame(frame, o, &plain_state);
   ASSERT_TRUE(plain.subbox.ran()) << plain.subbox.reason;
   EXPECT_FALSE(plain.coherent_motion.enabled);
   EXPECT_LT(dynamic_rate(s, plain, SceneKind::SittingUpper), 0.5);  // measured 0.0
 
-  o.use_coherent_motion = true;
+  o.coherent_motion.enabled = true;
   PipelineState<T> state;
   const PipelineResult<T>& r = cull_frame(frame, o, &state);
   ASSERT_TRUE(r.coherent_motion.ran()) << r.coherent_motion.reason;
@@ -320,7 +306,7 @@ TYPED_TEST(PipelineTest, StaticHistoryKeepsTracksProvenStillInACulledRegion) {
   auto no_ids = frame;
   no_ids.track_ids = nullptr;
   PipelineOptions<T> off = o;
-  off.static_history.min_frames = 0;
+  off.static_history.enabled = false;
   PipelineState<T> no_ids_state, off_state;
   for (int k = 1; k <= 8; ++k) {
     const PipelineResult<T>& rn = cull_frame(no_ids, o, &no_ids_state);
@@ -344,71 +330,13 @@ TYPED_TEST(PipelineTest, StaticHistoryKeepsTracksProvenStillInACulledRegion) {
 // Recommended: a medium-level candidate is culled only on its own geometric evidence (flagged itself in a
 // dynamic sub-box, or by the multi-view check), never by its sub-box's vote alone; the pushed chair,
 // whose features are flagged, is still culled.
-// Sub-box memory: the seated person's upper body moves in frame 1, then pauses (its 3-D points re-measured
-// where it is: residual 0, nothing flagged) for 20 frames. The recommended preset with a 15-frame memory
-// keeps culling it for 15 frames and then lets it go; without memory (the preset's default), or without
-// track ids, it is kept from the first pause on. The still legs are never culled.
-TYPED_TEST(PipelineTest, SubBoxMemoryBridgesAPauseOfASlowMover) {
-  using T = TypeParam;
-  SceneConfig config;
-  config.walking = false;  // the seated person's box alone, as its sway pauses
-  const auto s = test::make_culling_scene<T>(config);
-  const auto dets = detections_of(s);
-  std::vector<std::int64_t> ids(s.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::int64_t>(i);
-  // Points where the surfaces are now: what the reference keyframe's depth gives once the motion stops.
-  std::vector<Vec3<T>> paused = s.prev_points_world;
-  const Rigid3<T> world_from_cam = s.cam_from_world.inverse();
-  for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.kind[i] == SceneKind::SittingUpper && std::isfinite(double(s.prev_points_world[i].x())))
-      paused[i] = world_from_cam.apply(s.camera.backproject(s.keypoints[i], s.depth_m[i]));
-  auto frame = frame_of(s, dets);
-  frame.track_ids = &ids;
-  auto run_sequence = [&](const PipelineOptions<T>& o, bool with_ids) {
-    PipelineState<T> state;
-    auto f = frame;
-    if (!with_ids) f.track_ids = nullptr;
-    std::vector<double> upper, lower;
-    for (int k = 0; k <= 20; ++k) {
-      f.points_3d = k == 0 ? &s.prev_points_world : &paused;
-      const PipelineResult<T>& r = cull_frame(f, o, &state);
-      EXPECT_TRUE(r.ok()) << r.reason;
-      upper.push_back(dynamic_rate(s, r, SceneKind::SittingUpper));
-      lower.push_back(dynamic_rate(s, r, SceneKind::SittingLower));
-      if (k == 1 && o.subbox_memory_frames > 0 && !with_ids) {
-        EXPECT_NE(r.subbox.reason.find("track_ids"), std::string::npos) << r.subbox.reason;
-      }
-    }
-    return std::make_pair(upper, lower);
-  };
-  PipelineOptions<T> without = presets::recommended<T>();
-  ASSERT_EQ(without.subbox_memory_frames, 0);
-  // The preset's static history would keep the paused tracks from their 6th still frame on, memory or not
-  // (StaticHistoryKeepsTracksProvenStillInACulledRegion): this test is about the memory alone.
-  without.static_history.min_frames = 0;
-  PipelineOptions<T> with_memory = without;
-  with_memory.subbox_memory_frames = 15;
-  const auto [mem_upper, mem_lower] = run_sequence(with_memory, true);
-  const auto [no_upper, no_lower] = run_sequence(without, true);
-  const auto [no_ids_upper, no_ids_lower] = run_sequence(with_memory, false);
-  EXPECT_GT(mem_upper[0], 0.9);  // moving: culled by every configuration
-  EXPECT_GT(no_upper[0], 0.9);
-  for (int k = 1; k <= 15; ++k) {
-    EXPECT_GT(mem_upper[k], 0.9) << "pause frame " << k;
-    EXPECT_LT(no_upper[k], 0.1) << "pause frame " << k;
-    EXPECT_LT(no_ids_upper[k], 0.1) << "pause frame " << k;
-  }
-  for (int k = 16; k <= 20; ++k) EXPECT_LT(mem_upper[k], 0.1) << "pause frame " << k << ": forgotten";
-  for (int k = 0; k <= 20; ++k) EXPECT_LT(mem_lower[k], 0.2) << "frame " << k;
-}
-
 TYPED_TEST(PipelineTest, CandidatesAreCulledOnTheirOwnEvidenceOnly) {
   using T = TypeParam;
   SceneConfig config;
   const auto s = test::make_culling_scene<T>(config);
   const auto dets = detections_of(s);
   PipelineOptions<T> o = presets::recommended<T>();
-  ASSERT_FALSE(o.subbox_verifies_candidates);
+  ASSERT_FALSE(o.subbox.verifies_candidates);
   PipelineState<T> state;
   const auto& r = run(s, dets, o, &state, config);
   ASSERT_TRUE(r.subbox.ran()) << r.subbox.reason;
@@ -422,7 +350,7 @@ TYPED_TEST(PipelineTest, CandidatesAreCulledOnTheirOwnEvidenceOnly) {
     }
   }
   // The sub-box vote alone (true) culls at least as many chair features.
-  o.subbox_verifies_candidates = true;
+  o.subbox.verifies_candidates = true;
   PipelineState<T> vote_state;
   const auto& v = run(s, dets, o, &vote_state, config);
   EXPECT_GE(dynamic_rate(s, v, SceneKind::Chair), dynamic_rate(s, r, SceneKind::Chair));
@@ -487,7 +415,7 @@ TYPED_TEST(PipelineTest, MissingInputsSkipTheirStagesAndTheFrameNamesThem) {
   frame.detections = &dets;
   frame.camera = s.camera;
   PipelineOptions<T> all_on = presets::recommended<T>();
-  all_on.use_multiview = true;
+  all_on.multiview.enabled = true;
   const auto& r = cull_frame(frame, all_on, &state);
   ASSERT_TRUE(r.labelled()) << r.reason;
   EXPECT_EQ(r.status, Status::MissingInput);
@@ -539,7 +467,7 @@ TYPED_TEST(PipelineTest, SurvivorGuardUndoesAnAllDynamicFrame) {
   EXPECT_EQ(r.guard_restored, s.size());
   for (auto why : r.reasons) EXPECT_EQ(why, CullReason::SurvivorGuardUndo);
   PipelineOptions<T> off = presets::recommended<T>();
-  off.survivor_guard = false;
+  off.guard.enabled = false;
   PipelineState<T> state2;
   const auto& q = run(s, dets, off, &state2, config);
   EXPECT_EQ(q.guard, GuardAction::None);
@@ -551,11 +479,11 @@ TYPED_TEST(PipelineTest, SurvivorGuardSoftensGeometricCullsFirst) {
   const auto s = test::make_culling_scene<T>(SceneConfig{});
   const auto dets = detections_of(s);
   PipelineOptions<T> o = presets::recommended<T>();
-  o.min_survivor_fraction = 0.0;
+  o.guard.min_fraction = 0.0;
   PipelineState<T> st0;
   const std::size_t survivors = run(s, dets, o, &st0, SceneConfig{}).num_static;
   // Ask for just a few more survivors than there are: restoring the soft (geometric) culls suffices.
-  o.min_survivors = survivors + 5;
+  o.guard.min_survivors = survivors + 5;
   PipelineState<T> st;
   const auto& r = run(s, dets, o, &st, SceneConfig{});
   EXPECT_EQ(r.guard, GuardAction::Softened) << r.reason;
@@ -627,7 +555,7 @@ TYPED_TEST(PipelineTest, OverlappingMasksAreAssignedToTheNearestObjectDepth) {
   EXPECT_GT(rates(off, 1), 0.9) << "premise: the walker's band holds the chair in front of it";
   EXPECT_EQ(rates(off, 2), 0.0);
 
-  o.assign_overlaps_by_depth = true;
+  o.depth_mask.assign_overlaps_by_depth = true;
   PipelineState<T> on_state;
   const PipelineResult<T>& on = cull_frame(frame, o, &on_state);
   ASSERT_TRUE(on.depth_mask.ran()) << on.depth_mask.reason;
@@ -660,7 +588,7 @@ TYPED_TEST(PipelineTest, HighLevelMarginGivesNearTiesToThePerson) {
   const std::size_t on_chair = kp.size();
   for (int u = 10; u < 300; u += 7) kp.emplace_back(T(u), T(10));  // wall: keeps the guard quiet
   PipelineOptions<T> o = box_rule_and_depth_mask<T>();
-  o.assign_overlaps_by_depth = true;
+  o.depth_mask.assign_overlaps_by_depth = true;
   auto chair_share = [&](float chair_depth, double margin) {
     const std::vector<float> depth = scene(chair_depth);
     CullingFrame<T, std::vector<Vec2<T>>> frame;
@@ -668,7 +596,7 @@ TYPED_TEST(PipelineTest, HighLevelMarginGivesNearTiesToThePerson) {
     frame.detections = &dets;
     frame.depth = DepthView<float>{depth.data(), W, H, 0, 1.f, 0.f, 1e30f};
     frame.camera = centred_camera<T>(W, H);
-    o.overlap_high_level_margin_m = margin;
+    o.depth_mask.overlap_high_level_margin_m = margin;
     PipelineState<T> state;
     const PipelineResult<T>& r = cull_frame(frame, o, &state);
     EXPECT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
@@ -741,7 +669,7 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
   EXPECT_EQ(d[0], 0.0) << "premise: the TV box shelters the walker (Zhu et al. 2024 Table 2)";
   EXPECT_EQ(d[1], 1.0);
   EXPECT_EQ(unsheltered, 0u);
-  o.low_override_by_depth = true;
+  o.depth_mask.low_override_by_depth = true;
   rates(behind, o, &d);
   EXPECT_EQ(d[0], 1.0) << "the walker is 1.5 m in front of the TV";
   const auto walker_in_tv_box = static_cast<std::size_t>(std::count(kind.begin(), kind.end(), 0));
@@ -761,9 +689,9 @@ TYPED_TEST(PipelineTest, LowLevelBoxesShelterOnlyFeaturesAtTheirDepth) {
 TYPED_TEST(PipelineTest, TrackerCarriesMoversNotLowLevelBoxes) {
   using T = TypeParam;
   PipelineOptions<T> o = presets::none<T>();
-  o.use_detection_filter = false;
-  o.use_box_rule = true;
-  o.use_box_tracker = true;
+  o.detections.enabled = false;
+  o.box_rule.enabled = true;
+  o.tracker.enabled = true;
   PinholeCamera<T> camera;
   camera.width = 320;
   camera.height = 240;
@@ -806,9 +734,9 @@ TYPED_TEST(PipelineTest, TrackerOptionsDecideHowLongAMissedBoxIsCarried) {
   std::vector<FeatureLabel> person_label;
   for (int max_missed : {0, 2}) {
     PipelineOptions<T> o = presets::none<T>();
-    o.use_detection_filter = false;
-    o.use_box_rule = true;
-    o.use_box_tracker = true;
+    o.detections.enabled = false;
+    o.box_rule.enabled = true;
+    o.tracker.enabled = true;
     o.tracker.max_missed_frames = max_missed;
     PipelineState<T> state;
     frame.detections = &seen;
@@ -822,7 +750,7 @@ TYPED_TEST(PipelineTest, TrackerOptionsDecideHowLongAMissedBoxIsCarried) {
   EXPECT_EQ(person_label[1], FeatureLabel::Dynamic) << "max_missed_frames 2: the missed box is carried";
 }
 
-// edge_evidence_radius_px: epipolar flags of features near a depth step stop counting as evidence
+// edge_evidence: epipolar flags of features near a depth step stop counting as evidence
 // (their moving-consistency label becomes Candidate), and only those; movers are still culled through
 // their boxes' sub-box votes.
 TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
@@ -831,11 +759,12 @@ TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
   const auto s = test::make_culling_scene<T>(config);
   const auto dets = detections_of(s);
   PipelineOptions<T> o = presets::recommended<T>();
-  o.edge_evidence_radius_px = 0;
+  o.edge_evidence.enabled = false;
   PipelineState<T> off_state;
   run(s, dets, o, &off_state, config);
   const std::vector<FeatureLabel> off_geo = off_state.internals().geometric.labels;
-  o.edge_evidence_radius_px = 8;
+  o.edge_evidence.enabled = true;
+  ASSERT_EQ(o.edge_evidence.radius_px, 8);
   PipelineState<T> on_state;
   const auto& on = run(s, dets, o, &on_state, config);
   ASSERT_TRUE(on.moving_consistency.ran()) << on.moving_consistency.reason;
@@ -857,7 +786,7 @@ TYPED_TEST(PipelineTest, EpipolarFlagsAtDepthEdgesAreNotEvidence) {
   EXPECT_LT(dynamic_rate(s, on, SceneKind::Room), 0.03);
 }
 
-// min_evidence_frames: on a one-frame baseline "not flagged" is no evidence of "static", so the sub-box vote
+// subbox.min_evidence_frames: on a one-frame baseline "not flagged" is no evidence of "static", so the sub-box vote
 // is skipped and the box rule decides: the seated person's still legs are culled with the rest of it. From
 // the minimum on (and when the baseline is unknown, 0) the vote keeps them as before.
 TYPED_TEST(PipelineTest, ShortBaselineLeavesPersonBoxesToTheBoxRule) {
@@ -866,7 +795,7 @@ TYPED_TEST(PipelineTest, ShortBaselineLeavesPersonBoxesToTheBoxRule) {
   const auto s = test::make_culling_scene<T>(config);
   const auto dets = detections_of(s);
   const PipelineOptions<T> o = presets::recommended<T>();
-  ASSERT_EQ(o.min_evidence_frames, 2);
+  ASSERT_EQ(o.subbox.min_evidence_frames, 2);
   auto cull_with_baseline = [&](int evidence_frames, PipelineState<T>* state) -> const PipelineResult<T>& {
     auto frame = frame_of(s, dets);
     frame.evidence_frames = evidence_frames;
@@ -910,7 +839,7 @@ TYPED_TEST(PipelineTest, ShortBaselineKeepsTheLastVoteOfTrackedBoxes) {
   const auto s = test::make_culling_scene<T>(config);
   const auto dets = detections_of(s);
   PipelineOptions<T> o = presets::recommended<T>();
-  ASSERT_TRUE(o.short_baseline_keeps_last_vote);
+  ASSERT_TRUE(o.subbox.short_baseline_keeps_last_vote);
   auto cull_with_baseline = [&](int evidence_frames, PipelineState<T>* state) -> const PipelineResult<T>& {
     auto frame = frame_of(s, dets);
     frame.evidence_frames = evidence_frames;
@@ -940,7 +869,7 @@ TYPED_TEST(PipelineTest, ShortBaselineKeepsTheLastVoteOfTrackedBoxes) {
   const auto& first = cull_with_baseline(1, &fresh);
   EXPECT_FALSE(first.subbox.ran());
   EXPECT_GT(dynamic_rate(s, first, SceneKind::SittingLower), 0.9);
-  o.use_box_tracker = false;  // no box identity across frames: no memory
+  o.tracker.enabled = false;  // no box identity across frames: no memory
   PipelineState<T> untracked;
   cull_with_baseline(2, &untracked);
   EXPECT_FALSE(cull_with_baseline(1, &untracked).subbox.ran());

@@ -10,37 +10,39 @@ namespace {
 
 TEST(Presets, EachPaperRunsItsStrategies) {
   const auto dld = presets::dld_slam<double>();
-  EXPECT_TRUE(dld.use_depth_mask && dld.use_probability && dld.use_box_rule);
-  EXPECT_FALSE(dld.use_moving_consistency || dld.use_subbox || dld.use_multiview);
+  EXPECT_TRUE(dld.depth_mask.enabled && dld.probability.enabled && dld.box_rule.enabled);
+  EXPECT_FALSE(dld.moving_consistency.enabled || dld.subbox.enabled || dld.multiview.enabled);
   EXPECT_EQ(dld.depth_mask.mode, DepthMaskMode::Plain);
-  EXPECT_EQ(dld.probability_flow_model, FlowModel::MeanFlow);
+  EXPECT_EQ(dld.probability.flow_model, FlowModel::MeanFlow);
 
   const auto rtd = presets::rtd_slam<double>();
-  EXPECT_TRUE(rtd.use_box_rule && rtd.use_multiview);
-  EXPECT_FALSE(rtd.use_moving_consistency || rtd.use_depth_mask || rtd.use_probability);
+  EXPECT_TRUE(rtd.box_rule.enabled && rtd.multiview.enabled);
+  EXPECT_FALSE(rtd.moving_consistency.enabled || rtd.depth_mask.enabled || rtd.probability.enabled);
   EXPECT_DOUBLE_EQ(rtd.multiview.depth_threshold_m, 0.4);
   EXPECT_DOUBLE_EQ(rtd.multiview.max_parallax_deg, 30.0);
   EXPECT_EQ(rtd.candidates, CandidatePolicy::Verify);
 
   const auto zhu = presets::zhu_2024<float>();
-  EXPECT_TRUE(zhu.use_box_rule);
+  EXPECT_TRUE(zhu.box_rule.enabled);
   EXPECT_FALSE(zhu.box_rule.medium_as_candidate);
-  EXPECT_FALSE(zhu.use_moving_consistency || zhu.use_multiview || zhu.use_depth_mask);
+  EXPECT_FALSE(zhu.moving_consistency.enabled || zhu.multiview.enabled || zhu.depth_mask.enabled);
 
   const auto dfd = presets::dfd_slam<float>();
-  EXPECT_TRUE(dfd.use_moving_consistency && dfd.use_subbox);
+  EXPECT_TRUE(dfd.moving_consistency.enabled && dfd.subbox.enabled);
   EXPECT_FLOAT_EQ(dfd.subbox.merge_ratio, 0.f);  // the paper's literal merge
   EXPECT_EQ(dfd.subbox.sigma2, 4);
-  EXPECT_FALSE(dfd.moving.fit_outside_boxes);
-  EXPECT_FLOAT_EQ(dfd.moving.max_epipolar_distance_px, 1.f);
-  EXPECT_FLOAT_EQ(dfd.moving.max_epipolar_distance_in_boxes_px, 1.f);
+  EXPECT_FALSE(dfd.moving_consistency.fit_outside_boxes);
+  EXPECT_FLOAT_EQ(dfd.moving_consistency.max_epipolar_distance_px, 1.f);
+  EXPECT_FLOAT_EQ(dfd.moving_consistency.max_epipolar_distance_in_boxes_px, 1.f);
+  EXPECT_FALSE(dfd.subbox.requires_fit_outside_boxes);  // F on all tracks, the vote always trusted
 
   const auto zhang = presets::zhang_2023<float>();
   EXPECT_EQ(zhang.candidates, CandidatePolicy::Cull);
-  EXPECT_FALSE(zhang.use_moving_consistency);
+  EXPECT_FALSE(zhang.moving_consistency.enabled);
   // Our additions stay out of the papers' presets.
   const auto without_our_additions = [](const auto& paper) {
-    return paper.static_history.min_frames == 0 && !paper.use_coherent_motion;
+    return !paper.static_history.enabled && !paper.coherent_motion.enabled && !paper.edge_evidence.enabled &&
+           !paper.reprojection.enabled && !paper.tracker.enabled;
   };
   EXPECT_TRUE(without_our_additions(dld) && without_our_additions(rtd) && without_our_additions(zhu) &&
               without_our_additions(dfd) && without_our_additions(zhang));
@@ -48,22 +50,26 @@ TEST(Presets, EachPaperRunsItsStrategies) {
 
 TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   const auto o = presets::recommended<float>();
-  EXPECT_TRUE(o.use_box_rule && o.use_depth_mask && o.use_moving_consistency && o.use_subbox &&
-              o.use_box_tracker && o.use_detection_filter && o.survivor_guard && o.assign_overlaps_by_depth);
-  EXPECT_FALSE(o.use_probability);
-  EXPECT_FALSE(o.use_multiview);
-  EXPECT_TRUE(o.moving.fit_outside_boxes);
-  EXPECT_FLOAT_EQ(o.moving.max_epipolar_distance_in_boxes_px, 1.0f);  // tracks against the keyframe
-  EXPECT_EQ(o.edge_evidence_radius_px, 8);
+  EXPECT_TRUE(o.box_rule.enabled && o.depth_mask.enabled && o.moving_consistency.enabled && o.subbox.enabled &&
+              o.tracker.enabled && o.detections.enabled && o.guard.enabled && o.depth_mask.assign_overlaps_by_depth);
+  EXPECT_FALSE(o.probability.enabled);
+  EXPECT_FALSE(o.multiview.enabled);
+  EXPECT_TRUE(o.moving_consistency.fit_outside_boxes);
+  EXPECT_FLOAT_EQ(o.moving_consistency.max_epipolar_distance_in_boxes_px, 1.0f);  // tracks against the keyframe
+  EXPECT_TRUE(o.edge_evidence.enabled);
+  EXPECT_EQ(o.edge_evidence.radius_px, 8);
   // RGB-D evidence when the frame carries 3-D points: the reprojection residual replaces the epipolar one.
-  EXPECT_TRUE(o.use_reprojection);
-  EXPECT_EQ(o.reprojection_evidence, PipelineOptions<float>::Evidence::Replace);
+  EXPECT_TRUE(o.reprojection.enabled);
+  EXPECT_TRUE(o.coherent_motion.enabled && o.static_history.enabled);
+  EXPECT_FALSE(o.subbox.verifies_candidates);
+  EXPECT_EQ(o.subbox.min_evidence_frames, 2);
+  EXPECT_TRUE(o.subbox.short_baseline_keeps_last_vote);
   EXPECT_FLOAT_EQ(o.reprojection.max_residual_in_boxes_px, 1.5f);
   EXPECT_FLOAT_EQ(o.reprojection.uncertainty_sigmas, 0.f);
   EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
   EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
-  EXPECT_DOUBLE_EQ(o.min_survivor_fraction, 0.10);
-  EXPECT_EQ(o.min_survivors, 30u);
+  EXPECT_DOUBLE_EQ(o.guard.min_fraction, 0.10);
+  EXPECT_EQ(o.guard.min_survivors, 30u);
   EXPECT_FLOAT_EQ(o.detections.box_padding_px, 5.f);
   EXPECT_DOUBLE_EQ(o.depth_mask.eps_m, 0.5);  // DLD-SLAM's range is 0.3-0.5 m; see the test below
   EXPECT_EQ(o.static_history.min_frames, 6);  // docs/results.md
@@ -102,7 +108,7 @@ TEST(Presets, DefaultsOfTheGeometricOptions) {
   EXPECT_DOUBLE_EQ(p.pnp.ransac.max_residual, 2.0);
   EXPECT_TRUE(p.fit_outside_boxes);
   EXPECT_EQ(p.min_tracks_outside_boxes, 20u);
-  EXPECT_FALSE(presets::none<double>().use_reprojection);
+  EXPECT_FALSE(presets::none<double>().reprojection.enabled);
   const SubBoxOptions<double> s;
   EXPECT_EQ(s.grid, 3);
   EXPECT_DOUBLE_EQ(s.sigma1, 0.5);

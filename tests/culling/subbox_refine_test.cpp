@@ -386,11 +386,7 @@ TYPED_TEST(SubBoxTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
   expect_invalid(r, "in_object_mask has 1 entries for 3 points");
   refine_subboxes(pts, geo, boxes, o, &r, flags, one_bits);
   expect_invalid(r, "object_box_bits has 1 entries for 3 points");
-  refine_subboxes(pts, geo, boxes, o, &r, flags, bits, few_cells, flags);
-  expect_invalid(r, "extra_dynamic_cells has 9 entries for 18 cells (boxes x grid x grid)");
-  refine_subboxes(pts, geo, boxes, o, &r, flags, bits, cells, one);
-  expect_invalid(r, "extra_eligible has 1 entries for 3 points");
-  refine_subboxes(pts, geo, boxes, o, &r, flags, bits, cells, flags);
+  refine_subboxes(pts, geo, boxes, o, &r, flags, bits);
   EXPECT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);
 

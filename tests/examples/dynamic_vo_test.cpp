@@ -490,14 +490,14 @@ TEST(DynamicVo, FamilySummaryGivesMediansRatiosAndPooledLabels) {
 std::string ablated_fields(const vo::StrategySpec& s) {
   const PipelineOptions<float>& o = s.pipeline;
   std::ostringstream t;
-  t << o.use_detection_filter << o.use_box_tracker << o.use_box_rule << o.use_depth_mask << o.use_moving_consistency
-    << o.use_reprojection << o.use_subbox << o.use_coherent_motion << o.static_history.min_frames << o.survivor_guard
-    << s.tracks_from_keyframe << static_cast<int>(o.depth_mask.missing_depth) << " " << o.depth_mask.eps_m << " "
-    << o.moving.max_epipolar_distance_in_boxes_px << " " << o.reprojection.max_depth_residual_sigmas << " "
-    << o.assign_overlaps_by_depth << " " << o.overlap_high_level_margin_m << " " << o.low_override_by_depth << " "
-    << o.edge_evidence_radius_px << " " << o.subbox.object_mask_votes_only << o.subbox.static_needs_evidence
-    << o.subbox_verifies_candidates << " " << o.min_evidence_frames << o.short_baseline_keeps_last_vote
-    << o.cull_geometric_outside_boxes;
+  t << o.detections.enabled << o.tracker.enabled << o.box_rule.enabled << o.depth_mask.enabled
+    << o.moving_consistency.enabled << o.reprojection.enabled << o.edge_evidence.enabled << o.coherent_motion.enabled
+    << o.subbox.enabled << o.static_history.enabled << o.guard.enabled << s.tracks_from_keyframe
+    << static_cast<int>(o.depth_mask.missing_depth) << " " << o.depth_mask.eps_m << " "
+    << o.moving_consistency.max_epipolar_distance_in_boxes_px << " " << o.reprojection.max_depth_residual_sigmas << " "
+    << o.depth_mask.assign_overlaps_by_depth << " " << o.depth_mask.overlap_high_level_margin_m << " "
+    << o.depth_mask.low_override_by_depth << " " << o.subbox.object_mask_votes_only << o.subbox.static_needs_evidence
+    << o.subbox.verifies_candidates << " " << o.subbox.min_evidence_frames << o.subbox.short_baseline_keeps_last_vote;
   return t.str();
 }
 

@@ -66,23 +66,23 @@ void perturb(fuzz::Input& in, PipelineOptions<T>* o) {
   const int count = in.range(0, 6);
   for (int c = 0; c < count; ++c) {
     switch (in.range(0, 33)) {
-      case 0: o->use_box_tracker = in.flag(); break;
-      case 1: o->use_depth_mask = in.flag(); break;
-      case 2: o->use_probability = in.flag(); break;
-      case 3: o->use_reprojection = in.flag(); break;
-      case 4: o->use_subbox = in.flag(); break;
-      case 5: o->use_multiview = in.flag(); break;
-      case 6: o->use_coherent_motion = in.flag(); break;
+      case 0: o->tracker.enabled = in.flag(); break;
+      case 1: o->depth_mask.enabled = in.flag(); break;
+      case 2: o->probability.enabled = in.flag(); break;
+      case 3: o->reprojection.enabled = in.flag(); break;
+      case 4: o->subbox.enabled = in.flag(); break;
+      case 5: o->multiview.enabled = in.flag(); break;
+      case 6: o->coherent_motion.enabled = in.flag(); break;
       case 7: o->candidates = static_cast<CandidatePolicy>(in.range(0, 3)); break;
       case 8: o->detections.box_padding_px = in.scalar<T>(-200, 200); break;
       case 9: o->detections.min_confidence = in.scalar<T>(-1, 2); break;
-      case 10: o->min_survivor_fraction = in.value(-1, 2); break;
-      case 11: o->min_survivors = in.u32(); break;
-      case 12: o->max_reference_keyframes = in.flag() ? in.u8() : static_cast<std::size_t>(in.u64()); break;
-      case 13: o->edge_evidence_radius_px = static_cast<int>(in.u32()); break;
-      case 14: o->edge_depth_step_ratio = in.value(-1, 1); break;
-      case 15: o->subbox_memory_frames = in.range(-5, 100); break;
-      case 16: o->min_evidence_frames = in.range(-5, 100); break;
+      case 10: o->guard.min_fraction = in.value(-1, 2); break;
+      case 11: o->guard.min_survivors = in.u32(); break;
+      case 12: o->multiview.max_reference_keyframes = in.flag() ? in.u8() : static_cast<std::size_t>(in.u64()); break;
+      case 13: o->edge_evidence.radius_px = static_cast<int>(in.u32()); break;
+      case 14: o->edge_evidence.depth_step_ratio = in.value(-1, 1); break;
+      case 15: o->edge_evidence.enabled = in.flag(); break;
+      case 16: o->subbox.min_evidence_frames = in.range(-5, 100); break;
       case 17: o->depth_mask.histogram_bin_m = in.value(-1, 1); break;
       case 18: o->depth_mask.histogram_max_m = in.value(-1, 1e13); break;
       case 19: o->depth_mask.eps_m = in.value(-1, 5); break;
@@ -93,13 +93,13 @@ void perturb(fuzz::Input& in, PipelineOptions<T>* o) {
       case 24: o->subbox.sigma1 = in.scalar<T>(-1, 2); break;
       case 25: o->multiview.search_radius_px = static_cast<int>(in.u32()); break;
       case 26: o->multiview.depth_threshold_m = in.scalar<T>(-1, 2); break;
-      case 27: o->moving.max_epipolar_distance_px = in.scalar<T>(-1, 10); break;
-      case 28: o->moving.refit_iterations = static_cast<int>(in.u32()); break;
+      case 27: o->moving_consistency.max_epipolar_distance_px = in.scalar<T>(-1, 10); break;
+      case 28: o->moving_consistency.refit_iterations = static_cast<int>(in.u32()); break;
       case 29: o->reprojection.max_residual_px = in.scalar<T>(-1, 10); break;
       case 30: o->tracker.max_missed_frames = in.range(-5, 100); break;
       case 31: o->static_history.min_frames = in.range(-5, 20); break;
-      case 32: o->assign_overlaps_by_depth = in.flag(); break;
-      default: o->low_override_by_depth = in.flag(); break;
+      case 32: o->depth_mask.assign_overlaps_by_depth = in.flag(); break;
+      default: o->depth_mask.low_override_by_depth = in.flag(); break;
     }
   }
 }
@@ -109,7 +109,7 @@ void run(fuzz::Input& in) {
   PipelineOptions<T> options = preset<T>(in.range(0, 6));
   // RANSAC on random tracks runs to its iteration cap (10000 by default, 90 % of the time here): a
   // lower cap gives several times more inputs per second; the sampling loop is not what this checks.
-  for (RansacOptions* ransac : {&options.moving.fundamental.ransac, &options.reprojection.pnp.ransac}) {
+  for (RansacOptions* ransac : {&options.moving_consistency.fundamental.ransac, &options.reprojection.pnp.ransac}) {
     ransac->max_iterations = std::min<std::size_t>(ransac->max_iterations, 200);
     ransac->min_iterations = std::min(ransac->min_iterations, ransac->max_iterations);
   }

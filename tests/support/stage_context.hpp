@@ -199,7 +199,6 @@ Parts parts_of(const detail::PipelineWork<T>& w) {
                    .add(v.coherent_ran)
                    .add(v.coherent_eligible)
                    .add(v.remembered_cells)
-                   .add(v.memory_eligible)
                    .add(v.subbox.status)
                    .add(v.subbox.labels)
                    .add(v.subbox.reasons)

@@ -157,7 +157,7 @@ struct CullerOptions {
   /// its LK tracks: a detector that re-detects every frame matches about half of its keypoints one frame
   /// later (repeatability, and movers the pose-guided search does not find), so at 0.5 nearly every
   /// frame would be a keyframe and the evidence a one-frame baseline, on which the recommended preset
-  /// leaves the decision to the box rule (min_evidence_frames).
+  /// leaves the decision to the box rule (subbox.min_evidence_frames).
   double keyframe_min_matched_ratio = 0.3;
   KeyframeMatchOptions matching{};
   /// Keyframe depth used for its 3-D points: the TUM sensor's reliable range, and no point within
@@ -266,13 +266,14 @@ class Culler {
     const PipelineOptions<T>& p = o.pipeline;
     CullerInputs in;
     in.keypoints = true;
-    const bool tracks = p.use_moving_consistency || p.use_reprojection || p.use_probability || p.use_subbox ||
-                        p.static_history.min_frames > 0;
+    const bool tracks = p.moving_consistency.enabled || p.reprojection.enabled || p.probability.enabled ||
+                        p.subbox.enabled || p.static_history.enabled;
     in.descriptors = tracks;
-    in.depth = p.use_depth_mask || p.use_reprojection || p.use_multiview || p.edge_evidence_radius_px > 0 ||
-               p.low_override_by_depth || p.assign_overlaps_by_depth;
-    in.detections = p.use_box_rule || p.use_depth_mask || p.use_probability || p.use_subbox || p.use_box_tracker;
-    in.pose = p.use_reprojection || p.use_multiview || (tracks && o.keyframe_policy == KeyframePolicy::Own);
+    in.depth = p.depth_mask.enabled || p.reprojection.enabled || p.multiview.enabled || p.edge_evidence.enabled ||
+               p.depth_mask.low_override_by_depth || p.depth_mask.assign_overlaps_by_depth;
+    in.detections =
+        p.box_rule.enabled || p.depth_mask.enabled || p.probability.enabled || p.subbox.enabled || p.tracker.enabled;
+    in.pose = p.reprojection.enabled || p.multiview.enabled || (tracks && o.keyframe_policy == KeyframePolicy::Own);
     return in;
   }
 
@@ -372,7 +373,7 @@ class Culler {
     pf.camera = camera_;
     pf.cam_from_world = have_pose ? &pose : nullptr;
     // Only the multi-view check reads the pipeline's keyframe store; filling it otherwise costs allocations.
-    pf.is_keyframe = new_keyframe && options_.pipeline.use_multiview;
+    pf.is_keyframe = new_keyframe && options_.pipeline.multiview.enabled;
     const PipelineResult<T>* pr = nullptr;
     if (!f.depth_raw.empty()) {
       CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t, std::vector<Vec3<T>>> pu;
@@ -497,7 +498,7 @@ class Culler {
       if (r->missing.descriptors) s += "; no descriptors and no keyframe_match: no tracks, box evidence only";
       if (r->missing.pose) s += "; no predicted pose: the keyframe's pose stands in (no motion prior)";
       if (r->missing.detections) s += "; no detections: the box stages did not run";
-    } else if (!have_pose && have_depth && options_.pipeline.use_reprojection) {
+    } else if (!have_pose && have_depth && options_.pipeline.reprojection.enabled) {
       s = "no predicted pose: the reprojection check did not run";
     }
     if (!have_keyframe_) {

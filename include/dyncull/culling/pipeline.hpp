@@ -49,7 +49,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   detail::score_probability(frame, options, w.regions, w.semantic, w.geometric, &s.track_states, &w.probability, &r);
   detail::vote_regions(frame, options, s.frame_index, w.regions, w.semantic, w.semantic_labels(), w.geometric,
                        &s.subbox_memory, &w.votes, &r);
-  detail::check_against_keyframes(frame, options, w.semantic_labels(), s.keyframes, &w.multiview, &r);
+  detail::check_against_keyframes(frame, options, s.keyframes, &w.multiview, &r);
   detail::combine_evidence(options, w, &r);
   detail::apply_static_history(frame, options, w.geometric, &s.static_history, &w.still_frames, &w.history_kept, &r);
   detail::guard_survivors(options, &r);

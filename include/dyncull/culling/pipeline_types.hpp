@@ -24,7 +24,6 @@
 #include "dyncull/culling/reprojection_check.hpp"
 #include "dyncull/culling/multiview_check.hpp"
 #include "dyncull/culling/static_history.hpp"
-#include "dyncull/culling/subbox_memory.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 #include "dyncull/culling/validation.hpp"
 
@@ -56,164 +55,232 @@ constexpr const char* to_string(GuardAction a) noexcept {
   return "unknown";
 }
 
-/// Which strategies run and their options. presets.hpp builds the papers' configurations.
+/// The detection filter's options (detections.hpp) with its switch.
 template <class T>
-struct PipelineOptions {
-  bool use_detection_filter = true;   ///< padding and class-dependent confidence (detections.hpp)
-  bool use_box_tracker = false;       ///< carry missed boxes forward (Dynamic-VINS)
-  bool use_box_rule = true;           ///< 002 Table 2 / 004 Algorithm 1
-  bool use_depth_mask = false;        ///< 000 eq. 1-2: box culls limited to the object's depth band
-  bool use_probability = false;       ///< 000 eq. 3-5 for features in object masks (needs tracks)
-  bool use_moving_consistency = true; ///< 003 eq. 1-3 (needs tracks)
-  /// RGB-D reprojection check (reprojection_check.hpp; needs CullingFrame::points_3d): its labels join
-  /// the epipolar ones as the geometric evidence (see reprojection_evidence).
-  bool use_reprojection = false;
-  bool use_subbox = true;             ///< 003 Algorithm 1 (needs the moving-consistency labels)
-  bool use_multiview = false;         ///< 001 §III.A (needs the current pose and a keyframe)
+struct DetectionStageOptions : DetectionOptions<T> {
+  bool enabled = true;  ///< padding and class-dependent confidence
+};
 
-  DetectionOptions<T> detections{};
-  BoxTrackerOptions<T> tracker{};
-  MotionLevelTable levels = MotionLevelTable::coco80();
-  BoxRuleOptions<T> box_rule{};
-  DepthMaskOptions depth_mask{};
-  DynamicProbabilityOptions<T> probability{};
-  /// Flow model of the probability's M term: Fundamental reuses the moving-consistency F when it ran.
-  FlowModel probability_flow_model = FlowModel::Fundamental;
-  MovingConsistencyOptions<T> moving{};
-  ReprojectionCheckOptions<T> reprojection{};
-  /// How the reprojection labels combine with the epipolar ones when both ran: Replace (the residual
-  /// sees the motion along the epipolar line too, so it alone decides) or Either (dynamic when either
-  /// check flags the track, static when one says static and the other does not flag it).
-  enum class Evidence { Replace, Either } reprojection_evidence = Evidence::Replace;
-  SubBoxOptions<T> subbox{};
-  MultiViewOptions<T> multiview{};
-  std::size_t max_reference_keyframes = 2;  ///< keyframes checked per frame (DynaSLAM: 5)
+/// The box tracker's options (box_tracker.hpp) with its switch: missed dynamic-class boxes carried
+/// forward (Dynamic-VINS).
+template <class T>
+struct TrackerStageOptions : BoxTrackerOptions<T> {
+  bool enabled = false;
+};
 
-  CandidatePolicy candidates = CandidatePolicy::Verify;
-  /// Epipolar-dynamic features outside every dynamic-class box are culled (DS-SLAM) or only used as
-  /// evidence inside boxes (false: an unexplained flow outlier outside boxes is more often LK error).
-  bool cull_geometric_outside_boxes = true;
-  /// Multi-view-dynamic features are culled wherever they are (DynaSLAM); false: only candidates.
-  bool multiview_overrides_static = true;
-  /// Run the sub-box refinement only when F was fitted on tracks outside the dynamic-class boxes
-  /// (or no track lay inside one). An F fitted through a large mover absorbs its motion (measured in
-  /// docs/algorithms.md), and the refinement would then clear the whole box.
-  bool subbox_requires_fit_outside_boxes = true;
-  /// Medium-level candidates (a chair) are culled by a dynamic sub-box of their region (true), or only
-  /// on their own evidence, their epipolar distance or the multi-view check (false): a chair under a
-  /// seated person or behind a walker otherwise inherits the person's sub-box vote.
-  bool subbox_verifies_candidates = true;
+/// The box rule's options (002 Table 2 / 004 Algorithm 1) with its switch.
+template <class T>
+struct BoxRuleStageOptions : BoxRuleOptions<T> {
+  bool enabled = true;
+};
 
-  /// A feature held by the depth masks of several dynamic-class boxes (a chair in front of a walker,
-  /// a walker passing a chair) belongs to the one whose object depth d_c is nearest its own depth, and
-  /// takes that box's level: a static chair's features are then candidates verified on their own
-  /// evidence instead of inheriting the walker's label and sub-box vote. The same applies to a
-  /// feature in a person's box but only in a chair's mask. false: the box rule's label (highest level
-  /// of the rectangles holding it) stands.
+/// The depth mask (000 eq. 1-2: box culls limited to the object's depth band) with its switch and the
+/// decisions that need the objects' depths.
+struct DepthMaskStageOptions : DepthMaskOptions {
+  bool enabled = false;
+  /// A feature held by the depth masks of several dynamic-class boxes (a chair in front of a walker)
+  /// belongs to the one whose object depth d_c is nearest its own depth, and takes that box's level: a
+  /// static chair's features are then candidates verified on their own evidence instead of inheriting
+  /// the walker's label. false: the box rule's label (highest level of the rectangles holding it) stands.
   bool assign_overlaps_by_depth = false;
   /// With assign_overlaps_by_depth: a high-level object (a person) takes the feature unless another
-  /// object's d_c is nearer its depth by more than this: a seated person's torso and its chair lie at
-  /// nearly the same depth, and the torso's features would go to the chair. 0 = nearest d_c only.
+  /// object's d_c is nearer its depth by more than this (a seated person's torso and its chair lie at
+  /// nearly the same depth). 0 = nearest d_c only.
   double overlap_high_level_margin_m = 0;
   /// A low-level box (a TV) shelters a feature that a dynamic-class object's depth mask holds only when
-  /// the feature's depth is at least as near the low-level object's depth as that object's d_c: a walker
-  /// passing in front of a TV is not on it, and 002/004's rule would keep its features. The low-level
-  /// object's depth is its box's d_c (000's centre sample, re-estimated from the pixels outside a nearer
-  /// box that covers its centre: DepthMaskOptions::occluded_centre_search); without a depth there the
-  /// shelter stands. Needs the depth mask.
+  /// the feature's depth is at least as near the low-level object's d_c (re-estimated outside a nearer box
+  /// covering its centre: occluded_centre_search) as the object's: a walker passing in front of a TV is
+  /// not on it. Without a depth there the shelter stands.
   bool low_override_by_depth = false;
-  /// Sub-box memory (subbox_memory.hpp): a sub-box its own features voted dynamic stays dynamic for this
-  /// many frames in the same tracked box, for the tracks flagged in that time or younger than it. 0 = off.
-  /// Needs the box tracker (use_box_tracker) and CullingFrame::track_ids; without them the stage report
-  /// says so and the vote is this frame's only.
-  int subbox_memory_frames = 0;
-  /// An epipolar flag of a feature with a depth step above edge_depth_step_ratio within this many
-  /// pixels (sampled every 2 px) is not evidence (its moving-consistency label becomes Candidate): an LK
-  /// window straddling an occlusion edge follows the contour, not a 3-D point, and is flagged although
-  /// its surface is static. 0 = off. Needs the depth image.
-  int edge_evidence_radius_px = 0;
-  double edge_depth_step_ratio = 0.05;
 
-  /// Shortest baseline, in frames (CullingFrame::evidence_frames), at which the geometric labels may make
-  /// part of a dynamic-class box static through the sub-box vote. Over fewer frames a slow mover has not
-  /// moved past the thresholds (a walker at 0.4 m/s covers 13 mm a frame, at 2.5 m about 2.8 px sideways
-  /// and nothing along the ray), so "not flagged" says nothing: the sub-box refinement is skipped and the
-  /// box rule decides (high-level objects culled, candidates on their own flags). A front end that
-  /// measures against its keyframe has such frames right after each keyframe, when its corners on the
-  /// movers are new. 0 = off; frames with evidence_frames 0 (unknown) are never affected.
+  /// DepthMaskOptions::validate, then overlap_high_level_margin_m finite and in [0, 1e4] m.
+  Status validate(std::string* reason = nullptr) const {
+    if (DepthMaskOptions::validate(reason) != Status::Ok) return Status::InvalidInput;
+    if (!detail::finite_in(overlap_high_level_margin_m, 0, 1e4))
+      return detail::invalid_option(reason, "overlap_high_level_margin_m", "must be finite and in [0, 1e4] m");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// The dynamic probability (000 eq. 3-5, features in object masks; needs tracks) with its switch.
+template <class T>
+struct ProbabilityStageOptions : DynamicProbabilityOptions<T> {
+  bool enabled = false;
+  /// Flow model of the M term: Fundamental reuses the moving-consistency F when it ran (000: MeanFlow).
+  FlowModel flow_model = FlowModel::Fundamental;
+
+  /// DynamicProbabilityOptions::validate, then flow_model in range.
+  Status validate(std::string* reason = nullptr) const {
+    if (DynamicProbabilityOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
+    if (static_cast<int>(flow_model) > 2)
+      return detail::invalid_option(reason, "flow_model", "must be MeanFlow, Fundamental or Homography");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// The epipolar moving-consistency check (003 eq. 1-3; needs tracks) with its switch.
+template <class T>
+struct MovingConsistencyStageOptions : MovingConsistencyOptions<T> {
+  bool enabled = true;
+};
+
+/// The RGB-D reprojection check (reprojection_check.hpp; needs CullingFrame::points_3d) with its switch.
+/// Where it runs its labels replace the epipolar ones: the residual also sees the motion along the
+/// epipolar line.
+template <class T>
+struct ReprojectionStageOptions : ReprojectionCheckOptions<T> {
+  bool enabled = false;
+};
+
+/// Geometric flags on occlusion edges discounted (needs the depth image): an LK window straddling an
+/// occlusion edge follows the contour, not a 3-D point, and is flagged although its surface is static.
+/// A flag with a depth step above depth_step_ratio within radius_px (sampled every 2 px) becomes Candidate.
+struct EdgeEvidenceOptions {
+  bool enabled = false;
+  int radius_px = 8;
+  double depth_step_ratio = 0.05;
+
+  static constexpr int kMaxRadiusPx = 64;
+
+  /// InvalidInput naming the first field out of its range: radius_px in [1, 64], depth_step_ratio finite
+  /// and >= 0.
+  Status validate(std::string* reason = nullptr) const {
+    if (radius_px < 1 || radius_px > kMaxRadiusPx)
+      return detail::invalid_option(reason, "radius_px", "must be in [1, 64]");
+    if (!detail::finite_in(depth_step_ratio, 0, 1e30))
+      return detail::invalid_option(reason, "depth_step_ratio", "must be finite and >= 0");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// The sub-box refinement (003 Algorithm 1; needs the geometric labels) with its switch and when its
+/// vote is trusted.
+template <class T>
+struct SubBoxStageOptions : SubBoxOptions<T> {
+  bool enabled = true;
+  /// Vote only when F (or the pose) was fitted on tracks outside the dynamic-class boxes, or no track lay
+  /// inside one: a model fitted through a large mover absorbs its motion, and the vote would clear the box.
+  bool requires_fit_outside_boxes = true;
+  /// Medium-level candidates (a chair) are culled by a dynamic sub-box of their region (true), or only on
+  /// their own evidence (false): a chair under a seated person otherwise inherits the person's vote.
+  bool verifies_candidates = true;
+  /// Shortest baseline, in frames (CullingFrame::evidence_frames), at which "not flagged" may make part of
+  /// a dynamic-class box static: over fewer frames a slow mover has not moved past the thresholds, so the
+  /// vote is skipped and the box rule decides. 0 = no minimum; evidence_frames 0 (unknown) always votes.
   int min_evidence_frames = 0;
-  /// With min_evidence_frames: in a frame whose baseline is too short, the cells of a tracked box (box
-  /// tracker) keep the states of its last vote within min_evidence_frames frames, where there was one:
-  /// static where none of that cell's features was flagged (a seated person's still legs), dynamic where
-  /// it voted dynamic; the box rule decides elsewhere and in boxes without such a vote (a walker just
-  /// come into view). Needs the box tracker; without it the box rule decides.
+  /// With min_evidence_frames: on too short a baseline, the cells of a tracked box keep the states of its
+  /// last vote within min_evidence_frames frames (a seated person's still legs stay static); the box rule
+  /// decides elsewhere. Needs the box tracker.
   bool short_baseline_keeps_last_vote = false;
-  /// Cell-level evidence before the sub-box vote (coherent_motion.hpp): in a cell of a high-level object
-  /// (features the box rule labelled Dynamic; candidates such as chairs stay on their own evidence) whose
-  /// features' reprojection residuals share a significant median, every feature counts as flagged, so the
-  /// vote culls a seated person's sway that no single residual shows. Needs the reprojection check; runs
-  /// with the sub-box refinement, on its grid.
-  bool use_coherent_motion = false;
-  CoherentMotionOptions<T> coherent_motion{};
-  /// Track history (static_history.hpp; off while min_frames is 0): a feature culled only for the region it
-  /// lies in (its box, its medium-level box, a tracked box or its sub-box) stays static when the reprojection
-  /// check said Static with a residual below max_residual_px in each of its last min_frames evaluated frames
-  /// (baseline of at least min_evidence_frames, or unknown) and does not flag it now. Needs
-  /// CullingFrame::track_ids and the reprojection check.
-  StaticHistoryOptions<T> static_history{};
 
-  /// Minimum-survivor guard: if fewer than max(min_survivor_fraction * n, min_survivors) features stay
-  /// static, first soften (restore the culls of single geometric stages and of candidates), then undo
-  /// all culling. ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
-  bool survivor_guard = true;
-  double min_survivor_fraction = 0.10;
+  /// SubBoxOptions::validate, then min_evidence_frames in [0, 65535].
+  Status validate(std::string* reason = nullptr) const {
+    if (SubBoxOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
+    if (min_evidence_frames < 0 || min_evidence_frames > 0xFFFF)
+      return detail::invalid_option(reason, "min_evidence_frames", "must be in [0, 65535]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// Cell-level coherent motion before the sub-box vote (coherent_motion.hpp; needs the reprojection
+/// check, runs with the sub-box refinement on its grid) with its switch: in a cell of a high-level object
+/// whose residuals share a significant median every feature counts as flagged (a seated person's sway).
+template <class T>
+struct CoherentMotionStageOptions : CoherentMotionOptions<T> {
+  bool enabled = false;
+};
+
+/// A track's static history (static_history.hpp; needs CullingFrame::track_ids and the reprojection
+/// check) with its switch: a feature culled only for its region stays static when its own check said
+/// still in each of its last min_frames evaluated frames and does not flag it now.
+template <class T>
+struct StaticHistoryStageOptions : StaticHistoryOptions<T> {
+  bool enabled = false;
+};
+
+/// The multi-view check (001 §III.A after DynaSLAM; needs the current pose, depth and a keyframe) with
+/// its switch. Its flags cull wherever they are (DynaSLAM).
+template <class T>
+struct MultiViewStageOptions : MultiViewOptions<T> {
+  bool enabled = false;
+  std::size_t max_reference_keyframes = 2;  ///< keyframes checked per frame (DynaSLAM: 5)
+
+  static constexpr std::size_t kMaxReferenceKeyframes = 64;
+
+  /// MultiViewOptions::validate, then max_reference_keyframes in [1, 64].
+  Status validate(std::string* reason = nullptr) const {
+    if (MultiViewOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
+    if (max_reference_keyframes > kMaxReferenceKeyframes)
+      return detail::invalid_option(reason, "max_reference_keyframes", "must be at most 64");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// Minimum-survivor guard: if fewer than max(min_fraction * n, min_survivors) features stay static, first
+/// soften (restore the culls of single geometric stages and of candidates), then undo all culling.
+/// ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
+struct SurvivorGuardOptions {
+  bool enabled = true;
+  double min_fraction = 0.10;
   std::size_t min_survivors = 30;
 
-  static constexpr std::size_t kMaxReferenceKeyframes = 64;  ///< upper bound of max_reference_keyframes
-  static constexpr int kMaxEdgeEvidenceRadiusPx = 64;        ///< upper bound of edge_evidence_radius_px
-
-  /// InvalidInput naming the first field out of its range, nested fields as "depth_mask.histogram_bin_m":
-  /// every nested options struct that has a validate() passes it (whether its stage is on or not);
-  /// enums in range; max_reference_keyframes <= kMaxReferenceKeyframes; edge_evidence_radius_px in
-  /// [0, kMaxEdgeEvidenceRadiusPx]; edge_depth_step_ratio and overlap_high_level_margin_m finite and >= 0;
-  /// subbox_memory_frames and min_evidence_frames in [0, 65535]; min_survivor_fraction in [0, 1].
+  /// InvalidInput unless min_fraction is in [0, 1].
   Status validate(std::string* reason = nullptr) const {
-    using detail::finite_in;
-    using detail::invalid_option;
+    if (!detail::finite_in(min_fraction, 0, 1))
+      return detail::invalid_option(reason, "min_fraction", "must be in [0, 1]");
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
+};
+
+/// Which stages run and their options, in front-end order; each stage's `enabled` is its one switch.
+/// presets.hpp builds the papers' configurations.
+template <class T>
+struct PipelineOptions {
+  DetectionStageOptions<T> detections{};
+  TrackerStageOptions<T> tracker{};
+  MotionLevelTable levels = MotionLevelTable::coco80();
+  BoxRuleStageOptions<T> box_rule{};
+  DepthMaskStageOptions depth_mask{};
+  ProbabilityStageOptions<T> probability{};
+  MovingConsistencyStageOptions<T> moving_consistency{};
+  ReprojectionStageOptions<T> reprojection{};
+  EdgeEvidenceOptions edge_evidence{};
+  CoherentMotionStageOptions<T> coherent_motion{};
+  SubBoxStageOptions<T> subbox{};
+  StaticHistoryStageOptions<T> static_history{};
+  MultiViewStageOptions<T> multiview{};
+  /// What happens to the features still labelled Candidate (medium-level boxes) at the end.
+  CandidatePolicy candidates = CandidatePolicy::Verify;
+  SurvivorGuardOptions guard{};
+
+  /// InvalidInput naming the first field out of its range, nested fields as "subbox.min_evidence_frames":
+  /// every stage's options pass their validate() whether the stage is on or not; candidates in range.
+  Status validate(std::string* reason = nullptr) const {
     using detail::validate_nested;
-    // Nested structs first, in stage order; the first failure's reason stands.
+    // Stages in order; the first failure's reason stands.
     if (validate_nested(detections, "detections", reason) != Status::Ok ||
         validate_nested(tracker, "tracker", reason) != Status::Ok ||
         validate_nested(levels, "levels", reason) != Status::Ok ||
         validate_nested(box_rule, "box_rule", reason) != Status::Ok ||
         validate_nested(depth_mask, "depth_mask", reason) != Status::Ok ||
         validate_nested(probability, "probability", reason) != Status::Ok ||
-        validate_nested(moving, "moving", reason) != Status::Ok ||
+        validate_nested(moving_consistency, "moving_consistency", reason) != Status::Ok ||
         validate_nested(reprojection, "reprojection", reason) != Status::Ok ||
-        validate_nested(subbox, "subbox", reason) != Status::Ok ||
-        validate_nested(multiview, "multiview", reason) != Status::Ok ||
+        validate_nested(edge_evidence, "edge_evidence", reason) != Status::Ok ||
         validate_nested(coherent_motion, "coherent_motion", reason) != Status::Ok ||
-        validate_nested(static_history, "static_history", reason) != Status::Ok)
+        validate_nested(subbox, "subbox", reason) != Status::Ok ||
+        validate_nested(static_history, "static_history", reason) != Status::Ok ||
+        validate_nested(multiview, "multiview", reason) != Status::Ok ||
+        validate_nested(guard, "guard", reason) != Status::Ok)
       return Status::InvalidInput;
-    if (static_cast<int>(probability_flow_model) > 2)
-      return invalid_option(reason, "probability_flow_model", "must be MeanFlow, Fundamental or Homography");
-    if (static_cast<int>(reprojection_evidence) > 1)
-      return invalid_option(reason, "reprojection_evidence", "must be Replace or Either");
-    if (static_cast<int>(candidates) > 2) return invalid_option(reason, "candidates", "must be Keep, Cull or Verify");
-    if (max_reference_keyframes > kMaxReferenceKeyframes)
-      return invalid_option(reason, "max_reference_keyframes", "must be at most 64");
-    if (!finite_in(overlap_high_level_margin_m, 0, 1e4))
-      return invalid_option(reason, "overlap_high_level_margin_m", "must be finite and in [0, 1e4] m");
-    if (subbox_memory_frames < 0 || subbox_memory_frames > 0xFFFF)
-      return invalid_option(reason, "subbox_memory_frames", "must be in [0, 65535]");
-    if (edge_evidence_radius_px < 0 || edge_evidence_radius_px > kMaxEdgeEvidenceRadiusPx)
-      return invalid_option(reason, "edge_evidence_radius_px", "must be in [0, 64]");
-    if (!finite_in(edge_depth_step_ratio, 0, 1e30))
-      return invalid_option(reason, "edge_depth_step_ratio", "must be finite and >= 0");
-    if (min_evidence_frames < 0 || min_evidence_frames > 0xFFFF)
-      return invalid_option(reason, "min_evidence_frames", "must be in [0, 65535]");
-    if (!finite_in(min_survivor_fraction, 0, 1))
-      return invalid_option(reason, "min_survivor_fraction", "must be in [0, 1]");
+    if (static_cast<int>(candidates) > 2)
+      return detail::invalid_option(reason, "candidates", "must be Keep, Cull or Verify");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -286,7 +353,7 @@ struct CullingFrame {
   const Rigid3<T>* cam_from_world = nullptr;  ///< current pose (a motion-model prediction is enough)
   bool is_keyframe = false;  ///< store this frame's static features with depth as a multi-view reference
   /// Frames between the reference of prev_keypoints / points_3d and this frame (1: the previous frame;
-  /// a keyframe-based front end: frames since its keyframe); 0 = unknown. See min_evidence_frames.
+  /// a keyframe-based front end: frames since its keyframe); 0 = unknown. See SubBoxStageOptions::min_evidence_frames.
   int evidence_frames = 0;
 };
 

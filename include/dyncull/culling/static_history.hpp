@@ -23,17 +23,18 @@ namespace dyncull {
 template <class T>
 struct StaticHistoryOptions {
   /// Evaluated frames in a row, up to and including the current one, in which the track's own check said
-  /// Static with a residual below max_residual_px. 0 = off. A seated person's still legs share DFD-SLAM's cells
+  /// Static with a residual below max_residual_px. A seated person's still legs share DFD-SLAM's cells
   /// with its swaying upper body: one frame's residual does not separate the two (the sway pauses, so a
   /// moving track is often under any per-frame threshold), a few frames in a row mostly do.
-  int min_frames = 0;
+  int min_frames = 6;
   /// Residual (px) a frame must stay below to count; above it, or flagged, the count restarts at 0.
   T max_residual_px = T(0.8);
 
-  /// InvalidInput naming the first field out of its range: min_frames in [0, 65535] (the counts are
+  /// InvalidInput naming the first field out of its range: min_frames in [1, 65535] (the counts are
   /// 16-bit), max_residual_px finite and >= 0.
   Status validate(std::string* reason = nullptr) const {
-    if (min_frames < 0 || min_frames > 0xFFFF) return detail::invalid_option(reason, "min_frames", "must be in [0, 65535]");
+    if (min_frames < 1 || min_frames > 0xFFFF)
+      return detail::invalid_option(reason, "min_frames", "must be in [1, 65535]");
     if (!detail::finite_in(max_residual_px, 0, 1e30))
       return detail::invalid_option(reason, "max_residual_px", "must be finite and >= 0");
     if (reason) reason->clear();

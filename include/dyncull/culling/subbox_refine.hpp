@@ -183,16 +183,13 @@ bool subbox_options_valid(const SubBoxOptions<T>& options, SubBoxResult<T>* r) {
   return false;
 }
 
-/// The per-feature views hold n entries and the per-cell one `cells` entries (those given); else
-/// InvalidInput into the result started by subbox_begin, naming the view and both sizes (nothing read).
+/// The per-feature views hold n entries (those given); else InvalidInput into the result started by
+/// subbox_begin, naming the view and both sizes (nothing read).
 template <class T>
-bool subbox_inputs_fit(std::size_t n, std::size_t cells, FlagView in_object_mask, BoxBitsView object_box_bits,
-                       FlagView extra_dynamic_cells, FlagView extra_eligible, SubBoxResult<T>* r) {
+bool subbox_inputs_fit(std::size_t n, FlagView in_object_mask, BoxBitsView object_box_bits, SubBoxResult<T>* r) {
   std::string why;
   if (flags_fit(in_object_mask, n, "in_object_mask", "points", &why) &&
-      flags_fit(object_box_bits, n, "object_box_bits", "points", &why) &&
-      flags_fit(extra_dynamic_cells, cells, "extra_dynamic_cells", "cells (boxes x grid x grid)", &why) &&
-      flags_fit(extra_eligible, n, "extra_eligible", "points", &why))
+      flags_fit(object_box_bits, n, "object_box_bits", "points", &why))
     return true;
   r->status = Status::InvalidInput;
   r->reason = why;
@@ -235,7 +232,7 @@ std::size_t subbox_buffers(SubBoxResult<T>* out, std::size_t nb, int grid) {
 template <class T, class Points, class Boxes>
 void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                            const SubBoxOptions<T>& options, SubBoxResult<T>* out, FlagView in_object_mask,
-                           BoxBitsView object_box_bits, FlagView extra_dynamic_cells, FlagView extra_eligible) {
+                           BoxBitsView object_box_bits) {
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
@@ -251,9 +248,7 @@ void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometr
       if (c < 0) continue;
       in_box = true;
       const std::size_t cell = b * cells_per_box + static_cast<std::size_t>(c);
-      const bool extra =
-          extra_dynamic_cells.given && extra_dynamic_cells[cell] && (!extra_eligible.given || extra_eligible[i]);
-      in_dynamic = (r.cells[cell] != 0 || extra) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
+      in_dynamic = r.cells[cell] != 0 && detail::subbox_in_object(in_object_mask, object_box_bits, i, b);
     }
     const bool geo_dyn = geometric[i] == FeatureLabel::Dynamic;
     if (!std::isfinite(x) || !std::isfinite(y)) {
@@ -284,17 +279,12 @@ void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometr
 /// object_box_bits: optional per-feature bit set (bit b: in box b's own object mask, as
 /// DepthMaskResult::box_bits): box b then acts only on its own object's features, so a chair that a
 /// walker's box overlaps is not culled by the walker's sub-box (boxes from the 33rd on use in_object_mask).
-/// extra_dynamic_cells: optional per box grid*grid flags (box-major, as SubBoxResult::cells) of cells that
-/// are dynamic besides this frame's vote (remembered from earlier frames, subbox_memory.hpp); they take no
-/// part in merging or in the whole-box count and act only on the features with extra_eligible[i] != 0
-/// (not given: on all), inside the object mask as the voted cells. Options failing SubBoxOptions::validate,
-/// or a given view whose size is not points.size() (boxes.size() * grid * grid for extra_dynamic_cells),
-/// give InvalidInput (every feature Static, the view and both sizes named).
+/// Options failing SubBoxOptions::validate, or a given view whose size is not points.size(), give
+/// InvalidInput (every feature Static, the view and both sizes named).
 template <class T, class Points, class Boxes>
 void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
-                     FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
-                     FlagView extra_dynamic_cells = nullptr, FlagView extra_eligible = nullptr) {
+                     FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::refine_subboxes: points must hold points (see PointTraits)");
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -302,9 +292,8 @@ void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, co
   const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
-  const std::size_t cells = nb * static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
   if (!detail::subbox_geometric_fits(geometric, n, &r) ||
-      !detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, extra_dynamic_cells, extra_eligible, &r))
+      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r))
     return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
 
@@ -380,8 +369,7 @@ void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, co
       }
   }
 
-  detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits,
-                                extra_dynamic_cells, extra_eligible);
+  detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
 }
 
@@ -424,7 +412,7 @@ void apply_subbox_states(const Points& points, ArrayView<FeatureLabel> geometric
     return;
   }
   if (!detail::subbox_geometric_fits(geometric, n, &r) ||
-      !detail::subbox_inputs_fit(n, cells, in_object_mask, object_box_bits, nullptr, nullptr, &r))
+      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r))
     return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
   for (std::size_t b = 0; b < nb; ++b) {
@@ -437,8 +425,7 @@ void apply_subbox_states(const Points& points, ArrayView<FeatureLabel> geometric
       r.votes[b].num_dynamic_cells += r.cells[b * cells_per_box + c];
     }
   }
-  detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits, nullptr,
-                                nullptr);
+  detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
 }
 

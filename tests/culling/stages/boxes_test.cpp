@@ -72,7 +72,7 @@ TYPED_TEST(BoxesStageTest, TrackerCarriesMissedDynamicBoxesGrownAndKeepsTheirIds
   using T = TypeParam;
   auto f = living_room<T>();
   PipelineOptions<T> o;
-  o.use_box_tracker = true;  // grows a carried box by 10 px a frame, keeps it 2 frames
+  o.tracker.enabled = true;  // grows a carried box by 10 px a frame, keeps it 2 frames
   BoxTracker<T> tracker;
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());
@@ -130,7 +130,7 @@ TYPED_TEST(BoxesStageTest, DisabledFilterPassesTheBoxesAsDrawn) {
   using T = TypeParam;
   const auto f = living_room<T>();
   PipelineOptions<T> o;
-  o.use_detection_filter = false;
+  o.detections.enabled = false;
   BoxTracker<T> tracker;
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());

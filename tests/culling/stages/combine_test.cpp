@@ -58,16 +58,16 @@ PipelineResult<T> combined(const PipelineOptions<T>& o, const detail::PipelineWo
 TYPED_TEST(CombineStageTest, EvidenceCombinesInOrderAndTheReasonNamesTheDecidingStage) {
   using T = TypeParam;
   const auto w = evidence<T>();
-  const PipelineOptions<T> o;  // Verify candidates, cull geometric flags outside boxes
+  const PipelineOptions<T> o;  // Verify candidates
   PipelineResult<T> r = test::fresh_result(o, 8);
   const auto work_before = test::parts_of(w);
   const auto result_before = test::parts_of(r);
   detail::combine_evidence(o, w, &r);
   // 2: a candidate flagged by the epipolar check; 3: a candidate without a flag (Verify: static);
-  // 4: flagged outside every box, by the reprojection check; 5: sheltered by a low-level box.
-  EXPECT_EQ(r.labels, (std::vector<L>{L::Static, L::Dynamic, L::Dynamic, L::Static, L::Dynamic, L::Static, L::Dynamic,
+  // 4: flagged outside every box (a flag alone culls nothing there); 5: sheltered by a low-level box.
+  EXPECT_EQ(r.labels, (std::vector<L>{L::Static, L::Dynamic, L::Dynamic, L::Static, L::Static, L::Static, L::Dynamic,
                                       L::Dynamic}));
-  EXPECT_EQ(r.reasons, (std::vector<R>{R::None, R::HighLevelBox, R::Epipolar, R::None, R::Reprojection, R::None,
+  EXPECT_EQ(r.reasons, (std::vector<R>{R::None, R::HighLevelBox, R::Epipolar, R::None, R::None, R::None,
                                        R::InvalidInput, R::DepthMask}));
   test::expect_only_changed(work_before, test::parts_of(w), {});
   test::expect_only_changed(result_before, test::parts_of(r), {"frame"});
@@ -90,30 +90,24 @@ TYPED_TEST(CombineStageTest, CandidatePolicyDecidesTheUnflaggedCandidate) {
   EXPECT_EQ(r.reasons[2], R::Epipolar);
 }
 
-TYPED_TEST(CombineStageTest, GeometricFlagsOutsideBoxesCullOnlyWhenAsked) {
+TYPED_TEST(CombineStageTest, GeometricFlagsOutsideBoxesAloneCullNothing) {
   using T = TypeParam;
   const auto w = evidence<T>();
-  PipelineOptions<T> o;
-  o.cull_geometric_outside_boxes = false;
+  const PipelineOptions<T> o;
   const auto r = combined(o, w);
   EXPECT_EQ(r.labels[4], L::Static);
   EXPECT_EQ(r.labels[2], L::Dynamic);  // a candidate's own flag is still evidence
 }
 
-TYPED_TEST(CombineStageTest, MultiViewFlagsCullCandidatesAndStaticsAsConfigured) {
+TYPED_TEST(CombineStageTest, MultiViewFlagsCullCandidatesAndStatics) {
   using T = TypeParam;
   auto w = evidence<T>();
   w.multiview.ok = true;
   w.multiview.dynamic[0] = w.multiview.dynamic[3] = 1;
-  PipelineOptions<T> o;  // multiview_overrides_static
-  auto r = combined(o, w);
+  const PipelineOptions<T> o;
+  const auto r = combined(o, w);
   EXPECT_EQ(r.labels[0], L::Dynamic);
   EXPECT_EQ(r.reasons[0], R::MultiView);
-  EXPECT_EQ(r.labels[3], L::Dynamic);
-  EXPECT_EQ(r.reasons[3], R::MultiView);
-  o.multiview_overrides_static = false;
-  r = combined(o, w);
-  EXPECT_EQ(r.labels[0], L::Static);
   EXPECT_EQ(r.labels[3], L::Dynamic);
   EXPECT_EQ(r.reasons[3], R::MultiView);
 }
@@ -121,9 +115,9 @@ TYPED_TEST(CombineStageTest, MultiViewFlagsCullCandidatesAndStaticsAsConfigured)
 /// Five features in a person's box (0-3) or outside it (4), with a sub-box vote:
 ///   0 semantic Dynamic, in a dynamic sub-box, no flag         -> SubBox
 ///   1 semantic Dynamic, in a static sub-box                    -> refined to static
-///   2 semantic Candidate (a chair), in a dynamic sub-box       -> SubBox (subbox_verifies_candidates)
+///   2 semantic Candidate (a chair), in a dynamic sub-box       -> SubBox (subbox.verifies_candidates)
 ///   3 semantic Dynamic, in a dynamic sub-box, coherent flag    -> CoherentMotion
-///   4 outside, flagged by the epipolar check                   -> Epipolar
+///   4 outside, flagged by the epipolar check                   -> static (a flag alone culls nothing there)
 template <class T>
 detail::PipelineWork<T> voted() {
   detail::PipelineWork<T> w;
@@ -149,10 +143,10 @@ TYPED_TEST(CombineStageTest, SubBoxVoteDecidesInsideTheBoxAndNamesCoherentMotion
   const auto w = voted<T>();
   PipelineOptions<T> o;
   auto r = combined(o, w);
-  EXPECT_EQ(r.labels, (std::vector<L>{L::Dynamic, L::Static, L::Dynamic, L::Dynamic, L::Dynamic}));
-  EXPECT_EQ(r.reasons, (std::vector<R>{R::SubBox, R::None, R::SubBox, R::CoherentMotion, R::Epipolar}));
+  EXPECT_EQ(r.labels, (std::vector<L>{L::Dynamic, L::Static, L::Dynamic, L::Dynamic, L::Static}));
+  EXPECT_EQ(r.reasons, (std::vector<R>{R::SubBox, R::None, R::SubBox, R::CoherentMotion, R::None}));
   // A candidate left to its own evidence: not flagged itself, so Verify keeps it.
-  o.subbox_verifies_candidates = false;
+  o.subbox.verifies_candidates = false;
   r = combined(o, w);
   EXPECT_EQ(r.labels[2], L::Static);
   EXPECT_EQ(r.reasons[2], R::None);
@@ -161,7 +155,8 @@ TYPED_TEST(CombineStageTest, SubBoxVoteDecidesInsideTheBoxAndNamesCoherentMotion
 TYPED_TEST(CombineStageTest, StaticHistoryKeepsATrackStillOverItsLastFramesAgainstItsRegion) {
   using T = TypeParam;
   PipelineOptions<T> o;
-  o.use_reprojection = true;
+  o.reprojection.enabled = true;
+  o.static_history.enabled = true;
   o.static_history.min_frames = 2;  // residual below max_residual_px in each of the last 2 frames
   test::StageFrame<T> f(64, 48);
   for (int i = 0; i < 3; ++i) f.add(T(10 + 10 * i), T(10));

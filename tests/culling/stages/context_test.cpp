@@ -94,12 +94,12 @@ TYPED_TEST(ContextTest, EveryStageReusesItsBuffersOnTheNextFrame) {
   auto frame = test::frame_of(s, dets);
   frame.points_3d = &s.prev_points_world;
   PipelineOptions<T> o;
-  o.use_box_tracker = true;
-  o.use_depth_mask = true;
-  o.use_probability = true;
-  o.use_reprojection = true;
-  o.use_coherent_motion = true;
-  o.use_multiview = true;
+  o.tracker.enabled = true;
+  o.depth_mask.enabled = true;
+  o.probability.enabled = true;
+  o.reprojection.enabled = true;
+  o.coherent_motion.enabled = true;
+  o.multiview.enabled = true;
   PipelineState<T> state;
   const auto kf = test::make_scene_keyframe<T>(config, 8, 600);
   state.keyframes.push(kf.cam_from_world, kf.keypoints, kf.depth_m);
@@ -115,7 +115,7 @@ TYPED_TEST(ContextTest, EveryStageReusesItsBuffersOnTheNextFrame) {
     detail::score_probability(frame, o, w.regions, w.semantic, w.geometric, &state.track_states, &w.probability, &r);
     detail::vote_regions(frame, o, 1, w.regions, w.semantic, w.semantic_labels(), w.geometric, &state.subbox_memory,
                          &w.votes, &r);
-    detail::check_against_keyframes(frame, o, w.semantic_labels(), state.keyframes, &w.multiview, &r);
+    detail::check_against_keyframes(frame, o, state.keyframes, &w.multiview, &r);
     detail::combine_evidence(o, w, &r);
     detail::apply_static_history(frame, o, w.geometric, &state.static_history, &w.still_frames, &w.history_kept, &r);
     detail::guard_survivors(o, &r);

@@ -80,7 +80,7 @@ TYPED_TEST(GeometricStageTest, ReprojectionLabelsReplaceTheEpipolarOnesAndNameTh
   using T = TypeParam;
   const auto f = moving_tracks<T>();
   PipelineOptions<T> o;
-  o.use_reprojection = true;  // Replace: the residual decides where it labelled the track
+  o.reprojection.enabled = true;  // Replace: the residual decides where it labelled the track
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());
   const auto work_before = test::parts_of(w);
@@ -101,8 +101,8 @@ TYPED_TEST(GeometricStageTest, ReprojectionAloneIsTheEvidenceWhenTheEpipolarChec
   using T = TypeParam;
   const auto f = moving_tracks<T>();
   PipelineOptions<T> o;
-  o.use_moving_consistency = false;
-  o.use_reprojection = true;
+  o.moving_consistency.enabled = false;
+  o.reprojection.enabled = true;
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::gather_geometric_evidence(f.frame(), o, w.regions, w.semantic, &w.geometric, &r);
@@ -123,7 +123,8 @@ TYPED_TEST(GeometricStageTest, FlagOnADepthEdgeIsNotEvidence) {
   f.fill_depth(4.f);
   f.paint_depth(u3 + 2, v3 - 3, u3 + 10, v3 + 4, 1.f);
   PipelineOptions<T> o;
-  o.edge_evidence_radius_px = 4;  // edge_depth_step_ratio 0.05
+  o.edge_evidence.enabled = true;
+  o.edge_evidence.radius_px = 4;  // depth_step_ratio 0.05
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::gather_geometric_evidence(f.frame(), o, w.regions, w.semantic, &w.geometric, &r);
@@ -141,7 +142,7 @@ TYPED_TEST(GeometricStageTest, WithoutTracksOrPointsEachCheckSaysWhatItLacked) {
   f.with_tracks = false;
   f.points_3d.clear();
   PipelineOptions<T> o;
-  o.use_reprojection = true;
+  o.reprojection.enabled = true;
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::gather_geometric_evidence(f.frame(), o, w.regions, w.semantic, &w.geometric, &r);

@@ -36,10 +36,10 @@ TYPED_TEST(InputsStageTest, BeginFrameResetsEveryReportAndEnablesItFromTheOption
   r.history_kept = 2;
   r.unsheltered = 1;
   PipelineOptions<T> o;
-  o.use_box_tracker = true;
-  o.use_subbox = false;
-  o.use_multiview = true;
-  o.static_history.min_frames = 3;
+  o.tracker.enabled = true;
+  o.subbox.enabled = false;
+  o.multiview.enabled = true;
+  o.static_history.enabled = true;
   detail::begin_frame(o, &r);
 
   EXPECT_EQ(r.status, Status::Ok);
@@ -131,10 +131,10 @@ TYPED_TEST(InputsStageTest, InvalidOptionsOrDepthRefuseTheFrameNamingTheField) {
   using T = TypeParam;
   auto f = five_features<T>();
   PipelineOptions<T> o;
-  o.min_survivor_fraction = 2;
+  o.guard.min_fraction = 2;
   PipelineResult<T> r;
   EXPECT_FALSE(accept(f, o, &r));
-  expect_refused(r, 5, "invalid options: min_survivor_fraction");
+  expect_refused(r, 5, "invalid options: guard.min_fraction");
 
   const PipelineOptions<T> valid;
   auto frame = f.frame();

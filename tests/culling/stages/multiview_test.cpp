@@ -28,7 +28,6 @@ template <class T>
 struct KeyframeScene {
   test::StageFrame<T> f{64, 48};
   KeyframeRing<T> keyframes{4};
-  std::vector<FeatureLabel> semantic;
   KeyframeScene() {
     f.fill_depth(2.f);
     f.paint_depth(20, 10, 40, 30, 1.f);
@@ -36,17 +35,16 @@ struct KeyframeScene {
     const std::vector<Vec2<T>> points{Vec2<T>(T(30), T(20)), Vec2<T>(T(50), T(40)), Vec2<T>(T(10), T(40))};
     const std::vector<T> depths(3, T(2));
     EXPECT_EQ(keyframes.push(f.cam_from_world, points, depths), Status::Ok);
-    semantic.assign(f.size(), FeatureLabel::Static);
   }
   void check(const PipelineOptions<T>& o, detail::PipelineWork<T>* w, PipelineResult<T>* r) const {
-    detail::check_against_keyframes(f.frame(), o, semantic, keyframes, &w->multiview, r);
+    detail::check_against_keyframes(f.frame(), o, keyframes, &w->multiview, r);
   }
 };
 
 template <class T>
 PipelineOptions<T> multiview_on() {
   PipelineOptions<T> o;
-  o.use_multiview = true;  // tau_d 0.4 m, region growing within 0.2 m of the seed
+  o.multiview.enabled = true;  // tau_d 0.4 m, region growing within 0.2 m of the seed
   return o;
 }
 
@@ -71,19 +69,6 @@ TYPED_TEST(MultiViewStageTest, FeaturesInTheGrownRegionAreFlagged) {
   EXPECT_EQ(set, 400u);
   test::expect_only_changed(work_before, test::parts_of(w), {"multiview"});
   test::expect_only_changed(result_before, test::parts_of(r), {"multiview"});
-}
-
-TYPED_TEST(MultiViewStageTest, WithoutOverridingStaticsOnlyTheCandidatesRegionGrows) {
-  using T = TypeParam;
-  KeyframeScene<T> s;
-  s.semantic[0] = s.semantic[3] = FeatureLabel::Candidate;  // their bounding box (25, 15)-(35, 25) holds the seed
-  auto o = multiview_on<T>();
-  o.multiview_overrides_static = false;
-  detail::PipelineWork<T> w;
-  PipelineResult<T> r = test::fresh_result(o, s.f.size());
-  s.check(o, &w, &r);
-  ASSERT_TRUE(w.multiview.ok) << r.multiview.reason;
-  EXPECT_EQ(w.multiview.dynamic, (std::vector<std::uint8_t>{1, 0, 0, 1, 0}));  // 4 is outside that box
 }
 
 TYPED_TEST(MultiViewStageTest, EachMissingInputIsNamedAndNothingIsFlagged) {
@@ -120,15 +105,6 @@ TYPED_TEST(MultiViewStageTest, EachMissingInputIsNamedAndNothingIsFlagged) {
     PipelineResult<T> r = test::fresh_result(o, s.f.size());
     s.check(o, &w, &r);
     expect_skipped(w, r, "depth");
-  }
-  {
-    KeyframeScene<T> s;  // no candidates to verify
-    auto verify_only = o;
-    verify_only.multiview_overrides_static = false;
-    detail::PipelineWork<T> w;
-    PipelineResult<T> r = test::fresh_result(verify_only, s.f.size());
-    s.check(verify_only, &w, &r);
-    expect_skipped(w, r, "no candidate features to verify (multiview_overrides_static is off)");
   }
   {
     KeyframeScene<T> s;

@@ -77,7 +77,7 @@ detail::SemanticEvidence<T> semantic_evidence() {
 template <class T>
 PipelineOptions<T> probability_on() {
   PipelineOptions<T> o;
-  o.use_probability = true;  // a1 0.4, a2 0.4, a3 0.2, threshold 0.55, motion threshold >= 1.5 px
+  o.probability.enabled = true;  // a1 0.4, a2 0.4, a3 0.2, threshold 0.55, motion threshold >= 1.5 px
   return o;
 }
 
@@ -163,7 +163,7 @@ TYPED_TEST(ProbabilityStageTest, WithoutTracksItSaysSoAndDecidesNothing) {
 TYPED_TEST(ProbabilityStageTest, DisabledLeavesItsEvidenceInvalid) {
   using T = TypeParam;
   const auto f = frame_with_flows<T>(true);
-  const PipelineOptions<T> o;  // use_probability false
+  const PipelineOptions<T> o;  // probability.enabled false
   detail::PipelineWork<T> w;
   w.regions.boxes = f.detections;
   w.semantic = semantic_evidence<T>();

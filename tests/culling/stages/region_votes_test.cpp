@@ -103,8 +103,8 @@ TYPED_TEST(RegionVotesStageTest, ACoherentCellIsFlaggedBeforeTheVote) {
   using T = TypeParam;
   VoteScene<T> s;
   PipelineOptions<T> o;
-  o.use_reprojection = true;
-  o.use_coherent_motion = true;  // sigmas 10, noise floor 0.2 px, min_median 0.5 px, min_points 4
+  o.reprojection.enabled = true;
+  o.coherent_motion.enabled = true;  // sigmas 10, noise floor 0.2 px, min_median 0.5 px, min_points 4
   PipelineResult<T> r = test::fresh_result(o, s.f.size());
   r.reprojection.status = Status::Ok;  // the geometric stage ran the reprojection check
   // Top-left cell (features 0-9): every residual (1, 0) px, none flagged on its own. Standard error of
@@ -136,12 +136,12 @@ TYPED_TEST(RegionVotesStageTest, CoherentMotionWithoutResidualsSaysSoAndTheVoteR
   using T = TypeParam;
   VoteScene<T> s;
   PipelineOptions<T> o;
-  o.use_coherent_motion = true;
+  o.coherent_motion.enabled = true;
   PipelineResult<T> r = test::fresh_result(o, s.f.size());
   SubBoxMemory memory;
   s.vote(o, &r, &memory);
   EXPECT_FALSE(r.coherent_motion.ran());
-  EXPECT_EQ(r.coherent_motion.reason, "needs the reprojection check's residuals (use_reprojection, points_3d)");
+  EXPECT_EQ(r.coherent_motion.reason, "needs the reprojection check's residuals (reprojection.enabled, points_3d)");
   EXPECT_FALSE(s.w.votes.coherent_ran);
   ASSERT_TRUE(r.subbox.ran()) << r.subbox.reason;
   EXPECT_EQ(s.w.votes.subbox.cells, (std::vector<std::uint8_t>{0, 0, 0, 0, 1, 0, 0, 0, 0}));
@@ -181,12 +181,12 @@ TYPED_TEST(RegionVotesStageTest, EachMissingInputIsNamedAndNothingIsVoted) {
     VoteScene<T> s;
     s.f.evidence_frames = 1;
     PipelineOptions<T> short_baseline = o;
-    short_baseline.min_evidence_frames = 3;
+    short_baseline.subbox.min_evidence_frames = 3;
     PipelineResult<T> r = test::fresh_result(short_baseline, s.f.size());
     s.vote(short_baseline, &r, &memory);
     EXPECT_FALSE(s.w.votes.ok);
     EXPECT_EQ(r.subbox.reason,
-              "baseline of 1 frame(s) too short for static evidence (min_evidence_frames): the box rule decides");
+              "baseline of 1 frame(s) too short for static evidence (subbox.min_evidence_frames): the box rule decides");
   }
 }
 
@@ -194,7 +194,7 @@ TYPED_TEST(RegionVotesStageTest, DisabledVotesNothing) {
   using T = TypeParam;
   VoteScene<T> s;
   PipelineOptions<T> o;
-  o.use_subbox = false;
+  o.subbox.enabled = false;
   s.w.votes.ok = true;  // a previous frame's
   PipelineResult<T> r = test::fresh_result(o, s.f.size());
   SubBoxMemory memory;

@@ -57,7 +57,7 @@ detail::BoxRegions<T> regions_of(const test::StageFrame<T>& f) {
 template <class T>
 PipelineOptions<T> box_rule_with_depth_mask() {
   PipelineOptions<T> o;
-  o.use_depth_mask = true;  // robust mode: d_c from the centre patch, eps 0.3 m
+  o.depth_mask.enabled = true;  // robust mode: d_c from the centre patch, eps 0.3 m
   return o;
 }
 
@@ -139,7 +139,7 @@ TYPED_TEST(SemanticStageTest, DisabledBoxRuleLeavesTheMaskAlone) {
   using T = TypeParam;
   const auto f = scene<T>();
   auto o = box_rule_with_depth_mask<T>();
-  o.use_box_rule = false;
+  o.box_rule.enabled = false;
   detail::PipelineWork<T> w;
   w.regions = regions_of(f);
   PipelineResult<T> r = test::fresh_result(o, f.size());

@@ -16,7 +16,7 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
   BoxRegions<T>& s = *out;
   s.boxes.clear();
   if (frame.detections) {
-    if (options.use_detection_filter) {
+    if (options.detections.enabled) {
       DetectionsResult<T>& d = s.filtered;
       filter_detections(*frame.detections, W, H, options.detections, &d);
       r->detections.status = d.status;
@@ -25,10 +25,10 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
     } else {
       s.boxes = *frame.detections;
     }
-  } else if (options.use_detection_filter) {
+  } else if (options.detections.enabled) {
     lacks_input(&r->detections, "no detections given");
   }
-  if (options.use_box_tracker) {
+  if (options.tracker.enabled) {
     // Only dynamic-class boxes are tracked: carrying a missed (or one-frame false positive) low-level box
     // would only stretch its shelter over whatever moves in front of it.
     s.untracked_boxes.clear();

@@ -39,7 +39,7 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
     bool geo_flagged = geo_dyn;
     if (subbox_ok) {
       const CullReason vote = w.votes.subbox.reasons[i];
-      if (lab == FeatureLabel::Candidate && !options.subbox_verifies_candidates) {
+      if (lab == FeatureLabel::Candidate && !options.subbox.verifies_candidates) {
         // Stays a candidate, verified below on its own evidence: flagged itself inside a dynamic sub-box,
         // or by the multi-view check.
         geo_flagged = geo_dyn && vote == CullReason::SubBox;
@@ -52,18 +52,16 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
       } else if (w.semantic.in_dyn_box[i] && sem_reasons[i] != CullReason::Probability) {
         lab = FeatureLabel::Static;  // refined: in a static sub-box of its box
         why = CullReason::None;
-      } else if (geo_dyn && options.cull_geometric_outside_boxes && lab == FeatureLabel::Static && !sheltered) {
-        lab = FeatureLabel::Dynamic;
-        why = w.evidence_source(i);
       }
-    } else if (geo_dyn && lab != FeatureLabel::Dynamic &&
-               (lab == FeatureLabel::Candidate || (options.cull_geometric_outside_boxes && !sheltered))) {
+      // Outside the boxes a geometric flag alone culls nothing: an unexplained flow outlier there is more
+      // often tracking error than a mover the detector missed.
+    } else if (geo_dyn && lab == FeatureLabel::Candidate) {
       lab = FeatureLabel::Dynamic;
       why = w.evidence_source(i);
     }
     if (mv_ok && w.multiview.dynamic[i]) {
       geo_flagged = true;
-      if (lab == FeatureLabel::Candidate || (lab == FeatureLabel::Static && options.multiview_overrides_static)) {
+      if (lab != FeatureLabel::Dynamic) {  // DynaSLAM: a multi-view flag culls wherever it is
         lab = FeatureLabel::Dynamic;
         why = CullReason::MultiView;
       }
@@ -93,15 +91,15 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
   }
   const ReprojectionCheckResult<T>& rp = geometric.reprojection;
   const bool checked = r->reprojection.ran() && rp.labels.size() == n && rp.residual_px.size() == n;
-  // A baseline too short to vote (min_evidence_frames) is too short to prove a slow mover still.
+  // A baseline too short to vote (subbox.min_evidence_frames) is too short to prove a slow mover still.
   const bool evaluated = checked && (frame.evidence_frames <= 0 ||
-                                     frame.evidence_frames >= std::max(1, options.min_evidence_frames));
+                                     frame.evidence_frames >= std::max(1, options.subbox.min_evidence_frames));
   history->update(*frame.track_ids, checked ? ArrayView<FeatureLabel>(rp.labels) : nullptr,
                   checked ? ArrayView<T>(rp.residual_px) : nullptr, evaluated, options.static_history.max_residual_px,
                   still_frames);
   if (!checked) {
     r->static_history.reason =
-        "needs the reprojection check (use_reprojection, points_3d), which did not run: counts carried over";
+        "needs the reprojection check (reprojection.enabled, points_3d), which did not run: counts carried over";
     return;
   }
   const auto min_frames = static_cast<std::uint16_t>(std::min(options.static_history.min_frames, 0xFFFF));
@@ -120,7 +118,7 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
   r->static_history.reason += " feature(s) kept static by their history";
 }
 
-/// Minimum-survivor guard: below max(min_survivor_fraction * n, min_survivors) static features, first
+/// Minimum-survivor guard: below max(guard.min_fraction * n, guard.min_survivors) static features, first
 /// soften (restore the culls of single geometric stages and of candidates), then undo all culling.
 template <class T>
 void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
@@ -133,10 +131,10 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   std::size_t survivors = count_static();
   // The fraction is clamped to [0, 1] before the conversion (validate() rejects others; NaN counts as 0).
   const double survivor_fraction =
-      options.min_survivor_fraction >= 0 ? std::min(options.min_survivor_fraction, 1.0) : 0.0;
+      options.guard.min_fraction >= 0 ? std::min(options.guard.min_fraction, 1.0) : 0.0;
   const std::size_t need =
-      std::max(options.min_survivors, static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));
-  if (options.survivor_guard && survivors < need && n > 0) {
+      std::max(options.guard.min_survivors, static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));
+  if (options.guard.enabled && survivors < need && n > 0) {
     std::size_t soft = 0;
     for (std::size_t i = 0; i < n; ++i) soft += r->labels[i] == FeatureLabel::Dynamic && is_soft_cull(r->reasons[i]);
     const bool soften_enough = survivors + soft >= need;
@@ -173,7 +171,7 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
 template <class T>
 void report_missing_inputs(PipelineResult<T>* r) {
   const std::pair<const char*, const StageReport*> stages[] = {
-      {"detection_filter", &r->detections}, {"box_tracker", &r->tracker},
+      {"detections", &r->detections},       {"tracker", &r->tracker},
       {"box_rule", &r->box_rule},           {"depth_mask", &r->depth_mask},
       {"probability", &r->probability},     {"moving_consistency", &r->moving_consistency},
       {"reprojection", &r->reprojection},   {"coherent_motion", &r->coherent_motion},

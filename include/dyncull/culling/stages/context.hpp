@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dyncull/culling/pipeline_types.hpp"
+#include "dyncull/culling/subbox_memory.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -74,7 +75,8 @@ struct RegionVotes {
   CoherentMotionResult<T> coherent;
   std::vector<FeatureLabel> evidence;  ///< the geometric labels with the coherent cells' features flagged
   bool coherent_ran = false;           ///< evidence holds the coherent stage's labels
-  std::vector<std::uint8_t> coherent_eligible, remembered_cells, memory_eligible;
+  std::vector<std::uint8_t> coherent_eligible;
+  std::vector<std::uint8_t> remembered_cells;  ///< a tracked box's last vote, on too short a baseline
   SubBoxResult<T> subbox;
   bool ok = false;
 };
@@ -136,7 +138,7 @@ template <class T>
 struct PipelineState {
   BoxTracker<T> tracker;             ///< given PipelineOptions::tracker each frame
   TrackStateStore track_states;      ///< K of 000 eq. 3, keyed by the caller's track ids
-  SubBoxMemory subbox_memory;        ///< PipelineOptions::subbox_memory_frames
+  SubBoxMemory subbox_memory;        ///< last votes: SubBoxStageOptions::short_baseline_keeps_last_vote
   StaticHistory static_history;      ///< PipelineOptions::static_history
   KeyframeRing<T> keyframes;         ///< multi-view references (push with is_keyframe or by hand)
   std::uint64_t frame_index = 0;

@@ -22,11 +22,12 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
   const std::size_t n = r->num_features;
   GeometricEvidence<T>& g = *out;
   const FlagView in_boxes = regions.dyn_boxes.empty() ? nullptr : FlagView(semantic.in_dyn_box);
-  if (options.use_moving_consistency) {
+  if (options.moving_consistency.enabled) {
     if (!frame.prev_keypoints) {  // given ones hold n positions (accept_inputs)
       lacks_input(&r->moving_consistency, "no prev_keypoints given");
     } else {
-      check_moving_consistency(*frame.prev_keypoints, kp, options.moving, &g.moving, frame.track_valid, in_boxes);
+      check_moving_consistency(*frame.prev_keypoints, kp, options.moving_consistency, &g.moving, frame.track_valid,
+                               in_boxes);
       r->moving_consistency.status = g.moving.status;
       r->moving_consistency.reason = g.moving.reason;
       r->moving_consistency.num_dynamic = g.moving.num_dynamic;
@@ -36,7 +37,7 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
     g.labels.assign(g.moving.labels.begin(), g.moving.labels.end());
     g.source.assign(n, CullReason::Epipolar);
   }
-  if (options.use_reprojection) {
+  if (options.reprojection.enabled) {
     if (!frame.points_3d) {  // given ones hold n points (accept_inputs)
       lacks_input(&r->reprojection, "no points_3d given");
     } else {
@@ -51,15 +52,12 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
         g.labels.assign(g.reprojection.labels.begin(), g.reprojection.labels.end());
         g.source.assign(n, CullReason::Reprojection);
       } else {
+        // The residual also sees the motion along the epipolar line: where it decided, it alone decides.
         for (std::size_t i = 0; i < n; ++i) {
           const FeatureLabel rl = g.reprojection.labels[i];
-          FeatureLabel& gl = g.labels[i];
-          const bool replace = options.reprojection_evidence == PipelineOptions<T>::Evidence::Replace ||
-                               rl == FeatureLabel::Dynamic || gl == FeatureLabel::Candidate;
-          if (replace && rl != FeatureLabel::Candidate) {
-            gl = rl;
-            g.source[i] = CullReason::Reprojection;
-          }
+          if (rl == FeatureLabel::Candidate) continue;
+          g.labels[i] = rl;
+          g.source[i] = CullReason::Reprojection;
         }
       }
     }
@@ -68,14 +66,14 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
   g.fit_outside_boxes = (!r->moving_consistency.ran() || g.moving.fitted_outside_boxes) &&
                         (!r->reprojection.ran() || g.reprojection.fitted_outside_boxes);
   // An LK window straddling an occlusion edge follows the contour, not a 3-D point: not evidence.
-  if (g.ok && options.edge_evidence_radius_px > 0 && !frame.depth.empty()) {
+  if (g.ok && options.edge_evidence.enabled && !frame.depth.empty()) {
     std::size_t discounted = 0;
     for (std::size_t i = 0; i < n; ++i) {
       int u = 0, v = 0;
       if (g.labels[i] != FeatureLabel::Dynamic ||
           !keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
         continue;
-      if (depth_step_near(frame.depth, u, v, options.edge_evidence_radius_px, options.edge_depth_step_ratio)) {
+      if (depth_step_near(frame.depth, u, v, options.edge_evidence.radius_px, options.edge_evidence.depth_step_ratio)) {
         g.labels[i] = FeatureLabel::Candidate;
         ++discounted;
       }

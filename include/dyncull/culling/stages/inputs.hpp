@@ -26,19 +26,19 @@ void begin_frame(const PipelineOptions<T>& options, PipelineResult<T>* r) {
     st->reason.clear();
     st->num_dynamic = 0;
   }
-  r->detections.enabled = options.use_detection_filter;
-  r->tracker.enabled = options.use_box_tracker;
-  r->box_rule.enabled = options.use_box_rule;
-  r->depth_mask.enabled = options.use_depth_mask;
-  r->probability.enabled = options.use_probability;
-  r->moving_consistency.enabled = options.use_moving_consistency;
-  r->reprojection.enabled = options.use_reprojection;
-  r->coherent_motion.enabled = options.use_coherent_motion;
-  if (options.use_coherent_motion)
+  r->detections.enabled = options.detections.enabled;
+  r->tracker.enabled = options.tracker.enabled;
+  r->box_rule.enabled = options.box_rule.enabled;
+  r->depth_mask.enabled = options.depth_mask.enabled;
+  r->probability.enabled = options.probability.enabled;
+  r->moving_consistency.enabled = options.moving_consistency.enabled;
+  r->reprojection.enabled = options.reprojection.enabled;
+  r->coherent_motion.enabled = options.coherent_motion.enabled;
+  if (options.coherent_motion.enabled)
     r->coherent_motion.reason = "runs with the sub-box refinement, on the reprojection check's residuals";
-  r->subbox.enabled = options.use_subbox;
-  r->multiview.enabled = options.use_multiview;
-  r->static_history.enabled = options.static_history.min_frames > 0;
+  r->subbox.enabled = options.subbox.enabled;
+  r->multiview.enabled = options.multiview.enabled;
+  r->static_history.enabled = options.static_history.enabled;
 }
 
 /// False (r filled: InvalidInput, every keypoint Static and kept) when the frame cannot be culled: no

@@ -14,14 +14,13 @@ namespace detail {
 
 /// out->dynamic: per feature, in a region the check found moving (valid when out->ok); reports into r.multiview.
 template <class T, class Frame>
-void check_against_keyframes(const Frame& frame, const PipelineOptions<T>& options,
-                             const std::vector<FeatureLabel>& semantic_labels, const KeyframeRing<T>& keyframes,
+void check_against_keyframes(const Frame& frame, const PipelineOptions<T>& options, const KeyframeRing<T>& keyframes,
                              MultiViewFlags<T>* out, PipelineResult<T>* r) {
   MultiViewFlags<T>& m = *out;
   const std::size_t n = r->num_features;
   m.dynamic.assign(n, 0);
   m.ok = false;
-  if (!options.use_multiview) return;
+  if (!options.multiview.enabled) return;
   const auto& kp = *frame.keypoints;
   if (!frame.cam_from_world || !frame.cam_from_world->all_finite()) {
     lacks_input(&r->multiview, frame.cam_from_world ? "cam_from_world not finite (tracking lost)"
@@ -38,30 +37,11 @@ void check_against_keyframes(const Frame& frame, const PipelineOptions<T>& optio
     lacks_input(&r->multiview, "no reference keyframe stored yet");
     return;
   }
-  if (!options.multiview_overrides_static &&
-      std::none_of(semantic_labels.begin(), semantic_labels.end(),
-                   [](FeatureLabel l) { return l == FeatureLabel::Candidate; })) {
-    r->multiview.reason = "no candidate features to verify (multiview_overrides_static is off)";
-    return;
-  }
-  // Growth only where labels are still open: all the image, or around the candidates.
+  // Seeds grow over the whole image: a flag culls wherever it is (DynaSLAM).
   PixelRect roi{0, 0, frame.depth.width, frame.depth.height};
-  if (!options.multiview_overrides_static) {
-    roi = PixelRect{frame.depth.width, frame.depth.height, 0, 0};
-    for (std::size_t i = 0; i < n; ++i) {
-      int u = 0, v = 0;
-      if (semantic_labels[i] != FeatureLabel::Candidate ||
-          !keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
-        continue;
-      roi.c0 = std::min(roi.c0, u);
-      roi.r0 = std::min(roi.r0, v);
-      roi.c1 = std::max(roi.c1, u + 1);
-      roi.r1 = std::max(roi.r1, v + 1);
-    }
-  }
-  m.ref_index.resize(std::max<std::size_t>(1, std::min(options.max_reference_keyframes, keyframes.size())));
+  m.ref_index.resize(std::max<std::size_t>(1, std::min(options.multiview.max_reference_keyframes, keyframes.size())));
   const std::size_t k =
-      keyframes.select_references(*frame.cam_from_world, options.max_reference_keyframes, m.ref_index.data());
+      keyframes.select_references(*frame.cam_from_world, options.multiview.max_reference_keyframes, m.ref_index.data());
   if (m.mask.width != frame.depth.width || m.mask.height != frame.depth.height)
     m.mask.reset(frame.depth.width, frame.depth.height, 0);
   else

@@ -17,7 +17,7 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
                        TrackStateStore* track_states, ProbabilityEvidence<T>* out, PipelineResult<T>* r) {
   ProbabilityEvidence<T>& p = *out;
   p.ok = false;
-  if (!options.use_probability) return;
+  if (!options.probability.enabled) return;
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
   if (!frame.prev_keypoints) {  // given ones hold n positions (accept_inputs)
@@ -36,7 +36,7 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
       p.levels[i] = options.levels.level(regions.boxes[static_cast<std::size_t>(semantic.rule.box_index[i])].class_id);
   }
   EgoMotion<T> ego;
-  if (options.probability_flow_model == FlowModel::Fundamental && r->moving_consistency.ran()) {
+  if (options.probability.flow_model == FlowModel::Fundamental && r->moving_consistency.ran()) {
     ego.model = FlowModel::Fundamental;
     ego.matrix = geometric.moving.F;
   }

@@ -1,7 +1,7 @@
 /// @file region_votes.hpp
 /// Stage 6 of the culling pipeline: region votes over the dynamic-class boxes, the sub-box refinement
 /// (DFD-SLAM 2024 Algorithm 1) on the geometric evidence, with cell-level coherent motion before the
-/// vote, the sub-box memory of a tracked box, and the box rule deciding on too short a baseline.
+/// vote, and on too short a baseline the box rule or a tracked box's last vote deciding.
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
@@ -20,11 +20,11 @@ template <class T, class Frame>
 void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::uint64_t frame_index,
                   const BoxRegions<T>& regions, const SemanticEvidence<T>& semantic,
                   const std::vector<FeatureLabel>& semantic_labels, const GeometricEvidence<T>& geometric,
-                  SubBoxMemory* memory_store, RegionVotes<T>* out, PipelineResult<T>* r) {
+                  SubBoxMemory* last_votes, RegionVotes<T>* out, PipelineResult<T>* r) {
   RegionVotes<T>& v = *out;
   v.ok = false;
   v.coherent_ran = false;
-  if (!options.use_subbox) return;
+  if (!options.subbox.enabled) return;
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
   const bool masks = semantic.masks;
@@ -34,12 +34,12 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
     r->subbox.reason = "needs geometric labels (moving consistency or reprojection), unavailable this frame";
   } else if (regions.dyn_boxes.empty()) {
     r->subbox.reason = "no dynamic-class boxes";
-  } else if (options.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
-             frame.evidence_frames < options.min_evidence_frames) {
+  } else if (options.subbox.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
+             frame.evidence_frames < options.subbox.min_evidence_frames) {
     const std::size_t recalled =
-        options.short_baseline_keeps_last_vote && options.use_box_tracker && r->tracker.ran()
-            ? memory_store->recall_states(regions.dyn_box_track_id, options.subbox.grid, frame_index,
-                                          options.min_evidence_frames, &v.remembered_cells)
+        options.subbox.short_baseline_keeps_last_vote && options.tracker.enabled && r->tracker.ran()
+            ? last_votes->recall_states(regions.dyn_box_track_id, options.subbox.grid, frame_index,
+                                        options.subbox.min_evidence_frames, &v.remembered_cells)
             : 0;
     if (recalled > 0) {
       apply_subbox_states(kp, geometric.labels, regions.dyn_boxes, v.remembered_cells, options.subbox,
@@ -48,20 +48,20 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
       r->subbox.num_dynamic = v.subbox.num_dynamic;
     }
     r->subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
-                       " frame(s) too short for static evidence (min_evidence_frames): " +
+                       " frame(s) too short for static evidence (subbox.min_evidence_frames): " +
                        (recalled > 0 ? "the last vote of " + std::to_string(recalled) +
                                            " tracked box(es) kept, the box rule elsewhere"
                                      : std::string("the box rule decides"));
-  } else if (options.subbox_requires_fit_outside_boxes && !geometric.fit_outside_boxes &&
+  } else if (options.subbox.requires_fit_outside_boxes && !geometric.fit_outside_boxes &&
              std::any_of(semantic.in_dyn_box.begin(), semantic.in_dyn_box.end(),
                          [](std::uint8_t f) { return f != 0; })) {
     r->subbox.reason = "F or the pose was fitted through the dynamic-class boxes (too few tracks outside them): "
                        "its evidence inside the boxes is not trusted";
   } else {
     ArrayView<FeatureLabel> evidence = geometric.labels;
-    if (options.use_coherent_motion) {
+    if (options.coherent_motion.enabled) {
       if (!r->reprojection.ran() || geometric.reprojection.residual_vec.size() != n) {
-        r->coherent_motion.reason = "needs the reprojection check's residuals (use_reprojection, points_3d)";
+        r->coherent_motion.reason = "needs the reprojection check's residuals (reprojection.enabled, points_3d)";
       } else {
         CoherentMotionOptions<T> co = options.coherent_motion;
         co.grid = options.subbox.grid;  // the cells the vote will count
@@ -79,28 +79,14 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
         r->coherent_motion.num_dynamic = v.coherent.num_flagged;
       }
     }
-    const bool memory = options.subbox_memory_frames > 0 && options.use_box_tracker && r->tracker.ran() &&
-                        frame.track_ids && frame.track_ids->size() == n;
-    if (memory) {
-      memory_store->recall(regions.dyn_box_track_id, options.subbox.grid, frame_index, options.subbox_memory_frames,
-                           &v.remembered_cells);
-      memory_store->update_tracks(*frame.track_ids, evidence, frame_index, options.subbox_memory_frames,
-                                  &v.memory_eligible);
-    }
-    refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits,
-                    memory ? FlagView(v.remembered_cells) : nullptr, memory ? FlagView(v.memory_eligible) : nullptr);
-    if (memory && v.subbox.ok())
-      memory_store->remember(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
-                             options.subbox_memory_frames);
-    if (options.short_baseline_keeps_last_vote && options.min_evidence_frames > 0 && options.use_box_tracker &&
-        r->tracker.ran() && v.subbox.ok())
-      memory_store->remember_states(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
-                                    options.min_evidence_frames);
+    refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits);
+    if (options.subbox.short_baseline_keeps_last_vote && options.subbox.min_evidence_frames > 0 &&
+        options.tracker.enabled && r->tracker.ran() && v.subbox.ok())
+      last_votes->remember_states(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
+                                  options.subbox.min_evidence_frames);
     r->subbox.status = v.subbox.status;
     r->subbox.reason = v.subbox.reason;
     r->subbox.num_dynamic = v.subbox.num_dynamic;
-    if (options.subbox_memory_frames > 0 && !memory && v.subbox.ok())
-      r->subbox.reason = "sub-box memory off this frame: it needs the box tracker and CullingFrame::track_ids";
   }
   v.ok = r->subbox.ran();
 }

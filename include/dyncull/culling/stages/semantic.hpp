@@ -14,7 +14,7 @@
 
 namespace dyncull {
 namespace detail {
-/// PipelineOptions::low_override_by_depth: features the box rule sheltered (LowLevelOverride) that a
+/// DepthMaskStageOptions::low_override_by_depth: features the box rule sheltered (LowLevelOverride) that a
 /// dynamic-class object's depth mask holds lose the shelter when their depth is nearer that object's d_c
 /// than the d_c of every low-level box holding them. `combined` lists the dynamic-class boxes, then the
 /// low-level ones (scratch); their depth is planned again with occluded_centre_search so a TV's depth is
@@ -88,7 +88,7 @@ std::size_t unshelter_by_depth(const Keypoints& kp, const DepthView<Raw>& depth,
   return changed;
 }
 
-/// PipelineOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
+/// DepthMaskStageOptions::assign_overlaps_by_depth: for features inside a dynamic-class box whose depth
 /// masks hold them, keeps one mask bit (the box with d_c nearest the feature's depth, a high-level box's
 /// gap counted `high_level_margin_m` smaller; ties and missing depth: the highest level, then the first
 /// box) and sets the semantic label from that box's level.
@@ -152,7 +152,7 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
   s.in_object.assign(n, 1);
   s.rule_ok = false;
   s.masks = false;
-  if (options.use_box_rule) {
+  if (options.box_rule.enabled) {
     apply_box_rule(kp, regions.boxes, options.levels, options.box_rule, &s.rule, &s.rule_scratch);
     r->box_rule.status = s.rule.status;
     r->box_rule.reason = s.rule.reason;
@@ -167,11 +167,11 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
     }
     // Without the detection filter, the box rule is the stage that reads the detections. It still ran on
     // no boxes, so a non-finite keypoint is culled as on any frame.
-    if (!frame.detections && !options.use_detection_filter) lacks_input(&r->box_rule, "no detections given");
+    if (!frame.detections && !options.detections.enabled) lacks_input(&r->box_rule, "no detections given");
   }
 
   // Inside dynamic-class boxes only the object's depth band is culled.
-  if (!options.use_depth_mask) return;
+  if (!options.depth_mask.enabled) return;
   if (frame.depth.empty()) {
     lacks_input(&r->depth_mask, "no depth given");
     return;
@@ -184,14 +184,14 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
   s.masks = true;
   r->depth_mask.num_dynamic = dm.num_dynamic;
   s.object_box_bits.assign(dm.box_bits.begin(), dm.box_bits.end());
-  if (options.low_override_by_depth && options.use_box_rule)
+  if (options.depth_mask.low_override_by_depth && options.box_rule.enabled)
     r->unsheltered = unshelter_by_depth(kp, frame.depth, dm, regions.dyn_boxes, regions.boxes, options.levels,
                                         options.depth_mask, &s.shelter_boxes, &s.shelter_mask, &s.mask_scratch,
                                         &s.object_box_bits, &s.labels,
                                         &s.reasons, &s.in_dyn_box);
-  if (options.assign_overlaps_by_depth && options.use_box_rule)
+  if (options.depth_mask.assign_overlaps_by_depth && options.box_rule.enabled)
     assign_overlaps_by_depth(kp, frame.depth, dm, regions.dyn_boxes, options.levels, &s.object_box_bits, &s.labels,
-                             &s.reasons, options.overlap_high_level_margin_m);
+                             &s.reasons, options.depth_mask.overlap_high_level_margin_m);
   for (std::size_t i = 0; i < n; ++i) {
     s.in_object[i] = dm.labels[i] != FeatureLabel::Static;
     if (dm.labels[i] == FeatureLabel::Dynamic && dm.reasons[i] == CullReason::InvalidInput) {
@@ -202,7 +202,7 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
       s.reasons[i] = CullReason::None;
     } else if (s.in_dyn_box[i] && dm.labels[i] == FeatureLabel::Dynamic && s.labels[i] == FeatureLabel::Dynamic) {
       s.reasons[i] = CullReason::DepthMask;
-    } else if (!options.use_box_rule && dm.labels[i] != FeatureLabel::Static) {
+    } else if (!options.box_rule.enabled && dm.labels[i] != FeatureLabel::Static) {
       s.labels[i] = dm.labels[i];
       s.reasons[i] = dm.reasons[i];
       s.in_dyn_box[i] = 1;
