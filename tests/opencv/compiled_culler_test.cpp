@@ -1,9 +1,12 @@
 // Tests of opencv/compiled_culler.hpp (library dyncull::culler): on the synthetic walking scene its
 // cv::KeyPoint, cv::Point2f and float-pair overloads give exactly the header-only FrameCuller's keep mask,
 // labels, reasons, track ids and status; bad calibration, options and inputs are refused with the input
-// named; compact() shrinks the descriptors with the parallel vectors. The C++11 / C++14 host compile is
-// checked by compiled_culler_host.cpp (built twice, -Werror).
+// named; compact() shrinks the descriptors with the parallel vectors; after warm-up a frame costs no heap
+// allocation beyond the header-only culler's. The C++11 / C++14 host compile is checked by
+// compiled_culler_host.cpp (built twice, -Werror).
 #include "dyncull/opencv/compiled_culler.hpp"
+
+#include "support/counting_allocator.hpp"
 
 #include "dyncull/opencv/culler.hpp"
 #include "dyncull/sim/families.hpp"
@@ -15,6 +18,7 @@
 #include <opencv2/features2d.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <utility>
@@ -35,8 +39,8 @@ std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detection
 }
 
 /// The compiled result equals the header-only one, element by element.
-void expect_same(const CullerResult& expected, const CompiledCuller::Result& got, int frame, const char* overload) {
-  SCOPED_TRACE(std::string(overload) + " overload, frame " + std::to_string(frame));
+void expect_same(const CullerResult& expected, const CompiledCuller::Result& got, int step, const char* overload) {
+  SCOPED_TRACE(std::string(overload) + " overload, step " + std::to_string(step));
   EXPECT_EQ(static_cast<int>(got.status), static_cast<int>(expected.status));
   EXPECT_EQ(got.reason, expected.reason);
   EXPECT_EQ(got.keep, expected.keep);
@@ -53,7 +57,7 @@ void expect_same(const CullerResult& expected, const CompiledCuller::Result& got
   EXPECT_EQ(got.keyframe, expected.keyframe);
 }
 
-TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypointType) {
+TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypointTypeWithoutExtraAllocations) {
   sim::SceneFamily family;
   ASSERT_TRUE(sim::find_scene_family("walking", &family));
   sim::SceneOptions scene_options = family.options;
@@ -69,8 +73,14 @@ TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypoint
   ASSERT_TRUE(with_keypoints.ok()) << with_keypoints.reason();
   const cv::Ptr<cv::ORB> orb = cv::ORB::create(1000);
   std::size_t dynamic = 0, keyframes = 0;
+  // Heap allocations of each call summed over the second pass through the frames: the header-only
+  // culler's, and the compiled overloads' beyond them (their result copies and point buffers reuse the
+  // capacity the first pass grew them to).
+  std::size_t header_only_allocations = 0, extra_keypoints = 0, extra_points = 0, extra_floats = 0;
   sim::FrameData frame;
-  for (int i = 0; i < scene_options.num_frames; ++i) {
+  for (int step = 0; step < 2 * scene_options.num_frames; ++step) {
+    const int i = step % scene_options.num_frames;
+    const bool second_pass = step >= scene_options.num_frames;
     scene.render(i, &frame);
     const cv::Mat gray(frame.height, frame.width, CV_8UC1, frame.gray.data());
     const cv::Mat depth(frame.height, frame.width, CV_32FC1, frame.depth_m.data());
@@ -83,21 +93,41 @@ TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypoint
     std::vector<cv::Point2f> points;
     cv::KeyPoint::convert(keys, points);
 
+    std::size_t before = test::allocations();
     header_only.cull(keys, descriptors, depth, frame.detections, &Tcw);
+    const std::size_t reference = test::allocations() - before;
+    before = test::allocations();
     with_keypoints.cull(keys, descriptors, depth, boxes, &Tcw);
+    const std::size_t by_keypoints = test::allocations() - before;
+    before = test::allocations();
     with_points.cull(points, descriptors, depth, boxes, &Tcw);
+    const std::size_t by_points = test::allocations() - before;
+    before = test::allocations();
     with_floats.cull(points.empty() ? nullptr : &points[0].x, points.size(), sizeof(cv::Point2f), descriptors, depth,
                      boxes, &Tcw);
+    const std::size_t by_floats = test::allocations() - before;
+    if (second_pass) {
+      header_only_allocations += reference;
+      extra_keypoints += by_keypoints > reference ? by_keypoints - reference : 0;
+      extra_points += by_points > reference ? by_points - reference : 0;
+      extra_floats += by_floats > reference ? by_floats - reference : 0;
+    }
     const CullerResult& expected = header_only.result();
-    expect_same(expected, with_keypoints.result(), i, "cv::KeyPoint");
-    expect_same(expected, with_points.result(), i, "cv::Point2f");
-    expect_same(expected, with_floats.result(), i, "float pairs");
+    expect_same(expected, with_keypoints.result(), step, "cv::KeyPoint");
+    expect_same(expected, with_points.result(), step, "cv::Point2f");
+    expect_same(expected, with_floats.result(), step, "float pairs");
     for (FeatureLabel l : expected.labels) dynamic += l == FeatureLabel::Dynamic;
     keyframes += expected.keyframe;
   }
   // The comparison means something only when the scene made the culler cull and change keyframes.
   EXPECT_GT(dynamic, 100u);
   EXPECT_GT(keyframes, 1u);
+  std::printf("allocations in the second pass: header-only %zu; beyond it: cv::KeyPoint %zu, cv::Point2f %zu, "
+              "floats %zu\n",
+              header_only_allocations, extra_keypoints, extra_points, extra_floats);
+  EXPECT_EQ(extra_keypoints, 0u);
+  EXPECT_EQ(extra_points, 0u);
+  EXPECT_EQ(extra_floats, 0u);
 }
 
 struct BadInputFixture {
