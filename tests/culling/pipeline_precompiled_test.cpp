@@ -46,7 +46,7 @@ std::vector<FrameOutcome> run_precompiled(const std::vector<SequenceFrame<T>>& s
 template <class T>
 class PrecompiledPipeline : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(PrecompiledPipeline, Scalars);
+TYPED_TEST_SUITE(PrecompiledPipeline, Scalars, );  // trailing comma: clang -Wpedantic rejects an empty variadic
 
 TYPED_TEST(PrecompiledPipeline, GivesTheHeaderOnlyLabelsForEveryPresetAndDepthType) {
   using T = TypeParam;
