@@ -4,12 +4,12 @@
 # compiler, library versions, commit, command and wall time, and writes the page from that output.
 #   scripts/benchmarks.sh [--out DIR] [--build DIR] [--page FILE] [--filter REGEX]   run, then write the page
 #   scripts/benchmarks.sh --page-only DIR [--page FILE]                            the page from an earlier run
-# DIR defaults to ./benchmarks_out, the build directory to build/bench, FILE to docs/benchmarks.md; --filter
+# DIR defaults to out/benchmarks (ignored by git), the build directory to build/bench, FILE to docs/benchmarks.md; --filter
 # runs only the bench binaries whose name matches (the page then shows those). Environment:
 # DYNCULL_BENCH_MIN_TIME (seconds per repetition, default 0.2), DYNCULL_BENCH_REPETITIONS (default 3).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-out=benchmarks_out
+out=out/benchmarks
 build="$root/build/bench"
 page="$root/docs/benchmarks.md"
 page_only=""
