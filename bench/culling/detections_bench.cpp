@@ -1,6 +1,6 @@
 // Per-frame detection ingest before any culling: YOLO text parsing (with file:line errors) against a
 // plain std::istringstream parse, YOLO box conversion with padding / class thresholds / clipping
-// (001 eq. 1-2, 004 eq. 1), motion-level lookup (COCO-80 table), and the box tracker that carries boxes
+// (RTD-SLAM eq. 1-2, Zhang et al. 2023 eq. 1), motion-level lookup (COCO-80 table), and the box tracker that carries boxes
 // over missed detections (Dynamic-VINS). 20 detections per frame, 640x480. There is no library peer;
 // the point is the scale: all of it together should stay far below one LK call (~10 ms).
 #include "dyncull/culling/box_tracker.hpp"

@@ -1,4 +1,4 @@
-// Dynamic probability (000 eq. 3-5) at 1000 features, 5 boxes' worth of masked features.
+// Dynamic probability (DLD-SLAM eq. 3-5) at 1000 features, 5 boxes' worth of masked features.
 // Baseline: the paper's plain loop (mean flow of static features, fixed t) to show what the
 // robust median/MAD threshold and the track store cost on top.
 #include "dyncull/culling/dynamic_probability.hpp"
@@ -91,7 +91,7 @@ void BM_DynamicProbability_Fundamental(benchmark::State& state) {
 }
 BENCHMARK(BM_DynamicProbability_Fundamental)->Unit(benchmark::kMicrosecond);
 
-// Baseline: 000 eq. 4-5 literally (mean of static flow, fixed t = 1.5 px, no K).
+// Baseline: DLD-SLAM eq. 4-5 literally (mean of static flow, fixed t = 1.5 px, no K).
 void BM_DynamicProbability_PlainLoopBaseline(benchmark::State& state) {
   const Data d = make();
   std::vector<std::uint8_t> dynamic(d.prev.size());

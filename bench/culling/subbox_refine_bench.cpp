@@ -1,4 +1,4 @@
-// Sub-box refinement (seed 003 Algorithm 1) at ~1100 features and 4 boxes: the vote against its floor
+// Sub-box refinement (DFD-SLAM Algorithm 1) at ~1100 features and 4 boxes: the vote against its floor
 // (one pass binning the features into the boxes' 3x3 cells, nothing else), and the raster mask with its
 // 15 px dilation against cv::dilate with the same 31x31 rectangle on the same pixels.
 #include "dyncull/culling/moving_consistency.hpp"
