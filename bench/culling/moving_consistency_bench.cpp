@@ -1,4 +1,4 @@
-// Moving-consistency check (seed 003 eq. 1-3) at ~1000 tracks: ours vs its own parts (F-RANSAC + one batch
+// Moving-consistency check (DFD-SLAM eq. 1-3) at ~1000 tracks: ours vs its own parts (F-RANSAC + one batch
 // distance pass, the 1.2x target) vs OpenCV findFundamentalMat + computeCorrespondEpilines, same data.
 #include "dyncull/culling/moving_consistency.hpp"
 
