@@ -36,11 +36,11 @@
 
 namespace dyncull {
 
-/// What happens to features still labelled Candidate (medium-level boxes, 001 §III.D) at the end.
+/// What happens to features still labelled Candidate (medium-level boxes, RTD-SLAM §III.D) at the end.
 enum class CandidatePolicy : std::uint8_t {
   Keep = 0,  ///< static: only proven motion culls them
-  Cull,      ///< dynamic: treat medium-level objects as moving (004 Algorithm 1)
-  Verify,    ///< dynamic only when a geometric stage flags the feature, else static (001)
+  Cull,      ///< dynamic: treat medium-level objects as moving (Zhang et al. 2023 Algorithm 1)
+  Verify,    ///< dynamic only when a geometric stage flags the feature, else static (RTD-SLAM)
 };
 
 /// What the minimum-survivor guard did.
@@ -68,13 +68,13 @@ struct TrackerStageOptions : BoxTrackerOptions<T> {
   bool enabled = false;
 };
 
-/// The box rule's options (002 Table 2 / 004 Algorithm 1) with its switch.
+/// The box rule's options (Zhu et al. 2024 Table 2 / Zhang et al. 2023 Algorithm 1) with its switch.
 template <class T>
 struct BoxRuleStageOptions : BoxRuleOptions<T> {
   bool enabled = true;
 };
 
-/// The depth mask (000 eq. 1-2: box culls limited to the object's depth band) with its switch and the
+/// The depth mask (DLD-SLAM eq. 1-2: box culls limited to the object's depth band) with its switch and the
 /// decisions that need the objects' depths.
 struct DepthMaskStageOptions : DepthMaskOptions {
   bool enabled = false;
@@ -103,11 +103,11 @@ struct DepthMaskStageOptions : DepthMaskOptions {
   }
 };
 
-/// The dynamic probability (000 eq. 3-5, features in object masks; needs tracks) with its switch.
+/// The dynamic probability (DLD-SLAM eq. 3-5, features in object masks; needs tracks) with its switch.
 template <class T>
 struct ProbabilityStageOptions : DynamicProbabilityOptions<T> {
   bool enabled = false;
-  /// Flow model of the M term: Fundamental reuses the moving-consistency F when it ran (000: MeanFlow).
+  /// Flow model of the M term: Fundamental reuses the moving-consistency F when it ran (DLD-SLAM: MeanFlow).
   FlowModel flow_model = FlowModel::Fundamental;
 
   /// DynamicProbabilityOptions::validate, then flow_model in range.
@@ -120,7 +120,7 @@ struct ProbabilityStageOptions : DynamicProbabilityOptions<T> {
   }
 };
 
-/// The epipolar moving-consistency check (003 eq. 1-3; needs tracks) with its switch.
+/// The epipolar moving-consistency check (DFD-SLAM eq. 1-3; needs tracks) with its switch.
 template <class T>
 struct MovingConsistencyStageOptions : MovingConsistencyOptions<T> {
   bool enabled = true;
@@ -156,7 +156,7 @@ struct EdgeEvidenceOptions {
   }
 };
 
-/// The sub-box refinement (003 Algorithm 1; needs the geometric labels) with its switch and when its
+/// The sub-box refinement (DFD-SLAM Algorithm 1; needs the geometric labels) with its switch and when its
 /// vote is trusted.
 template <class T>
 struct SubBoxStageOptions : SubBoxOptions<T> {
@@ -202,7 +202,7 @@ struct StaticHistoryStageOptions : StaticHistoryOptions<T> {
   bool enabled = false;
 };
 
-/// The multi-view check (001 §III.A after DynaSLAM; needs the current pose, depth and a keyframe) with
+/// The multi-view check (RTD-SLAM §III.A after DynaSLAM; needs the current pose, depth and a keyframe) with
 /// its switch. Its flags cull wherever they are (DynaSLAM).
 template <class T>
 struct MultiViewStageOptions : MultiViewOptions<T> {

@@ -1,6 +1,6 @@
 /// @file presets.hpp
-/// Pipeline configurations reproducing each source paper (000 DLD-SLAM, Yu et al. 2024; 001 RTD-SLAM, Gao
-/// et al. 2024; 002 Zhu et al. 2024; 003 DFD-SLAM, Qian et al. 2024; 004 Zhang et al. 2023; numbered as in
+/// Pipeline configurations reproducing each source paper (DLD-SLAM, Yu et al. 2024; RTD-SLAM, Gao et al. 2024;
+/// Zhu et al. 2024; DFD-SLAM, Qian et al. 2024; Zhang et al. 2023; cited in full in
 /// docs/algorithms.md) and the recommended combination. Each preset says what it runs and why; the figures
 /// behind the recommended one are the ablation table of docs/results.md.
 #pragma once
@@ -26,7 +26,7 @@ PipelineOptions<T> none() {
   return o;
 }
 
-/// 000 DLD-SLAM: the depth-threshold object mask inside the boxes (eq. 1-2, plain rule), then the dynamic
+/// DLD-SLAM (Yu et al. 2024): the depth-threshold object mask inside the boxes (eq. 1-2, plain rule), then the dynamic
 /// probability P = a1 S + a2 M + a3 K (eq. 3-5) of the features in the masks with the paper's mean-flow M.
 /// Features in a box but outside its mask stay static.
 template <class T>
@@ -42,7 +42,7 @@ PipelineOptions<T> dld_slam() {
   return o;
 }
 
-/// 001 RTD-SLAM: motion levels and box culling (§III.D: high-level boxes culled, medium-level ones sent to
+/// RTD-SLAM (Gao et al. 2024): motion levels and box culling (§III.D: high-level boxes culled, medium-level ones sent to
 /// verification), and the multi-view depth and parallax check (§III.A: 30 deg, 0.4 m) on every feature.
 template <class T>
 PipelineOptions<T> rtd_slam() {
@@ -56,7 +56,7 @@ PipelineOptions<T> rtd_slam() {
   return o;
 }
 
-/// 002 Zhu et al.: the static/dynamic box rule of Table 2 only (dynamic in a dynamic box and in no static
+/// Zhu et al. 2024: the static/dynamic box rule of Table 2 only (dynamic in a dynamic box and in no static
 /// box); no medium level.
 template <class T>
 PipelineOptions<T> zhu_2024() {
@@ -67,7 +67,7 @@ PipelineOptions<T> zhu_2024() {
   return o;
 }
 
-/// 003 DFD-SLAM: LK tracks, F-RANSAC and the epipolar distance (eq. 1-3, 1 px everywhere), refined by the
+/// DFD-SLAM (Qian et al. 2024): LK tracks, F-RANSAC and the epipolar distance (eq. 1-3, 1 px everywhere), refined by the
 /// 3x3 sub-box vote (Algorithm 1) with the paper's literal merge (every static neighbour of a dynamic
 /// sub-box) and sigma2 = 4. F is fitted on all tracks and the vote always trusted, as in the paper. Boxes
 /// only delimit the vote (no semantic culling of their own).
@@ -86,7 +86,7 @@ PipelineOptions<T> dfd_slam() {
   return o;
 }
 
-/// 004 Zhang et al.: the logical discrimination of Algorithm 1: high- and medium-level boxes are dynamic
+/// Zhang et al. 2023: the logical discrimination of Algorithm 1: high- and medium-level boxes are dynamic
 /// unless the feature is also in a low-level box.
 template <class T>
 PipelineOptions<T> zhang_2023() {
@@ -97,15 +97,15 @@ PipelineOptions<T> zhang_2023() {
   return o;
 }
 
-/// Recommended: the box rule with 002/004's low-level shelter, limited to each object's depth band (000
-/// eq. 1-2), verified per region by the geometric check fitted outside the boxes (003 eq. 1-3 with
-/// SG-SLAM's RGB-D reprojection where the caller gives 3-D points) and 003's sub-box vote, with a tracker
-/// for missed boxes, each track's static history and the survivor guard.
+/// Recommended: the box rule with the low-level shelter of Zhu et al. 2024 and Zhang et al. 2023, limited
+/// to each object's depth band (DLD-SLAM eq. 1-2), verified per region by the geometric check fitted outside
+/// the boxes (DFD-SLAM eq. 1-3 with SG-SLAM's RGB-D reprojection where the caller gives 3-D points) and
+/// DFD-SLAM's sub-box vote, with a tracker for missed boxes, each track's static history and the survivor guard.
 /// Inputs: prev_keypoints and points_3d measured in the front end's keyframe (a slow mover builds up a
 /// measurable displacement only over several frames), evidence_frames = frames since that keyframe, and
 /// track_ids for the static history.
-/// Left out: the probability (000; its M term is the geometric evidence already used, its S term the box
-/// rule) and the multi-view check (001; grown over the whole image, where a depth jump outside the boxes
+/// Left out: the probability (DLD-SLAM; its M term is the geometric evidence already used, its S term the box
+/// rule) and the multi-view check (RTD-SLAM; grown over the whole image, where a depth jump outside the boxes
 /// is more often a sensor edge than a mover).
 template <class T>
 PipelineOptions<T> recommended() {
@@ -119,7 +119,7 @@ PipelineOptions<T> recommended() {
   o.depth_mask.mode = DepthMaskMode::Robust;
   // On a silhouette a pixel without depth is dragged along the contour: culled with the object.
   o.depth_mask.missing_depth = MissingDepth::InMask;
-  // The top of 000's eps range (0.3-0.5 m): a walker near the camera, seen obliquely, reaches further
+  // The top of DLD-SLAM's eps range (0.3-0.5 m): a walker near the camera, seen obliquely, reaches further
   // behind its centre depth than 0.3 m.
   o.depth_mask.eps_m = 0.5;
   // A feature in overlapping masks belongs to the object nearest its depth, a person unless the other is
@@ -149,7 +149,7 @@ PipelineOptions<T> recommended() {
   // split votes stay with the box rule.
   o.subbox.static_needs_evidence = true;
   o.subbox.static_max_dynamic_ratio = T(0.3);
-  o.subbox.sigma2 = 4;  // 003's whole-box rule also culls movers their own cell's vote missed
+  o.subbox.sigma2 = 4;  // DFD-SLAM's whole-box rule also culls movers their own cell's vote missed
   o.subbox.verifies_candidates = false;  // a chair is culled on its own flags, not by a person's vote
   // On a one-frame baseline "not flagged" says nothing about a slow mover: the box rule decides, except in
   // the cells of a tracked box that voted within those frames (its still legs stay static).

@@ -29,7 +29,7 @@ struct BoxRegions {
   BoxTrackerResult<T> tracked;   ///< the box tracker's result, reused between frames
 };
 
-/// Per-feature semantic evidence: the box rule's labels limited to the objects' depth bands (000 eq. 1-2).
+/// Per-feature semantic evidence: the box rule's labels limited to the objects' depth bands (DLD-SLAM eq. 1-2).
 template <class T>
 struct SemanticEvidence {
   BoxRuleResult<T> rule;  ///< the box rule's own result (box index per feature)
@@ -45,7 +45,7 @@ struct SemanticEvidence {
   DepthMaskScratch mask_scratch;
 };
 
-/// 000 eq. 3-5 over the features of the object masks: the semantic labels with the probability's decisions.
+/// DLD-SLAM eq. 3-5 over the features of the object masks: the semantic labels with the probability's decisions.
 template <class T>
 struct ProbabilityEvidence {
   bool ok = false;
@@ -57,7 +57,7 @@ struct ProbabilityEvidence {
   DynamicProbabilityScratch<T> scratch;
 };
 
-/// Per-feature geometric evidence: the epipolar (003 eq. 3) and/or reprojection labels, combined, with
+/// Per-feature geometric evidence: the epipolar (DFD-SLAM eq. 3) and/or reprojection labels, combined, with
 /// flags on depth edges discounted.
 template <class T>
 struct GeometricEvidence {
@@ -69,7 +69,7 @@ struct GeometricEvidence {
   bool fit_outside_boxes = true;   ///< every check in the labels fitted its model outside the boxes
 };
 
-/// Region votes: cell-level coherent motion, then the sub-box vote (003 Algorithm 1) over the boxes.
+/// Region votes: cell-level coherent motion, then the sub-box vote (DFD-SLAM Algorithm 1) over the boxes.
 template <class T>
 struct RegionVotes {
   CoherentMotionResult<T> coherent;
@@ -81,7 +81,7 @@ struct RegionVotes {
   bool ok = false;
 };
 
-/// Multi-view check against stored keyframes (001 §III.A), grown into a mask over the depth image.
+/// Multi-view check against stored keyframes (RTD-SLAM §III.A), grown into a mask over the depth image.
 template <class T>
 struct MultiViewFlags {
   MultiViewResult<T> check;
@@ -137,7 +137,7 @@ inline void lacks_input(StageReport* stage, const char* what) {
 template <class T>
 struct PipelineState {
   BoxTracker<T> tracker;             ///< given PipelineOptions::tracker each frame
-  TrackStateStore track_states;      ///< K of 000 eq. 3, keyed by the caller's track ids
+  TrackStateStore track_states;      ///< K of DLD-SLAM eq. 3, keyed by the caller's track ids
   SubBoxMemory subbox_memory;        ///< last votes: SubBoxStageOptions::short_baseline_keeps_last_vote
   StaticHistory static_history;      ///< PipelineOptions::static_history
   KeyframeRing<T> keyframes;         ///< multi-view references (push with is_keyframe or by hand)
