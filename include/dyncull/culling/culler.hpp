@@ -157,7 +157,9 @@ struct CullerOptions {
   /// its LK tracks: a detector that re-detects every frame matches about half of its keypoints one frame
   /// later (repeatability, and movers the pose-guided search does not find), so at 0.5 nearly every
   /// frame would be a keyframe and the evidence a one-frame baseline, on which the recommended preset
-  /// leaves the decision to the box rule (subbox.min_evidence_frames).
+  /// leaves the decision to the box rule (subbox.min_evidence_frames). A host that keeps its tracks
+  /// between its own keyframes (new corners only there) matches fewer of them to the culler's keyframe:
+  /// about 0.6 suits it (the dynamic_vo demo's culler strategy).
   double keyframe_min_matched_ratio = 0.3;
   KeyframeMatchOptions matching{};
   /// Keyframe depth used for its 3-D points: the TUM sensor's reliable range, and no point within
