@@ -72,12 +72,15 @@ inline std::vector<StrategySpec> all_strategies() {
   };
   add("none", "no culling: every tracked feature goes to PnP-RANSAC", false, false, false, false,
       presets::none<float>());
-  add("dld_slam", "000: depth mask in boxes + dynamic probability", true, true, false, false, presets::dld_slam<float>());
-  add("rtd_slam", "001: motion levels, box culling, multi-view check", true, true, false, false,
+  add("dld_slam", "DLD-SLAM (Yu et al. 2024): depth mask in boxes + dynamic probability", true, true, false, false,
+      presets::dld_slam<float>());
+  add("rtd_slam", "RTD-SLAM (Gao et al. 2024): motion levels, box culling, multi-view check", true, true, false, false,
       presets::rtd_slam<float>());
-  add("zhu_2024", "002: static/dynamic box rule", true, true, false, false, presets::zhu_2024<float>());
-  add("dfd_slam", "003: epipolar check + 3x3 sub-box refinement", true, false, false, false, presets::dfd_slam<float>());
-  add("zhang_2023", "004: high/medium/low logical discrimination", true, true, false, false,
+  add("zhu_2024", "Zhu et al. 2024: static/dynamic box rule", true, true, false, false,
+      presets::zhu_2024<float>());
+  add("dfd_slam", "DFD-SLAM (Qian et al. 2024): epipolar check + 3x3 sub-box refinement", true, false, false, false,
+      presets::dfd_slam<float>());
+  add("zhang_2023", "Zhang et al. 2023: high/medium/low logical discrimination", true, true, false, false,
       presets::zhang_2023<float>());
   add("recommended", "dyncull's recommended preset (box rule + depth band + epipolar vs keyframe / sub-box + guard)",
       true, true, true, false, presets::recommended<float>());
