@@ -7,9 +7,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
-#include "support/counting_allocator.hpp"
-#include "support/culling_frames.hpp"
-#include "support/culling_scenes.hpp"
+#include "support/allocation_sequence.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -22,26 +20,8 @@
 namespace {
 using namespace dyncull;
 
-struct Frame {
-  test::CullingScene<float> scene;
-  std::vector<Detection<float>> detections;
-  std::vector<std::int64_t> ids;
-};
-
-const std::vector<Frame>& sequence() {
-  static const std::vector<Frame> seq = [] {
-    std::vector<Frame> s;
-    for (int k = 0; k < 3; ++k) {
-      test::SceneConfig config;
-      config.seed = 300 + static_cast<std::uint64_t>(k);
-      Frame f;
-      f.scene = test::make_culling_scene<float>(config);
-      for (const auto& d : f.scene.detections) f.detections.push_back(d);
-      for (std::size_t i = 0; i < f.scene.size(); ++i) f.ids.push_back(static_cast<std::int64_t>(i));
-      s.push_back(std::move(f));
-    }
-    return s;
-  }();
+const std::vector<test::AllocationFrame>& sequence() {
+  static const std::vector<test::AllocationFrame> seq = test::allocation_sequence();
   return seq;
 }
 
@@ -53,37 +33,19 @@ const Preset kPresets[] = {{"recommended", &presets::recommended<float>}, {"dfd_
                            {"dld_slam", &presets::dld_slam<float>},       {"rtd_slam", &presets::rtd_slam<float>},
                            {"zhu_2024", &presets::zhu_2024<float>},       {"zhang_2023", &presets::zhang_2023<float>}};
 
-/// One round over the sequence; adds each frame's allocation count to `counts` when it is given.
-void run_round(const std::vector<Frame>& seq, const PipelineOptions<float>& options, PipelineState<float>* state,
-               std::vector<std::size_t>* counts) {
-  for (std::size_t k = 0; k < seq.size(); ++k) {
-    const Frame& f = seq[k];
-    auto frame = test::frame_of(f.scene, f.detections);
-    frame.track_ids = &f.ids;
-    frame.points_3d = &f.scene.prev_points_world;
-    frame.is_keyframe = k == 0;
-    frame.evidence_frames = 2;
-    const std::size_t before = test::allocations();
-    const auto& r = cull_frame(frame, options, state);
-    const std::size_t n = test::allocations() - before;
-    benchmark::DoNotOptimize(r.labels.data());
-    if (counts) counts->push_back(n);
-  }
-}
-
 /// Counters: `allocs_per_frame` = the most any frame made after warm-up (the figure the test bounds),
 /// `allocs_mean` = their mean.
 void BM_Allocations(benchmark::State& bstate) {
   const Preset& preset = kPresets[bstate.range(0)];
   const PipelineOptions<float> options = preset.make();
-  const std::vector<Frame>& seq = sequence();
+  const std::vector<test::AllocationFrame>& seq = sequence();
   PipelineState<float> state(2);  // two keyframe slots: full, and their buffers reused, before the count
-  for (int round = 0; round < 3; ++round) run_round(seq, options, &state, nullptr);
+  for (int round = 0; round < 3; ++round) test::count_allocations_round(seq, options, &state, nullptr);
   std::vector<std::size_t> counts;
   counts.reserve(1 << 16);
   for (auto _ : bstate) {
     if (counts.size() + seq.size() > counts.capacity()) counts.clear();
-    run_round(seq, options, &state, &counts);
+    test::count_allocations_round(seq, options, &state, &counts);
   }
   std::size_t most = 0, sum = 0;
   for (std::size_t c : counts) {

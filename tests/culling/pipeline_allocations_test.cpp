@@ -3,10 +3,7 @@
 #include "dyncull/culling/pipeline.hpp"
 #include "dyncull/culling/presets.hpp"
 
-#include "support/culling_frames.hpp"
-#include "support/culling_scenes.hpp"
-
-#include "support/counting_allocator.hpp"
+#include "support/allocation_sequence.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,45 +16,19 @@
 namespace dyncull {
 namespace {
 
-struct Frame {
-  test::CullingScene<float> scene;
-  std::vector<Detection<float>> detections;
-  std::vector<std::int64_t> ids;
-};
-
-/// Allocations of each frame after `warmup` frames of the same sequence replayed (same sizes each round).
-std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& options, const std::vector<Frame>& seq,
-                                               int warmup_rounds) {
+/// Allocations of each frame after `warmup_rounds` rounds of the same sequence (same sizes each round).
+std::vector<std::size_t> allocations_per_frame(const PipelineOptions<float>& options,
+                                               const std::vector<test::AllocationFrame>& seq, int warmup_rounds) {
   // Two keyframe slots: the ring is full, and its slots' buffers reused, before the counted round.
   PipelineState<float> state(2);
+  for (int round = 0; round < warmup_rounds; ++round) test::count_allocations_round(seq, options, &state, nullptr);
   std::vector<std::size_t> counts;
-  for (int round = 0; round <= warmup_rounds; ++round) {
-    for (std::size_t k = 0; k < seq.size(); ++k) {
-      const Frame& f = seq[k];
-      auto frame = test::frame_of(f.scene, f.detections);
-      frame.track_ids = &f.ids;
-      frame.points_3d = &f.scene.prev_points_world;
-      frame.is_keyframe = k == 0;
-      frame.evidence_frames = 2;
-      const std::size_t before = test::allocations();
-      cull_frame(frame, options, &state);
-      if (round == warmup_rounds) counts.push_back(test::allocations() - before);
-    }
-  }
+  test::count_allocations_round(seq, options, &state, &counts);
   return counts;
 }
 
 TEST(PipelineAllocations, PerFrameAfterWarmUpStayWithinEachPresetsBound) {
-  std::vector<Frame> seq;
-  for (int k = 0; k < 3; ++k) {
-    test::SceneConfig config;
-    config.seed = 300 + static_cast<std::uint64_t>(k);
-    Frame f;
-    f.scene = test::make_culling_scene<float>(config);
-    for (const auto& d : f.scene.detections) f.detections.push_back(d);
-    for (std::size_t i = 0; i < f.scene.size(); ++i) f.ids.push_back(static_cast<std::int64_t>(i));
-    seq.push_back(std::move(f));
-  }
+  const std::vector<test::AllocationFrame> seq = test::allocation_sequence();
   // Bounds at what the pipeline reaches; the allocations left are listed in docs/design.md (the geometric
   // checks' solvers, new ids in the track store, and the frame's reason when a stage lacks an input).
   // dld_slam's are the ids frame 0 has and frame 2 lacks: 6 with g++, 8 with clang (the scene's sampling).
