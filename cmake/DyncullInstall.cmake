@@ -1,26 +1,26 @@
 include(CMakePackageConfigHelpers)
 
-set(DYNCULL_EXPORT_TARGETS dyncull)
+# One export set per component, so that a host loads only what it asks for and needs only that part's
+# dependencies: core (dyncull, pipeline) Eigen; opencv the OpenCV modules; culler OpenCV core (and
+# calib3d at link time); ceres Ceres.
+set(DYNCULL_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/dyncull)
+set(DYNCULL_CORE_TARGETS dyncull)
 if(DYNCULL_MASTER_PROJECT)  # otherwise dyncull_pipeline is built only when a target links it
-  list(APPEND DYNCULL_EXPORT_TARGETS dyncull_pipeline)
+  list(APPEND DYNCULL_CORE_TARGETS dyncull_pipeline)
 endif()
-if(DYNCULL_HAS_OPENCV)
-  list(APPEND DYNCULL_EXPORT_TARGETS dyncull_opencv)
-endif()
-if(DYNCULL_HAS_CERES)
-  list(APPEND DYNCULL_EXPORT_TARGETS dyncull_ceres)
-endif()
-if(TARGET dyncull_culler)
-  list(APPEND DYNCULL_EXPORT_TARGETS dyncull_culler)
-endif()
-
-install(TARGETS ${DYNCULL_EXPORT_TARGETS} EXPORT dyncullTargets)
+install(TARGETS ${DYNCULL_CORE_TARGETS} EXPORT dyncullTargets)
+install(EXPORT dyncullTargets NAMESPACE dyncull:: DESTINATION ${DYNCULL_CMAKE_DIR})
+set(DYNCULL_COMPONENTS "")
+foreach(_comp opencv culler ceres)
+  if(TARGET dyncull_${_comp})
+    list(APPEND DYNCULL_COMPONENTS ${_comp})
+    install(TARGETS dyncull_${_comp} EXPORT dyncull-${_comp}Targets)
+    install(EXPORT dyncull-${_comp}Targets NAMESPACE dyncull:: DESTINATION ${DYNCULL_CMAKE_DIR})
+  endif()
+endforeach()
 install(DIRECTORY include/dyncull DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES "${CMAKE_CURRENT_BINARY_DIR}/generated/include/dyncull/version.hpp"
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/dyncull)
-
-set(DYNCULL_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/dyncull)
-install(EXPORT dyncullTargets NAMESPACE dyncull:: DESTINATION ${DYNCULL_CMAKE_DIR})
 
 configure_package_config_file(cmake/dyncullConfig.cmake.in
   "${CMAKE_CURRENT_BINARY_DIR}/dyncullConfig.cmake"

@@ -20,6 +20,51 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the consumer ran but returned ${rc}")
 endif()
 
+# The exported targets name no absolute path: every path is relative to the install prefix.
+file(GLOB target_files "${SCRATCH_DIR}/prefix/lib*/cmake/dyncull/*Targets*.cmake")
+foreach(f IN LISTS target_files)
+  file(STRINGS "${f}" lines REGEX "INTERFACE_(INCLUDE_DIRECTORIES|LINK_LIBRARIES|COMPILE_OPTIONS)")
+  foreach(line IN LISTS lines)
+    string(REPLACE "\${_IMPORT_PREFIX}" "<prefix>" stripped "${line}")
+    if(stripped MATCHES "\"/|;/")
+      message(FATAL_ERROR "${f} exports an absolute path: ${line}")
+    endif()
+  endforeach()
+endforeach()
+
+# The core without Ceres: a host whose machine lacks Ceres's development files still configures.
+execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${SCRATCH_DIR}/build_no_ceres"
+                        -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+                        -DCMAKE_DISABLE_FIND_PACKAGE_Ceres=ON
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "configuring the consumer with Ceres hidden failed (${rc})")
+endif()
+
+# The compiled culler alone, with Eigen and Ceres hidden: OpenCV core and calib3d are all it needs.
+file(GLOB culler_targets "${SCRATCH_DIR}/prefix/lib*/cmake/dyncull/dyncull-cullerTargets.cmake")
+if(EXPECT_CULLER AND NOT culler_targets)
+  message(FATAL_ERROR "the build has dyncull::culler but the install has no culler component")
+endif()
+if(EXPECT_CULLER)
+  execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}/culler" -B "${SCRATCH_DIR}/build_culler"
+                          -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+                          -DCMAKE_DISABLE_FIND_PACKAGE_Ceres=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON
+                          -DHOST_SOURCE=${CONSUMER_SOURCE_DIR}/../opencv/compiled_culler_host.cpp
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "configuring a culler-only consumer with Eigen and Ceres hidden failed (${rc})")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_culler" RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "building the culler-only consumer failed (${rc})")
+  endif()
+  execute_process(COMMAND "${SCRATCH_DIR}/build_culler/culler_consumer" RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the culler-only consumer ran but returned ${rc}")
+  endif()
+endif()
+
 # The same consumer with dyncull vendored through add_subdirectory (no install step).
 execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${SCRATCH_DIR}/build_subdir"
                         -DCONSUMER_USE_SUBDIRECTORY=ON -DDYNCULL_SOURCE_DIR=${DYNCULL_SOURCE_DIR}
