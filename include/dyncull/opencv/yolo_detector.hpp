@@ -378,10 +378,31 @@ class YoloDetector {
                                           std::to_string(options.input_width) + " x " +
                                           std::to_string(options.input_height) + " input: " + first_line(e.what()));
     }
-    head_ = darknet ? YoloHead::Darknet
-                    : (options.head != YoloHead::Auto ? options.head
-                                                      : (outputs_.empty() ? YoloHead::Auto
-                                                                          : detail::onnx_head_of(outputs_[0], options.num_classes)));
+    if (outputs_.empty()) return fail(Status::InvalidInput, options.model + ": the network has no output");
+    if (darknet) {
+      head_ = YoloHead::Darknet;
+    } else {
+      // Some YOLOv5 exports keep the raw per-scale maps ([1, 3, H, W, 85]) beside the decoded output:
+      // the outputs that are a head are used, the others not computed.
+      head_ = options.head;
+      std::vector<cv::String> heads;
+      for (std::size_t k = 0; k < outputs_.size(); ++k) {
+        const YoloHead h = head_ != YoloHead::Auto ? head_ : detail::onnx_head_of(outputs_[k], options.num_classes);
+        int n = 0;
+        if (h == YoloHead::Auto || !detail::head_fits(outputs_[k], h, options.num_classes, &n)) continue;
+        head_ = h;
+        heads.push_back(out_names_[k]);
+      }
+      if (heads.empty()) heads.push_back(out_names_.front());  // reported below with its shape
+      if (heads.size() != out_names_.size()) {
+        out_names_ = heads;
+        try {
+          net_.forward(outputs_, out_names_);
+        } catch (const cv::Exception& e) {
+          return fail(Status::ParseError, options.model + ": the network does not run: " + first_line(e.what()));
+        }
+      }
+    }
     int anchors = 0;
     for (std::size_t k = 0; k < outputs_.size(); ++k) {
       int n = 0;
@@ -391,7 +412,6 @@ class YoloDetector {
                                               detail::expected_shapes(options.num_classes) + ")");
       anchors += n;
     }
-    if (outputs_.empty()) return fail(Status::InvalidInput, options.model + ": the network has no output");
     r.head = head_;
     r.num_outputs = static_cast<int>(outputs_.size());
     r.num_anchors = anchors;
@@ -404,7 +424,7 @@ class YoloDetector {
   YoloHead head() const { return head_; }
 
   /// Detections on one frame: CV_8UC3 BGR (the detector was trained on colour), or CV_8UC1 grey, which
-  /// is replicated to three channels (converted_from_grey; expect fewer and weaker detections). An empty
+  /// is replicated to three channels (converted_from_grey; expect fewer boxes than on colour). An empty
   /// frame, another type or a closed detector give InvalidInput and no detections. The returned reference
   /// is valid until the next detect(); its buffers are reused.
   const YoloDetectorResult& detect(const cv::Mat& frame) {
