@@ -97,6 +97,77 @@ struct TinyYoloNet {
   }
 };
 
+// A minimal ONNX writer (protobuf wire format) for tiny YOLOv5 / YOLOv8-shaped networks: a 1x1 Conv on a
+// 1x3x32x32 "images" input whose zero weights make every output its bias, reshaped to the export's layout.
+namespace onnx {
+std::string varint(std::uint64_t v) {
+  std::string out;
+  do {
+    const std::uint8_t byte = static_cast<std::uint8_t>(v & 0x7f);
+    v >>= 7;
+    out.push_back(static_cast<char>(byte | (v ? 0x80 : 0)));
+  } while (v);
+  return out;
+}
+std::string field_varint(int field, std::int64_t v) {
+  return varint(static_cast<std::uint64_t>(field) << 3) + varint(static_cast<std::uint64_t>(v));
+}
+std::string field_bytes(int field, const std::string& bytes) {
+  return varint((static_cast<std::uint64_t>(field) << 3) | 2) + varint(bytes.size()) + bytes;
+}
+template <class T>
+std::string raw(const std::vector<T>& values) {
+  return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+}
+std::string tensor(const std::string& name, const std::vector<std::int64_t>& dims, int data_type, const std::string& raw_data) {
+  std::string t;
+  for (const std::int64_t d : dims) t += field_varint(1, d);
+  return t + field_varint(2, data_type) + field_bytes(8, name) + field_bytes(9, raw_data);
+}
+std::string ints_attribute(const std::string& name, const std::vector<std::int64_t>& values) {
+  std::string a = field_bytes(1, name);
+  for (const std::int64_t v : values) a += field_varint(8, v);
+  return a + field_varint(20, 7);  // AttributeProto.INTS
+}
+std::string node(const std::string& op, const std::vector<std::string>& inputs, const std::string& output,
+                 const std::vector<std::string>& attributes = {}) {
+  std::string n;
+  for (const std::string& i : inputs) n += field_bytes(1, i);
+  n += field_bytes(2, output) + field_bytes(3, output + "_node") + field_bytes(4, op);
+  for (const std::string& a : attributes) n += field_bytes(5, a);
+  return n;
+}
+std::string value_info(const std::string& name, const std::vector<std::int64_t>& dims) {
+  std::string shape;
+  for (const std::int64_t d : dims) shape += field_bytes(1, field_varint(1, d));
+  const std::string tensor_type = field_varint(1, 1) + field_bytes(2, shape);  // FLOAT
+  return field_bytes(1, name) + field_bytes(2, field_bytes(1, tensor_type));
+}
+/// `channels` conv outputs with these biases, reshaped to [1, channels, 1024]; transposed to
+/// [1, 1024, channels] when `transpose` (YOLOv5's layout); `reshape` false leaves the 4-D conv map.
+/// `raw_map_output`: the conv map is a graph output too (as older YOLOv5 exports keep their raw maps).
+std::string yolo_model(const std::vector<float>& biases, bool transpose, bool reshape = true, bool raw_map_output = false) {
+  const std::int64_t channels = static_cast<std::int64_t>(biases.size());
+  std::string graph;
+  graph += field_bytes(1, node("Conv", {"images", "W", "B"}, reshape ? "conv" : "output0",
+                               {ints_attribute("kernel_shape", {1, 1}), ints_attribute("strides", {1, 1}),
+                                ints_attribute("pads", {0, 0, 0, 0})}));
+  if (reshape) graph += field_bytes(1, node("Reshape", {"conv", "shape"}, transpose ? "flat" : "output0"));
+  if (reshape && transpose) graph += field_bytes(1, node("Transpose", {"flat"}, "output0", {ints_attribute("perm", {0, 2, 1})}));
+  graph += field_bytes(2, "tiny_yolo");
+  graph += field_bytes(5, tensor("W", {channels, 3, 1, 1}, 1, raw(std::vector<float>(static_cast<std::size_t>(channels) * 3, 0.f))));
+  graph += field_bytes(5, tensor("B", {channels}, 1, raw(biases)));
+  graph += field_bytes(5, tensor("shape", {3}, 7, raw(std::vector<std::int64_t>{1, channels, -1})));
+  graph += field_bytes(11, value_info("images", {1, 3, 32, 32}));
+  const std::vector<std::int64_t> out = !reshape ? std::vector<std::int64_t>{1, channels, 32, 32}
+                                                 : (transpose ? std::vector<std::int64_t>{1, 1024, channels}
+                                                              : std::vector<std::int64_t>{1, channels, 1024});
+  if (raw_map_output) graph += field_bytes(12, value_info("conv", {1, channels, 32, 32}));
+  graph += field_bytes(12, value_info("output0", out));
+  return field_varint(1, 7) + field_bytes(7, graph) + field_bytes(8, field_bytes(1, "") + field_varint(2, 11));
+}
+}  // namespace onnx
+
 /// One hand-built anchor: input-pixel box, objectness (YOLOv5 only) and class scores.
 struct Anchor {
   float cx, cy, w, h, objectness;
@@ -500,6 +571,82 @@ TEST(YoloDetectorRun, DetectorThatFailedToOpenRefusesFrames) {
   const YoloDetectorResult& r = failed.detect(cv::Mat(48, 64, CV_8UC3));
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_NE(r.reason.find("absent.cfg"), std::string::npos) << r.reason;
+}
+
+TEST(YoloDetectorOnnx, Yolov8ExportIsRecognisedAndDecodedWithoutObjectness) {
+  TempDir dir;
+  std::vector<float> biases(84, 0.f);
+  biases[0] = 16, biases[1] = 16, biases[2] = 8, biases[3] = 8;  // every anchor: the input's centre, 8 x 8 px
+  biases[4 + 0] = 0.9f;                                           // person 0.9
+  biases[4 + 56] = 0.2f;                                          // chair below the threshold
+  YoloDetectorOptions o;
+  o.model = dir.file("v8.onnx", onnx::yolo_model(biases, false));
+  o.input_width = o.input_height = 32;
+  YoloDetector d;
+  const auto opened = d.open(o);
+  ASSERT_TRUE(opened.ok()) << opened.reason;
+  EXPECT_EQ(opened.head, YoloHead::YoloV8);
+  EXPECT_EQ(opened.num_anchors, 1024);
+  const YoloDetectorResult& r = d.detect(cv::Mat(48, 64, CV_8UC3, cv::Scalar(10, 20, 30)));
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.num_candidates, 1024u);
+  ASSERT_EQ(r.detections.size(), 1u) << "1024 identical boxes, one after NMS";
+  EXPECT_EQ(r.detections[0].class_id, 0);
+  EXPECT_NEAR(r.detections[0].confidence, 0.9f, 1e-6f);
+  expect_box(r.detections[0], 24.f, 18.f, 40.f, 30.f);  // (12..20) x 64/32, (12..20) x 48/32
+}
+
+TEST(YoloDetectorOnnx, Yolov5ExportIsRecognisedAndItsConfidenceIsObjectnessTimesClass) {
+  TempDir dir;
+  std::vector<float> biases(85, 0.f);
+  biases[0] = 16, biases[1] = 16, biases[2] = 8, biases[3] = 8;
+  biases[4] = 0.5f;        // objectness
+  biases[5 + 3] = 0.8f;    // motorbike: 0.5 x 0.8 = 0.4
+  YoloDetectorOptions o;
+  o.model = dir.file("v5.onnx", onnx::yolo_model(biases, true));
+  o.input_width = o.input_height = 32;
+  o.resize = cv_adapter::YoloResize::Letterbox;
+  YoloDetector d;
+  const auto opened = d.open(o);
+  ASSERT_TRUE(opened.ok()) << opened.reason;
+  EXPECT_EQ(opened.head, YoloHead::YoloV5);
+  const YoloDetectorResult& r = d.detect(cv::Mat(48, 64, CV_8UC3, cv::Scalar(10, 20, 30)));
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.detections.size(), 1u);
+  EXPECT_EQ(r.detections[0].class_id, 3);
+  EXPECT_NEAR(r.detections[0].confidence, 0.4f, 1e-6f);
+  // Letterbox 64 x 48 -> 32 x 24 at offset (0, 4): x (12..20) x 2, y (12 - 4 .. 20 - 4) x 2.
+  expect_box(r.detections[0], 24.f, 16.f, 40.f, 32.f);
+}
+
+TEST(YoloDetectorOnnx, ExportWithARawMapBesideTheHeadRunsOnTheHeadOutput) {
+  TempDir dir;
+  std::vector<float> biases(84, 0.f);
+  biases[0] = 16, biases[1] = 16, biases[2] = 8, biases[3] = 8;
+  biases[4 + 0] = 0.9f;
+  YoloDetectorOptions o;
+  o.model = dir.file("v8_raw.onnx", onnx::yolo_model(biases, false, true, true));
+  o.input_width = o.input_height = 32;
+  YoloDetector d;
+  const auto opened = d.open(o);
+  ASSERT_TRUE(opened.ok()) << opened.reason;
+  EXPECT_EQ(opened.head, YoloHead::YoloV8);
+  EXPECT_EQ(opened.num_outputs, 1);
+  const YoloDetectorResult& r = d.detect(cv::Mat(48, 64, CV_8UC3, cv::Scalar(0)));
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.detections.size(), 1u);
+}
+
+TEST(YoloDetectorOnnx, ExportWhoseOutputIsNotAYoloHeadIsInvalidInputNamingTheShape) {
+  TempDir dir;
+  YoloDetectorOptions o;
+  o.model = dir.file("conv.onnx", onnx::yolo_model(std::vector<float>(84, 0.f), false, false));
+  o.input_width = o.input_height = 32;
+  YoloDetector d;
+  const auto r = d.open(o);
+  EXPECT_EQ(r.status, Status::InvalidInput) << r.reason;
+  EXPECT_NE(r.reason.find("[1, 84, 32, 32]"), std::string::npos) << r.reason;
+  EXPECT_FALSE(d.ok());
 }
 
 // ------------------------------------------------------------------------------------------------
