@@ -4,6 +4,8 @@
 #include "dyncull/eval/yolo_json.hpp"
 #include "dyncull/opencv/yolo_detector.hpp"
 
+#include "support/counting_allocator.hpp"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -363,6 +365,46 @@ TEST(YoloDecode, OutputThatIsNotTheNamedHeadIsInvalidInputNamingTheShape) {
   cv_adapter::decode_yolo_outputs({yolov5_output(person_and_chair(), 80)}, YoloHead::YoloV5, geometry, o, &scratch, &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_NE(r.reason.find("nms_iou"), std::string::npos) << r.reason;
+}
+
+// The decoder's own buffers are reused: a frame without candidates allocates nothing after warm-up, and
+// one with candidates allocates only inside cv::dnn::NMSBoxes (a few times per class present).
+TEST(YoloDecode, ReusesItsBuffersAfterWarmUp) {
+  const std::vector<cv::Mat> busy = {yolov5_output(person_and_chair(), 80)};
+  std::vector<Anchor> faint = person_and_chair();
+  for (Anchor& a : faint) a.objectness = 0.01f;
+  const std::vector<cv::Mat> quiet = {yolov5_output(faint, 80)};
+  const auto geometry = YoloInputGeometry::plain(640, 480, 416, 416);
+  YoloDetectorOptions o;
+  cv_adapter::YoloDecodeScratch scratch;
+  YoloDetectorResult r;
+  cv_adapter::decode_yolo_outputs(busy, YoloHead::YoloV5, geometry, o, &scratch, &r);  // warm-up
+  ASSERT_EQ(r.detections.size(), 3u);
+
+  std::size_t before = test::allocations();
+  cv_adapter::decode_yolo_outputs(quiet, YoloHead::YoloV5, geometry, o, &scratch, &r);
+  EXPECT_EQ(test::allocations() - before, 0u);
+  EXPECT_TRUE(r.detections.empty());
+
+  before = test::allocations();
+  cv_adapter::decode_yolo_outputs(busy, YoloHead::YoloV5, geometry, o, &scratch, &r);
+  const std::size_t decode = test::allocations() - before;
+  EXPECT_EQ(r.detections.size(), 3u);
+
+  // NMSBoxes alone on the same class sizes (person 2 candidates; chair, class 3, class 4 one each).
+  std::vector<cv::Rect2d> boxes;
+  std::vector<float> scores;
+  std::vector<int> kept;
+  boxes.reserve(2), scores.reserve(2), kept.reserve(2);
+  before = test::allocations();
+  for (const std::size_t n : {2, 1, 1, 1}) {
+    boxes.assign(n, cv::Rect2d(0, 0, 10, 10));
+    scores.assign(n, 0.5f);
+    cv::dnn::NMSBoxes(boxes, scores, 0.f, 0.45f, kept);
+  }
+  const std::size_t nms = test::allocations() - before;
+  EXPECT_EQ(decode, nms) << "allocations beyond NMSBoxes' own";
+  RecordProperty("allocations_per_frame_4_classes", static_cast<int>(decode));
 }
 
 TEST(YoloDecode, NonFiniteCandidatesAreSkipped) {

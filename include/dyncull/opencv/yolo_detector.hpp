@@ -284,7 +284,11 @@ inline void decode_yolo_outputs(const std::vector<cv::Mat>& outputs, YoloHead he
   // NMS one class at a time: a person box never suppresses the chair it overlaps.
   s.order.resize(s.boxes.size());
   for (std::size_t i = 0; i < s.order.size(); ++i) s.order[i] = static_cast<int>(i);
-  std::stable_sort(s.order.begin(), s.order.end(), [&](int a, int b) { return s.class_ids[a] < s.class_ids[b]; });
+  // By class, then index: std::sort with the tie broken needs no temporary buffer (std::stable_sort does).
+  std::sort(s.order.begin(), s.order.end(), [&](int a, int b) {
+    const int ca = s.class_ids[static_cast<std::size_t>(a)], cb = s.class_ids[static_cast<std::size_t>(b)];
+    return ca != cb ? ca < cb : a < b;
+  });
   for (std::size_t begin = 0; begin < s.order.size();) {
     const int cls = s.class_ids[static_cast<std::size_t>(s.order[begin])];
     std::size_t end = begin;
@@ -320,7 +324,9 @@ inline void decode_yolo_outputs(const std::vector<cv::Mat>& outputs, YoloHead he
   }
 }
 
-/// A YOLO network on OpenCV DNN (CPU backend). Not thread-safe: one detector per thread.
+/// A YOLO network on OpenCV DNN (CPU backend). Not thread-safe: one detector per thread. After the
+/// first frame of a size its own buffers (resized frame, blob, candidates, result) are reused; OpenCV's
+/// forward() and NMSBoxes still allocate inside.
 class YoloDetector {
  public:
   /// Loads the network and runs it once on a blank input to check its outputs are a YOLO head (and to
