@@ -54,7 +54,7 @@ constexpr const char* to_string(YoloHead h) noexcept {
 
 /// How the frame is fitted into the network input.
 enum class YoloResize {
-  Plain,      ///< stretched to the input size (Darknet's own resize)
+  Plain,      ///< stretched to the input size, as cv::dnn::blobFromImage does
   Letterbox,  ///< scaled by min(in_w / W, in_h / H), centred, the rest filled (YOLOv5 / YOLOv8 export)
 };
 
@@ -160,7 +160,6 @@ struct YoloDecodeScratch {
   std::vector<int> class_ids;
   std::vector<cv::Rect2d> class_boxes;  ///< one class's candidates, for NMSBoxes
   std::vector<float> class_scores;
-  std::vector<int> class_members;  ///< candidate index of each class_boxes entry
   std::vector<int> kept;
   std::vector<int> order;  ///< candidates sorted by class
 };
@@ -294,17 +293,15 @@ inline void decode_yolo_outputs(const std::vector<cv::Mat>& outputs, YoloHead he
     std::size_t end = begin;
     s.class_boxes.clear();
     s.class_scores.clear();
-    s.class_members.clear();
     for (; end < s.order.size() && s.class_ids[static_cast<std::size_t>(s.order[end])] == cls; ++end) {
       const std::size_t i = static_cast<std::size_t>(s.order[end]);
       s.class_boxes.push_back(s.boxes[i]);
       s.class_scores.push_back(s.scores[i]);
-      s.class_members.push_back(static_cast<int>(i));
     }
     begin = end;
     s.kept.clear();
-    // NMSBoxes keeps scores strictly above its threshold (which must be >= 0): the candidates already
-    // passed >= min_confidence, so 0 only drops zero scores, never a detection.
+    // NMSBoxes keeps scores strictly above its threshold, which must be >= 0: the candidates already
+    // passed >= min_confidence, so 0 drops only zero scores (possible only with min_confidence 0).
     try {
       cv::dnn::NMSBoxes(s.class_boxes, s.class_scores, 0.f, options.nms_iou, s.kept);
     } catch (const cv::Exception& e) {
