@@ -1,8 +1,8 @@
 include(CMakePackageConfigHelpers)
 
 # One export set per component, so that a host loads only what it asks for and needs only that part's
-# dependencies: core (dyncull, pipeline) Eigen; opencv the OpenCV modules; culler OpenCV core (and
-# calib3d at link time); ceres Ceres.
+# dependencies: core (dyncull, pipeline) Eigen; opencv the OpenCV modules; opencv_dnn those and dnn;
+# culler OpenCV core (and calib3d at link time); ceres Ceres.
 set(DYNCULL_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/dyncull)
 set(DYNCULL_CORE_TARGETS dyncull)
 if(DYNCULL_MASTER_PROJECT)  # otherwise dyncull_pipeline is built only when a target links it
@@ -11,7 +11,7 @@ endif()
 install(TARGETS ${DYNCULL_CORE_TARGETS} EXPORT dyncullTargets)
 install(EXPORT dyncullTargets NAMESPACE dyncull:: DESTINATION ${DYNCULL_CMAKE_DIR})
 set(DYNCULL_COMPONENTS "")
-foreach(_comp opencv culler ceres)
+foreach(_comp opencv opencv_dnn culler ceres)
   if(TARGET dyncull_${_comp})
     list(APPEND DYNCULL_COMPONENTS ${_comp})
     install(TARGETS dyncull_${_comp} EXPORT dyncull-${_comp}Targets)

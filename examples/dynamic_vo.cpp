@@ -42,6 +42,7 @@ struct Args {
   std::string out = "dynamic_vo_out";
   bool quick = false;
   std::string tum, detections;
+  std::string detector;  // --detector CFG,WEIGHTS or MODEL.onnx: boxes found live (vo/live_detector.hpp)
   std::vector<std::string> strategies;  // empty: no culling + every preset
   bool list = false;
   bool diagnose = false;
@@ -78,6 +79,7 @@ void usage(const char* argv0) {
       "                      A malformed line is fatal (exit 1): the count and the first few are\n"
       "                      printed as file:line: reason. Boxes that parse but are invalid (NaN, zero\n"
       "                      size, outside the image) are dropped by the detection filter\n"
+      "%s"
       "  --strategies LIST   subset of strategies, comma separated (default: none + every preset + culler +\n"
       "                      oracle; --list). culler: the recommended preset through the stateful culler as a\n"
       "                      host runs it (ORB descriptors at the tracked keypoints, its own keyframe\n"
@@ -103,7 +105,7 @@ void usage(const char* argv0) {
       "  --jobs N            sequences run in parallel on N threads (default 1)\n"
       "\nscene families (--family):\n%s"
       "\nscene keys (--scene; vectors as x:y or x:y:z):\n%s",
-      argv0, kSuiteFrames, sim::format_scene_families().c_str(), sim::format_scene_keys().c_str());
+      argv0, vo::live_detector_help(), kSuiteFrames, sim::format_scene_families().c_str(), sim::format_scene_keys().c_str());
 }
 
 std::vector<std::string> split(const std::string& s) {
@@ -177,6 +179,8 @@ bool parse_args(int argc, char** argv, Args* a) {
       if (!value(&a->tum)) return false;
     } else if (arg == "--detections") {
       if (!value(&a->detections)) return false;
+    } else if (arg == "--detector") {
+      if (!value(&a->detector)) return false;
     } else if (arg == "--family") {
       if (!value(&v)) return false;
       a->families = split(v);
@@ -211,6 +215,10 @@ bool parse_args(int argc, char** argv, Args* a) {
       std::fprintf(stderr, "dynamic_vo: unknown option '%s' (try --help)\n", arg.c_str());
       return false;
     }
+  }
+  if (!a->detector.empty() && (a->tum.empty() || !a->detections.empty())) {
+    std::fprintf(stderr, "dynamic_vo: --detector runs on a recorded sequence (--tum DIR) and replaces --detections\n");
+    return false;
   }
   if (a->tum_trajectories.empty()) {
     const char* data = std::getenv("DYNCULL_DATA_DIR");
@@ -350,10 +358,17 @@ int main(int argc, char** argv) {
       std::printf("--family / --scene set the synthetic scene: ignored with --tum.\n");
     vo::TumSource source;
     std::string error;
+    // Opened first: a bad model is named before the sequence is read.
+    vo::LiveDetector live;
+    if (!args.detector.empty() && !live.open(args.detector, DetectionOptions<float>{}, &error)) {
+      std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
+      return 1;
+    }
     if (!source.open(args.tum, args.detections, vo::tum_camera_for(args.tum), &error)) {
       std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
       return 1;
     }
+    if (live.enabled()) source.use_live_detector(&live);
     // A TUM directory has no per-pixel motion truth: the oracle and the truth-repaired strategies cannot run there.
     std::vector<vo::StrategySpec> run;
     if (!source.has_detections())
@@ -367,6 +382,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
       return 1;
     }
+    if (live.enabled()) std::printf("%s\n", live.summary().c_str());
     if (!vo::evaluate_against_file(args.tum + "/groundtruth.txt", &rep, ro)) {
       std::printf("%s: no usable groundtruth.txt, ATE not computed (%s)\n", name.c_str(), rep.truth_note.c_str());
     }

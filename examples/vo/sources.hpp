@@ -11,6 +11,8 @@
 #include "dyncull/culling/detections.hpp"
 #include "dyncull/sim/scene.hpp"
 
+#include "live_detector.hpp"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -259,8 +261,10 @@ class TumSource {
 
   int size() const { return static_cast<int>(frames_.size()); }
   PinholeCamera<double> camera() const { return camera_; }
-  bool has_detections() const { return has_detections_; }
+  bool has_detections() const { return has_detections_ || live_ != nullptr; }
   bool has_truth_labels() const { return false; }
+  /// Boxes from this detector, run on each loaded frame, instead of any read from files (null: none).
+  void use_live_detector(LiveDetector* detector) { live_ = detector; }
   /// Malformed detection lines found by the last open() (which then failed).
   std::size_t bad_detection_lines() const { return bad_detection_lines_; }
 
@@ -281,7 +285,9 @@ class TumSource {
     out->instance.release();
     out->motion_m.release();
     out->detections.clear();
-    if (has_detections_) {
+    if (live_ != nullptr) {
+      if (!live_->detect(bgr_, &out->detections, error)) return false;
+    } else if (has_detections_) {
       auto it = detections_.find(detail::stem(p.rgb.path));
       if (it != detections_.end()) out->detections = it->second;
     }
@@ -352,6 +358,7 @@ class TumSource {
   std::map<std::string, std::vector<Detection<float>>> detections_;
   bool has_detections_ = false;
   std::size_t bad_detection_lines_ = 0;
+  LiveDetector* live_ = nullptr;
   cv::Mat bgr_, gray_, depth_;
 };
 
