@@ -77,6 +77,32 @@ TEST(DatasetSource, FramesWithoutDepthRunWithAnEmptyDepthMap) {
   fs::remove_all(dir);
 }
 
+// With distortion in camera.txt the source hands the front end undistorted images (so the pinhole model
+// holds) and moves the boxes with them: pincushion distortion (k1 > 0) pushes the image's rim outwards, so
+// the undistorted corners have no source pixel (0) and a box near the rim moves inwards.
+TEST(DatasetSource, DistortedCameraUndistortsImagesDepthAndBoxes) {
+  const fs::path dir = write_small_folder("distorted");
+  std::ofstream(dir / "camera.txt") << "fx 50\nfy 50\ncx 32\ncy 24\nk1 0.3\ndepth_units_per_metre 1000\n";
+  std::ofstream(dir / "yolo.txt") << "100.0 0 0.8 0.5 0.2 0.2 0.9\n";
+  vo::DatasetOptions o;
+  o.dir = dir.string();
+  o.detections = (dir / "yolo.txt").string();
+  vo::DatasetSource source;
+  std::string error;
+  ASSERT_TRUE(source.open(o, &error)) << error;
+  vo::SequenceFrame f;
+  ASSERT_TRUE(source.load(0, &f, &error)) << error;
+  EXPECT_EQ(f.gray.at<std::uint8_t>(24, 32), 90);
+  EXPECT_EQ(f.gray.at<std::uint8_t>(0, 0), 0);
+  EXPECT_FLOAT_EQ(f.depth_m.at<float>(24, 32), 10.0f);
+  EXPECT_EQ(f.depth_m.at<float>(0, 0), 0.0f);
+  ASSERT_EQ(f.detections.size(), 1u);
+  // Distorted box: x 44.8..57.6 plus 5 px padding = 39.8..62.6; undistorted its right edge moves in.
+  EXPECT_LT(f.detections[0].box.x1, 61.0f);
+  EXPECT_GT(f.detections[0].box.x1, f.detections[0].box.x0);
+  fs::remove_all(dir);
+}
+
 TEST(DatasetSource, BadCameraOrDetectionsStopTheOpenWithTheirReason) {
   const fs::path dir = write_small_folder("bad_inputs");
   vo::DatasetOptions o;
