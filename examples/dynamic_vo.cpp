@@ -9,6 +9,7 @@
 
 #include "vo/ablation.hpp"
 #include "vo/culling.hpp"
+#include "vo/dataset.hpp"
 #include "vo/figures.hpp"
 #include "vo/frontend.hpp"
 #include "vo/report.hpp"
@@ -24,6 +25,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -41,8 +43,9 @@ struct Args {
   std::vector<std::uint64_t> seeds = {1, 2, 3};  // scene seeds (SceneOptions::seed); several: median summary
   std::string out = "dynamic_vo_out";
   bool quick = false;
-  std::string tum, detections;
-  std::string detector;  // --detector CFG,WEIGHTS or MODEL.onnx: boxes found live (vo/live_detector.hpp)
+  std::string tum, detections;  // tum: the --dataset folder (--tum is its older name)
+  std::string camera;           // --camera: camera.txt, fx,fy,cx,cy[,k1,k2,p1,p2,k3] or a TUM name
+  std::string detector;         // --detector CFG,WEIGHTS or MODEL.onnx: boxes found live (vo/live_detector.hpp)
   std::vector<std::string> strategies;  // empty: no culling + every preset
   bool list = false;
   bool diagnose = false;
@@ -72,13 +75,21 @@ void usage(const char* argv0) {
       "  --tum-trajectories DIR  directory of the fr3_* recordings (default $DYNCULL_DATA_DIR/tum)\n"
       "  --seeds LIST        scene seeds, comma separated (default 1,2,3). Every sequence runs once per seed\n"
       "                      and, with several, a summary gives the median ATE and pooled labels per strategy\n"
-      "  --tum DIR           run on a TUM RGB-D directory (rgb.txt, depth.txt, optional groundtruth.txt)\n"
-      "                      instead of the synthetic sequences\n"
-      "  --detections PATH   YOLO detections for --tum: a directory of <rgb stem>.txt files or one file of\n"
-      "                      '<rgb timestamp> class cx cy w h [conf]' lines (normalised coordinates).\n"
-      "                      A malformed line is fatal (exit 1): the count and the first few are\n"
-      "                      printed as file:line: reason. Boxes that parse but are invalid (NaN, zero\n"
-      "                      size, outside the image) are dropped by the detection filter\n"
+      "  --dataset DIR       run on a real RGB-D sequence in TUM format (rgb.txt, depth.txt, optional\n"
+      "                      groundtruth.txt, camera.txt, detections/) instead of the synthetic sequences:\n"
+      "                      every frame unless --frames; writes dataset_summary.csv (ATE, RPE over 1 s, lost\n"
+      "                      frames, culls in person boxes / outside boxes, times), the trajectories, the\n"
+      "                      trajectory plot and a strip of annotated frames. --tum DIR is the same\n"
+      "  --camera SPEC       intrinsics for --dataset: a camera.txt (fx fy cx cy [k1 k2 p1 p2 k3]\n"
+      "                      [depth_units_per_metre] as 'key value' lines), fx,fy,cx,cy[,k1,k2,p1,p2,k3], or\n"
+      "                      fr1 / fr2 / fr3 (default: DIR/camera.txt, else TUM's by the folder's name)\n"
+      "  --detections PATH   boxes for --dataset (default DIR/detections when present; 'none': no boxes):\n"
+      "                      a folder of per-frame JSON (frame_id, timestamp, detections[] with class_id,\n"
+      "                      confidence, bbox [x1, y1, x2, y2]) matched by timestamp, a folder of YOLO\n"
+      "                      <rgb stem>.txt files, or one file of '<rgb timestamp> class cx cy w h [conf]'\n"
+      "                      lines (normalised coordinates). A malformed file or line is fatal (exit 1) and\n"
+      "                      named as file:line: reason. Boxes that parse but are invalid (NaN, zero size,\n"
+      "                      outside the image) are dropped by the detection filter\n"
       "%s"
       "  --strategies LIST   subset of strategies, comma separated (default: none + every preset + culler +\n"
       "                      oracle; --list). culler: the recommended preset through the stateful culler as a\n"
@@ -175,8 +186,10 @@ bool parse_args(int argc, char** argv, Args* a) {
       a->strategies = split(v);
     } else if (arg == "--out") {
       if (!value(&a->out)) return false;
-    } else if (arg == "--tum") {
+    } else if (arg == "--tum" || arg == "--dataset") {
       if (!value(&a->tum)) return false;
+    } else if (arg == "--camera") {
+      if (!value(&a->camera)) return false;
     } else if (arg == "--detections") {
       if (!value(&a->detections)) return false;
     } else if (arg == "--detector") {
@@ -217,7 +230,7 @@ bool parse_args(int argc, char** argv, Args* a) {
     }
   }
   if (!a->detector.empty() && (a->tum.empty() || !a->detections.empty())) {
-    std::fprintf(stderr, "dynamic_vo: --detector runs on a recorded sequence (--tum DIR) and replaces --detections\n");
+    std::fprintf(stderr, "dynamic_vo: --detector runs on a recorded sequence (--dataset DIR) and replaces --detections\n");
     return false;
   }
   if (a->tum_trajectories.empty()) {
@@ -302,6 +315,48 @@ std::vector<vo::StripFrame> family_frames(const std::vector<vo::SequenceReport>&
   return out;
 }
 
+/// dynamic_vo --dataset DIR: the real sequence with every chosen strategy; prints and writes the summary.
+int run_dataset_command(const Args& args, const std::vector<vo::StrategySpec>& chosen, vo::RunnerOptions ro,
+                        int argc, char** argv) {
+  const auto t0 = std::chrono::steady_clock::now();
+  vo::DatasetOptions o;
+  o.dir = args.tum;
+  o.detections = args.detections;
+  o.camera = args.camera;
+  o.strategies = chosen;
+  if (!args.frames_set && !args.quick) ro.max_frames = std::numeric_limits<int>::max();  // the whole sequence
+  o.runner = ro;
+  vo::DatasetRun run;
+  std::string error;
+  // Opened first: a bad model is named before the sequence is read.
+  vo::LiveDetector live;
+  if (!args.detector.empty()) {
+    if (!live.open(args.detector, o.sequence.detection_filter, &error)) {
+      std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
+      return 1;
+    }
+    o.live_detector = &live;
+  }
+  if (!vo::run_dataset(o, &run, &error)) {
+    std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
+    return 1;
+  }
+  if (live.enabled()) std::printf("%s\n", live.summary().c_str());
+  std::printf("camera: %s; detections: %s\n", run.camera_source.c_str(),
+              run.detections_path.empty() ? "none" : run.detections_path.c_str());
+  for (const std::string& n : run.notes) std::printf("note: %s\n", n.c_str());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::ostringstream cmd;
+  for (int i = 0; i < argc; ++i) cmd << (i ? " " : "") << argv[i];
+  const std::string md = vo::dataset_summary_md(run, cmd.str(), seconds);
+  std::printf("\n%s", md.c_str());
+  std::ofstream(args.out + "/dataset_summary.md") << md;
+  std::ofstream(args.out + "/results.md") << vo::format_table({run.report}, cmd.str(), seconds);
+  std::printf("\nwrote %s/dataset_summary.md\nwrote %s/results.md\n", args.out.c_str(), args.out.c_str());
+  for (const std::string& f : run.files) std::printf("wrote %s\n", f.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -355,38 +410,8 @@ int main(int argc, char** argv) {
 
   if (!args.tum.empty()) {
     if (args.families_set || !args.scene.empty())
-      std::printf("--family / --scene set the synthetic scene: ignored with --tum.\n");
-    vo::TumSource source;
-    std::string error;
-    // Opened first: a bad model is named before the sequence is read.
-    vo::LiveDetector live;
-    if (!args.detector.empty() && !live.open(args.detector, DetectionOptions<float>{}, &error)) {
-      std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
-      return 1;
-    }
-    if (!source.open(args.tum, args.detections, vo::tum_camera_for(args.tum), &error)) {
-      std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
-      return 1;
-    }
-    if (live.enabled()) source.use_live_detector(&live);
-    // A TUM directory has no per-pixel motion truth: the oracle and the truth-repaired strategies cannot run there.
-    std::vector<vo::StrategySpec> run;
-    if (!source.has_detections())
-      std::printf("No detections given (--detections): running only the strategies that need none.\n");
-    for (const auto& s : chosen)
-      if (!s.needs_truth() && (source.has_detections() || !s.needs_detections)) run.push_back(s);
-    std::string name = std::filesystem::path(args.tum).filename().string();
-    if (name.empty()) name = std::filesystem::path(args.tum).parent_path().filename().string();
-    vo::SequenceReport rep;
-    if (!vo::run_sequence(name, source, run, ro, &rep, &error)) {
-      std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
-      return 1;
-    }
-    if (live.enabled()) std::printf("%s\n", live.summary().c_str());
-    if (!vo::evaluate_against_file(args.tum + "/groundtruth.txt", &rep, ro)) {
-      std::printf("%s: no usable groundtruth.txt, ATE not computed (%s)\n", name.c_str(), rep.truth_note.c_str());
-    }
-    reports.push_back(std::move(rep));
+      std::printf("--family / --scene set the synthetic scene: ignored with --dataset.\n");
+    return run_dataset_command(args, chosen, ro, argc, argv);
   } else {
     std::map<std::string, sim::TrajectoryOptions> recorded;  // the recordings, loaded once
     for (const std::string& seq : args.sequences) {

@@ -77,9 +77,9 @@ struct StripFrame {
 };
 
 /// Tiles the annotated frames (those that exist), each scaled to `tile_width` with its label on top, into
-/// rows of `per_row`; false when none could be read.
+/// rows of `per_row`, each channel reduced to `levels` grey levels (256: unchanged); false when none could be read.
 inline bool write_frame_strip(const std::string& path, const std::vector<StripFrame>& frames, int tile_width = 240,
-                              int per_row = 4) {
+                              int per_row = 4, int levels = 4) {
   std::vector<cv::Mat> tiles;
   for (const StripFrame& f : frames) {
     cv::Mat img = cv::imread(f.path, cv::IMREAD_COLOR);
@@ -100,10 +100,12 @@ inline bool write_frame_strip(const std::string& path, const std::vector<StripFr
     cv::Mat roi = strip(cv::Rect(c * tile_width, r * tile_h, tile_width, std::min(tile_h, tiles[i].rows)));
     tiles[i](cv::Rect(0, 0, tile_width, roi.rows)).copyTo(roi);
   }
-  // Four levels a channel: the scenes' fine texture would otherwise make the PNG ten times larger.
-  strip.forEach<cv::Vec3b>([](cv::Vec3b& px, const int*) {
-    for (int c = 0; c < 3; ++c) px[c] = static_cast<std::uint8_t>((px[c] / 64) * 85);
-  });
+  // Four levels a channel for the sim: its fine texture would otherwise make the PNG ten times larger.
+  const int step = 256 / std::clamp(levels, 2, 256), top = (255 / step) * step;
+  if (step > 1)
+    strip.forEach<cv::Vec3b>([&](cv::Vec3b& px, const int*) {
+      for (int c = 0; c < 3; ++c) px[c] = static_cast<std::uint8_t>((px[c] / step) * step * 255 / top);
+    });
   return cv::imwrite(path, strip, {cv::IMWRITE_PNG_COMPRESSION, 9});
 }
 

@@ -216,12 +216,13 @@ struct RecallBySpeed {
   }
 };
 
-/// A distinct colour per strategy (BGR), ground truth is black.
+/// A distinct colour per strategy (BGR), ground truth is black: as many as dynamic_vo's default strategies
+/// and a few more, so no two strategies of one figure share a colour.
 inline cv::Scalar strategy_colour(std::size_t i) {
-  static const std::array<cv::Scalar, 8> colours = {cv::Scalar(40, 40, 220),  cv::Scalar(40, 160, 40),
-                                                    cv::Scalar(220, 120, 30), cv::Scalar(180, 50, 180),
-                                                    cv::Scalar(30, 160, 220), cv::Scalar(140, 140, 40),
-                                                    cv::Scalar(90, 90, 90),   cv::Scalar(200, 60, 120)};
+  static const std::array<cv::Scalar, 12> colours = {
+      cv::Scalar(40, 40, 220),  cv::Scalar(40, 160, 40),  cv::Scalar(220, 120, 30), cv::Scalar(180, 50, 180),
+      cv::Scalar(30, 160, 220), cv::Scalar(140, 140, 40), cv::Scalar(90, 90, 90),   cv::Scalar(200, 60, 120),
+      cv::Scalar(20, 90, 140),  cv::Scalar(160, 200, 90), cv::Scalar(120, 20, 20),  cv::Scalar(170, 150, 250)};
   return colours[i % colours.size()];
 }
 

@@ -8,6 +8,7 @@
 #include "dyncull/eval/statistics.hpp"
 #include "dyncull/eval/trajectory.hpp"
 
+#include "box_culls.hpp"
 #include "culling.hpp"
 #include "frontend.hpp"
 #include "report.hpp"
@@ -42,6 +43,7 @@ struct StrategyRun {
   StrategySpec spec;
   eval::Trajectory<double> estimate;
   LabelCounts labels;
+  BoxCullCounts box_culls;  ///< culls inside person boxes / outside every box (needs no truth)
   LabelBreakdown breakdown;  ///< filled when RunnerOptions::diagnose
   RecallBySpeed recall_by_speed;  ///< filled when RunnerOptions::diagnose (sim only)
   double cull_ms = 0, front_end_ms = 0;  ///< totals over the frames
@@ -130,6 +132,7 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
       const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
       if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
+      run.box_culls.add(fe.tracks().cur_px, keep, frame.detections);
       if (options.diagnose) {
         run.breakdown.add(fe.tracks().cur_px, keep, cullers[k].reasons(), cullers[k].kept_why(), frame.moving,
                           frame.instance);

@@ -1,0 +1,375 @@
+/// @file dataset.hpp
+/// dynamic_vo --dataset: a real RGB-D sequence in TUM format (Sturm et al. 2012; the Bonn RGB-D Dynamic
+/// layout, Palazzolo et al. 2019) indexed by eval/sequence.hpp, run with each culling strategy and
+/// evaluated as the TUM benchmark does: ATE RMSE after rigid alignment (0.02 s association) and RPE over
+/// 1 s (evaluate_rpe.py --fixed_delta), plus lost frames, where the culls fall relative to the boxes and
+/// culling time against the front end's. Writes dataset_summary.csv / .md, the trajectories (TUM format),
+/// the trajectory plot and a strip of annotated frames.
+#pragma once
+
+#include "dyncull/eval/rpe.hpp"
+#include "dyncull/eval/sequence.hpp"
+
+#include "figures.hpp"
+#include "live_detector.hpp"
+#include "runner.hpp"
+#include "sources.hpp"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace dyncull {
+namespace vo {
+
+/// What to run. Empty detections / camera take the folder's own (DIR/detections, DIR/camera.txt) when
+/// present; detections "none" runs without boxes; camera falls back to TUM's by the folder's name.
+struct DatasetOptions {
+  std::string dir;
+  std::string detections;
+  std::string camera;
+  std::vector<StrategySpec> strategies;
+  RunnerOptions runner;  ///< out_dir, max_frames, front end
+  eval::SequenceOptions sequence;
+  int strip_frames = 4;  ///< annotated frames in the strip (evenly spaced, drawn with the recommended preset)
+  LiveDetector* live_detector = nullptr;  ///< when set (and open), boxes come from it instead of files
+};
+
+/// A TUM-format folder as a frame source of the runner: images loaded with OpenCV, depth scaled by the
+/// camera's depth_units_per_metre, undistorted when the camera has distortion. A frame without depth (no
+/// partner, or an unreadable depth file) runs with an empty depth map (0 = no measurement).
+class DatasetSource {
+ public:
+  bool open(const DatasetOptions& options, std::string* error) {
+    index_ = eval::read_sequence(options.dir, options.sequence);
+    if (!index_.ok()) {
+      *error = index_.reason;
+      return false;
+    }
+    for (const std::string& n : index_.notes.first) notes_.push_back(n);
+    if (index_.notes.count > index_.notes.first.size())
+      notes_.push_back("... and " + std::to_string(index_.notes.count - index_.notes.first.size()) + " more");
+    if (!open_camera(options, error)) return false;
+    std::string det = options.detections;
+    std::error_code ec;
+    if (det.empty() && std::filesystem::exists(options.dir + "/detections", ec)) det = options.dir + "/detections";
+    if (options.live_detector != nullptr && options.live_detector->enabled()) {
+      live_ = options.live_detector;
+      has_detections_ = true;
+      detections_path_ = "the live detector";
+    } else if (!det.empty() && det != "none") {
+      detections_ = eval::read_sequence_detections(det, index_, camera_.width, camera_.height, options.sequence);
+      if (!detections_.ok()) {
+        *error = "detections: " + detections_.reason;
+        return false;
+      }
+      has_detections_ = true;
+      detections_path_ = det;
+      for (const std::string& n : detections_.notes.first) notes_.push_back(n);
+    }
+    return true;
+  }
+
+  int size() const { return static_cast<int>(index_.frames.size()); }
+  PinholeCamera<double> camera() const { return camera_; }
+  const eval::SequenceCamera& sequence_camera() const { return seq_camera_; }
+  const eval::SequenceIndex& index() const { return index_; }
+  bool has_detections() const { return has_detections_; }
+  const std::string& detections_path() const { return detections_path_; }
+  bool has_truth_labels() const { return false; }
+  /// What the reading noted (missing files, frames without depth or boxes), and what load() found.
+  const std::vector<std::string>& notes() const { return notes_; }
+  std::size_t frames_without_depth() const { return index_.frames_without_depth + unreadable_depth_; }
+
+  bool load(int index, SequenceFrame* out, std::string* error) {
+    const eval::SequenceFrame& f = index_.frames[static_cast<std::size_t>(index)];
+    const std::string image_path = index_.dir + "/" + f.image_path;
+    const cv::Mat image = cv::imread(image_path, cv::IMREAD_UNCHANGED);
+    if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3) ||
+        image.cols != camera_.width || image.rows != camera_.height) {
+      *error = image_path + ": cannot read an 8-bit grey or colour image of " + std::to_string(camera_.width) + "x" +
+               std::to_string(camera_.height);
+      return false;
+    }
+    if (image.channels() == 3) {
+      bgr_ = image;
+      cv::cvtColor(image, gray_, cv::COLOR_BGR2GRAY);
+    } else {
+      gray_ = image;
+      bgr_.release();
+    }
+    // The detector sees the image as recorded; its boxes are undistorted below as file boxes are.
+    if (live_ != nullptr && !live_->detect(bgr_.empty() ? gray_ : bgr_, &live_boxes_, error)) return false;
+    depth_.create(gray_.size(), CV_32FC1);
+    depth_.setTo(0);
+    if (f.has_depth()) {
+      const std::string depth_path = index_.dir + "/" + f.depth_path;
+      const cv::Mat raw = cv::imread(depth_path, cv::IMREAD_ANYDEPTH);
+      if (raw.empty() || raw.type() != CV_16UC1 || raw.size() != gray_.size()) {
+        ++unreadable_depth_;
+        notes_.push_back(depth_path + ": not a 16-bit depth image of the grey image's size: frame " +
+                         std::to_string(index) + " runs without depth");
+      } else {
+        raw.convertTo(depth_, CV_32FC1, 1.0 / seq_camera_.depth_units_per_metre);
+      }
+    }
+    if (!map_x_.empty()) {
+      cv::remap(gray_.clone(), gray_, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+      cv::remap(depth_.clone(), depth_, map_x_, map_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);  // no mixed depths
+      if (!bgr_.empty()) cv::remap(bgr_.clone(), bgr_, map_x_, map_y_, cv::INTER_LINEAR);
+    }
+    out->timestamp = f.timestamp;
+    out->gray = gray_;
+    out->depth_m = depth_;
+    out->moving.release();
+    out->instance.release();
+    out->motion_m.release();
+    out->detections.clear();
+    if (live_ != nullptr) out->detections = undistorted(live_boxes_);
+    else if (has_detections_) out->detections = undistorted(detections_.per_frame[static_cast<std::size_t>(index)]);
+    out->has_truth_pose = false;
+    out->bgr.release();
+    return true;
+  }
+  void load_colour(SequenceFrame* out) const {
+    if (!bgr_.empty()) out->bgr = bgr_;
+    else cv::cvtColor(gray_, out->bgr, cv::COLOR_GRAY2BGR);
+  }
+
+ private:
+  bool open_camera(const DatasetOptions& options, std::string* error) {
+    std::error_code ec;
+    eval::CameraResult c;
+    if (!options.camera.empty()) {
+      c = eval::camera_from_spec(options.camera, options.sequence);
+    } else if (std::filesystem::exists(options.dir + "/camera.txt", ec)) {
+      c = eval::read_camera_file(options.dir + "/camera.txt", options.sequence);
+    } else {
+      c = eval::tum_camera(std::filesystem::absolute(options.dir, ec).lexically_normal().string());
+      if (!c.ok()) c = eval::tum_camera("fr3");
+      notes_.push_back("no --camera and no camera.txt: " + c.camera.source + " intrinsics assumed");
+    }
+    if (!c.ok()) {
+      *error = c.reason;
+      return false;
+    }
+    seq_camera_ = c.camera;
+    // The image size is the first image's, whatever camera.txt says.
+    const std::string first = index_.dir + "/" + index_.frames.front().image_path;
+    const cv::Mat image = cv::imread(first, cv::IMREAD_UNCHANGED);
+    if (image.empty()) {
+      *error = first + ": cannot read the first image";
+      return false;
+    }
+    seq_camera_.width = image.cols;
+    seq_camera_.height = image.rows;
+    camera_ = PinholeCamera<double>{seq_camera_.fx, seq_camera_.fy, seq_camera_.cx, seq_camera_.cy, image.cols, image.rows};
+    if (seq_camera_.has_distortion()) {
+      K_ = (cv::Mat_<double>(3, 3) << camera_.fx, 0, camera_.cx, 0, camera_.fy, camera_.cy, 0, 0, 1);
+      dist_ = cv::Mat(1, 5, CV_64F);
+      for (int k = 0; k < 5; ++k) dist_.at<double>(0, k) = seq_camera_.distortion[static_cast<std::size_t>(k)];
+      cv::initUndistortRectifyMap(K_, dist_, cv::Mat(), K_, image.size(), CV_32FC1, map_x_, map_y_);
+    }
+    return true;
+  }
+
+  /// Boxes of the distorted image moved to the undistorted one: the box around the undistorted corners
+  /// and edge midpoints (a detector box is coarse; its shape is kept only approximately).
+  std::vector<Detection<float>> undistorted(const std::vector<Detection<float>>& boxes) const {
+    if (map_x_.empty()) return boxes;
+    std::vector<Detection<float>> out = boxes;
+    for (Detection<float>& d : out) {
+      const float xm = 0.5f * (d.box.x0 + d.box.x1), ym = 0.5f * (d.box.y0 + d.box.y1);
+      std::vector<cv::Point2f> p = {{d.box.x0, d.box.y0}, {d.box.x1, d.box.y0}, {d.box.x0, d.box.y1},
+                                    {d.box.x1, d.box.y1}, {xm, d.box.y0},       {xm, d.box.y1},
+                                    {d.box.x0, ym},       {d.box.x1, ym}},
+                              q;
+      cv::undistortPoints(p, q, K_, dist_, cv::noArray(), K_);
+      const cv::Rect2f r = cv::boundingRect(q);
+      const float w = static_cast<float>(camera_.width - 1), h = static_cast<float>(camera_.height - 1);
+      d.box.x0 = std::clamp(r.x, 0.f, w);
+      d.box.y0 = std::clamp(r.y, 0.f, h);
+      d.box.x1 = std::clamp(r.x + r.width, 0.f, w);
+      d.box.y1 = std::clamp(r.y + r.height, 0.f, h);
+    }
+    return out;
+  }
+
+  eval::SequenceIndex index_;
+  eval::SequenceDetections detections_;
+  LiveDetector* live_ = nullptr;
+  std::vector<Detection<float>> live_boxes_;
+  eval::SequenceCamera seq_camera_;
+  PinholeCamera<double> camera_;
+  bool has_detections_ = false;
+  std::string detections_path_;
+  std::vector<std::string> notes_;
+  std::size_t unreadable_depth_ = 0;
+  cv::Mat K_, dist_, map_x_, map_y_;
+  cv::Mat gray_, depth_, bgr_;
+};
+
+/// One row of dataset_summary.csv.
+struct DatasetRow {
+  std::string strategy;
+  bool culls = false, recommended = false;
+  std::size_t frames = 0, lost_frames = 0, keyframes = 0;
+  double ate_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  std::size_t ate_pairs = 0;
+  double rpe_trans_m = std::numeric_limits<double>::quiet_NaN();  ///< RMSE over 1 s
+  double rpe_rot_deg = std::numeric_limits<double>::quiet_NaN();
+  std::size_t rpe_pairs = 0;
+  double culled_in_person_boxes = std::numeric_limits<double>::quiet_NaN();
+  double culled_outside_boxes = std::numeric_limits<double>::quiet_NaN();
+  double cull_ms = 0, front_end_ms = 0;  ///< per frame
+};
+
+struct DatasetRun {
+  SequenceReport report;
+  std::vector<DatasetRow> rows;
+  std::vector<std::string> notes;    ///< from the reader and the run
+  std::vector<std::string> skipped;  ///< strategies that could not run here, with why
+  std::size_t frames_without_depth = 0;
+  std::string camera_source, detections_path;
+  std::vector<std::string> files;    ///< everything written
+};
+
+/// dataset_summary.csv: one row per strategy.
+inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
+  std::ostringstream o;
+  o << "strategy,frames,lost_frames,keyframes,ate_rmse_m,ate_pairs,rpe_trans_m,rpe_rot_deg,rpe_pairs,"
+       "culled_in_person_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end\n";
+  auto num = [](double v, const char* f) { return std::isfinite(v) ? fmt(v, f) : std::string(); };
+  for (const DatasetRow& r : rows) {
+    o << r.strategy << "," << r.frames << "," << r.lost_frames << "," << r.keyframes << "," << num(r.ate_rmse_m, "%.6f")
+      << "," << r.ate_pairs << "," << num(r.rpe_trans_m, "%.6f") << "," << num(r.rpe_rot_deg, "%.4f") << ","
+      << r.rpe_pairs << "," << (r.culls ? num(r.culled_in_person_boxes, "%.4f") : "0") << ","
+      << (r.culls ? num(r.culled_outside_boxes, "%.4f") : "0") << "," << num(r.cull_ms, "%.4f") << ","
+      << num(r.front_end_ms, "%.3f") << ","
+      << (r.culls && r.front_end_ms > 0 ? num(r.cull_ms / r.front_end_ms, "%.4f") : "") << "\n";
+  }
+  return o.str();
+}
+
+/// The same as a Markdown table (ATE and RPE in cm).
+inline std::string dataset_summary_md(const DatasetRun& run, const std::string& command, double seconds) {
+  std::ostringstream o;
+  o << "| strategy | ATE RMSE (cm) | RPE 1 s (cm) | RPE 1 s (deg) | lost frames | keyframes | culled in person boxes "
+       "| culled outside boxes | cull ms/frame | front end ms/frame | cull / front end |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const DatasetRow& r : run.rows) {
+    o << "| " << r.strategy << (r.recommended ? " (default)" : "") << " | " << fmt(100 * r.ate_rmse_m, "%.2f") << " | "
+      << fmt(100 * r.rpe_trans_m, "%.2f") << " | " << fmt(r.rpe_rot_deg, "%.2f") << " | " << r.lost_frames << " of "
+      << r.frames << " | " << r.keyframes << " | "
+      << (r.culls ? fmt(100 * r.culled_in_person_boxes, "%.1f %%") : "-") << " | "
+      << (r.culls ? fmt(100 * r.culled_outside_boxes, "%.1f %%") : "-") << " | " << fmt(r.cull_ms, "%.2f") << " | "
+      << fmt(r.front_end_ms, "%.1f") << " | " << (r.culls ? fmt(r.cull_ms / r.front_end_ms, "%.3f") : "-") << " |\n";
+  }
+  o << "\nATE: TUM evaluate_ate.py (0.02 s association, rigid SE(3) alignment, RMSE). RPE: evaluate_rpe.py "
+       "--fixed_delta --delta 1 --delta_unit s, RMSE over every pair. Lost frames: PnP failed and the pose came from "
+       "the constant-velocity prior. Culled in person boxes / outside boxes: share of the tracked features inside a "
+       "person box / outside every box that the strategy culled. Times: wall clock per frame on this machine.\n";
+  if (run.frames_without_depth > 0) o << "Frames without depth: " << run.frames_without_depth << ".\n";
+  for (const std::string& s : run.skipped) o << "Not run: " << s << ".\n";
+  o << "\nCommand: `" << command << "` (" << fmt(seconds, "%.0f") << " s)\n";
+  return o.str();
+}
+
+namespace detail {
+/// The annotated frames the runner wrote (name_frameNNNN.png), in frame order.
+inline std::vector<StripFrame> dataset_strip(const SequenceReport& report, const std::string& strategy) {
+  std::vector<StripFrame> out;
+  for (const std::string& f : report.files) {
+    const std::size_t at = f.rfind("_frame");
+    if (at == std::string::npos || f.size() < 4 || f.compare(f.size() - 4, 4, ".png") != 0) continue;
+    const int frame = std::atoi(f.c_str() + at + 6);
+    out.push_back({f, "frame " + std::to_string(frame) + ", " + strategy + ": green kept, red culled"});
+  }
+  return out;
+}
+}  // namespace detail
+
+/// Runs every strategy over the folder (RunnerOptions::max_frames frames at most), evaluates it against
+/// DIR/groundtruth.txt and writes the summary, trajectories, plot and strip into runner.out_dir (when
+/// runner.write_outputs). False with `error` when the folder, camera or detections cannot be read, a frame
+/// cannot be loaded, or no strategy can run.
+inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::string* error) {
+  DatasetSource source;
+  if (!source.open(options, error)) return false;
+  out->camera_source = source.sequence_camera().source;
+  out->detections_path = source.has_detections() ? source.detections_path() : std::string();
+  std::vector<StrategySpec> run;
+  for (const StrategySpec& s : options.strategies) {
+    if (s.needs_truth()) out->skipped.push_back(s.name + " (needs the sim's per-pixel motion truth)");
+    else if (s.needs_detections && !source.has_detections()) out->skipped.push_back(s.name + " (needs detections)");
+    else run.push_back(s);
+  }
+  if (run.empty()) {
+    *error = options.dir + ": none of the strategies can run here";
+    return false;
+  }
+  RunnerOptions ro = options.runner;
+  ro.frames_to_draw = options.strip_frames;
+  std::string name = std::filesystem::path(options.dir).filename().string();
+  if (name.empty()) name = std::filesystem::path(options.dir).parent_path().filename().string();
+  if (!run_sequence(name, source, run, ro, &out->report, error)) return false;
+  out->notes = source.notes();
+  out->frames_without_depth = 0;
+  const int n = std::min(source.size(), ro.max_frames);
+  for (int i = 0; i < n; ++i) out->frames_without_depth += source.index().frames[static_cast<std::size_t>(i)].has_depth() ? 0 : 1;
+  if (source.index().groundtruth_path.empty() ||
+      !evaluate_against_file(source.index().groundtruth_path, &out->report, ro))
+    out->notes.push_back(options.dir + ": no usable groundtruth.txt, ATE and RPE not computed" +
+                         (out->report.truth_note.empty() ? std::string() : " (" + out->report.truth_note + ")"));
+  for (const StrategyRun& r : out->report.runs) {
+    DatasetRow row;
+    row.strategy = r.spec.name;
+    row.culls = r.spec.culls;
+    row.recommended = r.spec.recommended;
+    row.frames = r.frames;
+    row.lost_frames = r.fallbacks;
+    row.keyframes = r.keyframes;
+    row.ate_rmse_m = r.has_ate ? r.ate_rmse_m : std::numeric_limits<double>::quiet_NaN();
+    row.ate_pairs = r.ate_pairs;
+    if (!out->report.truth.empty()) {
+      const eval::RpeResult<double> rpe = eval::evaluate_rpe(out->report.truth, r.estimate);
+      if (rpe.ok()) {
+        row.rpe_trans_m = rpe.translation_m.rmse;
+        row.rpe_rot_deg = rpe.rotation_deg.rmse;
+        row.rpe_pairs = rpe.num_pairs;
+      } else {
+        out->notes.push_back(r.spec.name + ": RPE not computed (" + rpe.reason + ")");
+      }
+    }
+    row.culled_in_person_boxes = r.box_culls.culled_in_person_boxes();
+    row.culled_outside_boxes = r.box_culls.culled_outside_boxes();
+    row.cull_ms = r.cull_ms_per_frame();
+    row.front_end_ms = r.front_end_ms_per_frame();
+    out->rows.push_back(row);
+  }
+  if (!ro.write_outputs) return true;
+  const std::string csv = ro.out_dir + "/dataset_summary.csv";
+  std::ofstream(csv) << dataset_summary_csv(out->rows);
+  out->files.push_back(csv);
+  std::string drawn = run.back().name;
+  for (const StrategySpec& s : run)
+    if (s.recommended) drawn = s.name;
+  const std::string strip = ro.out_dir + "/" + name + "_frame_strip.png";
+  if (write_frame_strip(strip, detail::dataset_strip(out->report, drawn), 320, 4, 16)) out->files.push_back(strip);
+  for (const std::string& f : out->report.files) out->files.push_back(f);
+  return true;
+}
+
+}  // namespace vo
+}  // namespace dyncull
