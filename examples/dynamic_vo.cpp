@@ -18,17 +18,20 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -133,7 +136,8 @@ bool parse_int(const std::string& option, const std::string& v, long lo, long hi
   char* end = nullptr;
   const long n = std::strtol(v.c_str(), &end, 10);
   if (end == v.c_str() || *end != '\0' || n < lo || n > hi) {
-    std::fprintf(stderr, "dynamic_vo: %s needs an integer in [%ld, %ld], got '%s'\n", option.c_str(), lo, hi, v.c_str());
+    std::fprintf(stderr, "dynamic_vo: %s needs an integer in [%ld, %ld], got %s\n", option.c_str(), lo, hi,
+                 text::quote_token(v).c_str());
     return false;
   }
   *out = static_cast<int>(n);
@@ -167,13 +171,15 @@ bool parse_args(int argc, char** argv, Args* a) {
       a->seeds_set = true;
       a->seeds.clear();
       for (const std::string& item : split(v)) {
-        char* end = nullptr;
-        const unsigned long long seed = std::strtoull(item.c_str(), &end, 10);
-        if (end == item.c_str() || *end != '\0' || item[0] == '-') {
-          std::fprintf(stderr, "dynamic_vo: --seeds needs non-negative integers, got '%s'\n", item.c_str());
+        // Exact: from_chars refuses what does not fit (strtoull would saturate 2^64 to 2^64 - 1).
+        std::uint64_t seed = 0;
+        const std::from_chars_result r = std::from_chars(item.data(), item.data() + item.size(), seed);
+        if (r.ec != std::errc() || r.ptr != item.data() + item.size()) {
+          std::fprintf(stderr, "dynamic_vo: --seeds needs integers in [0, 18446744073709551615] (64-bit seeds), got %s\n",
+                       text::quote_token(item).c_str());
           return false;
         }
-        a->seeds.push_back(static_cast<std::uint64_t>(seed));
+        a->seeds.push_back(seed);
       }
       if (a->seeds.empty()) {
         std::fprintf(stderr, "dynamic_vo: --seeds needs at least one seed\n");
@@ -225,7 +231,7 @@ bool parse_args(int argc, char** argv, Args* a) {
     } else if (arg == "--list") {
       a->list = true;
     } else {
-      std::fprintf(stderr, "dynamic_vo: unknown option '%s' (try --help)\n", arg.c_str());
+      std::fprintf(stderr, "dynamic_vo: unknown option %s (try --help)\n", text::quote_token(arg).c_str());
       return false;
     }
   }
@@ -272,13 +278,13 @@ bool is_recorded(const std::string& name) { return name.rfind("fr3_", 0) == 0; }
 /// Loads <dir>/<name>/groundtruth.txt as the recorded camera motion; false with a reason.
 bool load_recorded(const std::string& dir, const std::string& name, sim::TrajectoryOptions* t, std::string* error) {
   if (dir.empty()) {
-    *error = "sequence '" + name + "' needs the TUM trajectories: set DYNCULL_DATA_DIR or give --tum-trajectories DIR";
+    *error = "sequence " + text::quote_token(name) + " needs the TUM trajectories: set DYNCULL_DATA_DIR or give --tum-trajectories DIR";
     return false;
   }
   const std::string path = dir + "/" + name + "/groundtruth.txt";
   const eval::TrajectoryReadResult<double> gt = eval::read_tum_trajectory<double>(path);
   if (!gt.ok() || gt.trajectory.size() < 2) {
-    *error = "sequence '" + name + "': " + (gt.ok() ? path + " has fewer than 2 poses" : gt.reason);
+    *error = "sequence " + text::quote_token(name) + ": " + (gt.ok() ? text::quote_path(path) + " has fewer than 2 poses" : gt.reason);
     return false;
   }
   t->recorded_stamps_s = gt.trajectory.stamps;
@@ -359,7 +365,9 @@ int run_dataset_command(const Args& args, const std::vector<vo::StrategySpec>& c
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// Every failure has a reason and a status; an exception reaching here (OpenCV refusing an input the
+// checks above missed) still ends with a message and exit 1, never an abort.
+int main(int argc, char** argv) try {
   Args args;
   if (!parse_args(argc, argv, &args)) return 2;
 
@@ -385,7 +393,7 @@ int main(int argc, char** argv) {
         }
       }
       if (!found) {
-        std::fprintf(stderr, "dynamic_vo: unknown strategy '%s' (try --list)\n", name.c_str());
+        std::fprintf(stderr, "dynamic_vo: unknown strategy %s (try --list)\n", text::quote_token(name).c_str());
         return 2;
       }
     }
@@ -396,7 +404,7 @@ int main(int argc, char** argv) {
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   if (ec) {
-    std::fprintf(stderr, "dynamic_vo: cannot create %s: %s\n", args.out.c_str(), ec.message().c_str());
+    std::fprintf(stderr, "dynamic_vo: cannot create %s: %s\n", text::quote_path(args.out).c_str(), ec.message().c_str());
     return 1;
   }
 
@@ -423,8 +431,8 @@ int main(int argc, char** argv) {
           return 2;
         }
       } else if (!motion_from_name(seq, &m)) {
-        std::fprintf(stderr, "dynamic_vo: unknown sequence '%s' (static, xyz, rpy, halfsphere, fr3_<TUM sequence>)\n",
-                     seq.c_str());
+        std::fprintf(stderr, "dynamic_vo: unknown sequence %s (static, xyz, rpy, halfsphere, fr3_<TUM sequence>)\n",
+                     text::quote_token(seq).c_str());
         return 2;
       }
     }
@@ -475,8 +483,13 @@ int main(int argc, char** argv) {
         rep.family = jobs[k].family;
         rep.sequence = jobs[k].sequence;
         rep.seed = jobs[k].seed;
-        if (!vo::run_sequence(jobs[k].name, source, chosen, ro, &rep, &errors[k])) continue;
-        vo::evaluate_against_recorded_truth(&rep, ro);
+        try {
+          if (!vo::run_sequence(jobs[k].name, source, chosen, ro, &rep, &errors[k])) continue;
+          vo::evaluate_against_recorded_truth(&rep, ro);
+        } catch (const std::exception& e) {  // a worker thread's exception would abort the process
+          errors[k] = jobs[k].name + ": stopped by an unexpected error: " + e.what();
+          continue;
+        }
         if (quiet)
           std::printf("[%zu/%zu] %s: %.0f s\n", ++finished, jobs.size(), jobs[k].name.c_str(),
                       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
@@ -540,4 +553,7 @@ int main(int argc, char** argv) {
   }
   if (several_families) std::printf("wrote %zu trajectory files and images under %s\n", files, args.out.c_str());
   return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "dynamic_vo: stopped by an unexpected error: %s\n", e.what());
+  return 1;
 }

@@ -337,7 +337,10 @@ class FrontEnd {
     const cv::Mat& gray = frame_.gray;
     mask_.create(gray.size(), CV_8UC1);
     mask_.setTo(0);
-    const int b = options_.border_px;
+    // An image no wider or taller than its two borders has no room for a feature: the rectangle
+    // would be empty or negative (which OpenCV refuses with an exception).
+    const int b = std::max(0, options_.border_px);
+    if (gray.cols <= 2 * b || gray.rows <= 2 * b) return;
     mask_(cv::Rect(b, b, gray.cols - 2 * b, gray.rows - 2 * b)).setTo(255);
     for (const cv::Point2f& p : tracks_.cur_px)
       cv::circle(mask_, cv::Point(cvRound(p.x), cvRound(p.y)), options_.min_feature_distance_px, cv::Scalar(0), -1);

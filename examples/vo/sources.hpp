@@ -7,6 +7,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/text.hpp"
+#include "dyncull/core/text_file.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/detections.hpp"
 #include "dyncull/sim/scene.hpp"
@@ -21,9 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -101,48 +100,36 @@ struct StampedFile {
   std::string path;
 };
 
-/// Reads a whole text file; false with "path: why" for a directory or an unreadable path.
-inline bool read_text_file(const std::string& path, std::string* text, std::string* error) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    *error = path + ": is a directory, not a detections file";
-    return false;
-  }
-  std::ifstream in(path, std::ios::in | std::ios::binary);
-  if (!in) {
-    *error = path + ": cannot open for reading";
-    return false;
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) {
-    *error = path + ": read error";
-    return false;
-  }
-  *text = ss.str();
-  return true;
-}
+/// Lines of the demo's list and detection files: at most this many per file (a TUM sequence lists
+/// a few thousand images; a detections file a few per image).
+constexpr std::size_t kMaxListLines = 1000000;
 
-/// TUM list file: "timestamp filename" per line (more fields ignored), '#' comments. The stamp is a
-/// number as Python's float() reads it, whatever the locale; errors name file:line.
+/// TUM list file: "timestamp filename" per line (more fields ignored), '#' comments, read line by line
+/// (text::LineReader: regular files only, bounded lines). The stamp is a number as Python's float()
+/// reads it, whatever the locale; errors name file:line.
 inline bool read_tum_list(const std::string& file, std::vector<StampedFile>* out, std::string* error) {
-  std::string text;
-  if (!read_text_file(file, &text, error)) return false;
-  const std::string_view all(text);
-  int line_no = 0;
-  for (std::size_t pos = 0; pos < all.size();) {
-    std::size_t end = all.find('\n', pos);
-    if (end == std::string_view::npos) end = all.size();
-    const std::string_view line = all.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  text::LineReaderOptions limits;
+  limits.max_lines = kMaxListLines;
+  text::LineReader in;
+  if (!in.open(file, limits)) {
+    *error = in.error();
+    return false;
+  }
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  std::string_view line;
+  for (text::LineStatus s; (s = in.next(&line)) != text::LineStatus::End;) {
+    if (s == text::LineStatus::TooManyLines || s == text::LineStatus::ReadError) {
+      *error = in.error();
+      return false;
+    }
     std::size_t k = 0;
     while (k < line.size() && space(line[k])) ++k;
-    if (k == line.size() || line[k] == '#') continue;
-    const std::string where = file + ":" + std::to_string(line_no) + ": ";
-    if (line.size() > text::kMaxLineChars) {
-      *error = where + "line is " + std::to_string(line.size()) + " bytes long";
+    if (k < line.size() && line[k] == '#') continue;
+    if (k == line.size() && s == text::LineStatus::Line) continue;
+    const std::string where = text::line_location(in);
+    if (s == text::LineStatus::TooLong) {
+      *error = where + "line is " + std::to_string(in.line_chars()) + " bytes long (limit " +
+               std::to_string(text::kMaxLineChars) + ")";
       return false;
     }
     std::string_view fields[2];
@@ -158,8 +145,12 @@ inline bool read_tum_list(const std::string& file, std::vector<StampedFile>* out
       return false;
     }
     StampedFile f;
-    if (text::parse_python_float(fields[0], &f.timestamp) != text::NumberStatus::Ok || !std::isfinite(f.timestamp)) {
+    if (text::parse_python_float(fields[0], &f.timestamp) != text::NumberStatus::Ok) {
       *error = where + "timestamp " + text::quote_token(fields[0]) + " is not a number";
+      return false;
+    }
+    if (!std::isfinite(f.timestamp)) {
+      *error = where + "timestamp " + text::quote_token(fields[0]) + " is not finite";
       return false;
     }
     f.path = std::string(fields[1]);
@@ -193,17 +184,49 @@ struct DetectionLineErrors {
   }
 };
 
-/// YOLO text ("class cx cy w h [conf]" normalised per line) -> pixel detections through dyncull's
-/// conversion (RTD-SLAM eq. 1-2) and filter; malformed lines go to `errors` as `file`:line (line numbers
-/// counted from `first_line`).
-inline void yolo_text_to_detections(std::string_view text, int width, int height, const std::string& file,
-                                    int first_line, std::vector<Detection<float>>* out, DetectionLineErrors* errors) {
-  const YoloParseResult<float> parsed = parse_yolo_lines<float>(text, file);
-  for (const YoloParseError& e : parsed.errors) errors->add(file, first_line - 1 + e.line, e.message);
+/// Boxes that parsed but the detection filter dropped (non-finite, zero size, outside the image, low
+/// confidence): the count by reason and the first few as "file:line: why", so none is dropped unseen.
+struct DroppedBoxes {
+  static constexpr std::size_t kListed = 5;
+  std::size_t count = 0, total = 0;
+  std::size_t by_reason[6] = {0, 0, 0, 0, 0, 0};  ///< indexed by BoxRejection
+  std::vector<std::string> first;
+  std::string format() const {
+    if (count == 0) return {};
+    std::string out = std::to_string(count) + " of " + std::to_string(total) + " boxes dropped by the detection filter (";
+    bool comma = false;
+    for (std::size_t r = 1; r < 6; ++r) {
+      if (by_reason[r] == 0) continue;
+      out += (comma ? ", " : "") + std::to_string(by_reason[r]) + " " + to_string(static_cast<BoxRejection>(r));
+      comma = true;
+    }
+    out += ")";
+    for (const std::string& e : first) out += "\n  " + e;
+    if (count > first.size()) out += "\n  ...";
+    return out;
+  }
+};
+
+/// Parsed YOLO lines -> pixel detections through dyncull's conversion (RTD-SLAM eq. 1-2) and filter;
+/// malformed lines go to `errors`, boxes the filter drops to `dropped`, both as `file`:line.
+inline void yolo_lines_to_detections(const YoloParseResult<float>& parsed, int width, int height,
+                                     const std::string& file, std::vector<Detection<float>>* out,
+                                     DetectionLineErrors* errors, DroppedBoxes* dropped) {
+  const std::string shown = text::quote_path(file);
+  for (const YoloParseError& e : parsed.errors) errors->add(shown, e.line, e.message);
   // Bad lines beyond the listed ones are counted only.
   errors->count += parsed.num_bad_lines - parsed.errors.size();
   const DetectionsResult<float> boxes = convert_yolo_detections<float>(parsed.boxes, width, height);
   out->insert(out->end(), boxes.detections.begin(), boxes.detections.end());
+  dropped->total += boxes.rejections.size();
+  for (std::size_t i = 0; i < boxes.rejections.size() && i < parsed.line_of_box.size(); ++i) {
+    const BoxRejection why = boxes.rejections[i];
+    if (why == BoxRejection::None) continue;
+    ++dropped->count;
+    ++dropped->by_reason[static_cast<std::size_t>(why) < 6 ? static_cast<std::size_t>(why) : 0];
+    if (dropped->first.size() < DroppedBoxes::kListed)
+      dropped->first.push_back(shown + ":" + std::to_string(parsed.line_of_box[i]) + ": " + to_string(why));
+  }
 }
 
 }  // namespace detail
@@ -224,11 +247,13 @@ class TumSource {
     frames_.clear();
     detections_.clear();
     bad_detection_lines_ = 0;
+    dropped_boxes_ = 0;
+    detection_note_.clear();
     std::vector<detail::StampedFile> rgb, depth;
     if (!detail::read_tum_list(dir + "/rgb.txt", &rgb, error)) return false;
     if (!detail::read_tum_list(dir + "/depth.txt", &depth, error)) return false;
     if (rgb.empty() || depth.empty()) {
-      *error = dir + ": rgb.txt or depth.txt lists no images";
+      *error = text::quote_path(dir) + ": rgb.txt or depth.txt lists no images";
       return false;
     }
     std::sort(depth.begin(), depth.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
@@ -248,7 +273,7 @@ class TumSource {
       if (best) frames_.push_back({r, *best});
     }
     if (frames_.empty()) {
-      *error = dir + ": no RGB image has a depth image within 0.02 s";
+      *error = text::quote_path(dir) + ": no RGB image has a depth image within 0.02 s";
       return false;
     }
     has_detections_ = false;
@@ -267,13 +292,26 @@ class TumSource {
   void use_live_detector(LiveDetector* detector) { live_ = detector; }
   /// Malformed detection lines found by the last open() (which then failed).
   std::size_t bad_detection_lines() const { return bad_detection_lines_; }
+  /// Boxes that parsed but the detection filter dropped at the last open() (non-finite such as 1e400,
+  /// zero size, outside the image, low confidence), and what to tell the user about them ("" if none).
+  std::size_t dropped_boxes() const { return dropped_boxes_; }
+  const std::string& detection_note() const { return detection_note_; }
 
   bool load(int index, SequenceFrame* out, std::string* error) {
     const Pair& p = frames_[static_cast<std::size_t>(index)];
+    // imread would block on a FIFO and read a device without end: regular files only.
+    for (const std::string* image : {&p.rgb.path, &p.depth.path}) {
+      const std::string problem = text::regular_file_problem(dir_ + "/" + *image);
+      if (!problem.empty()) {
+        *error = problem;
+        return false;
+      }
+    }
     bgr_ = cv::imread(dir_ + "/" + p.rgb.path, cv::IMREAD_COLOR);
     const cv::Mat raw = cv::imread(dir_ + "/" + p.depth.path, cv::IMREAD_ANYDEPTH);
     if (bgr_.empty() || raw.empty() || raw.type() != CV_16UC1 || raw.size() != bgr_.size()) {
-      *error = "cannot read " + p.rgb.path + " / " + p.depth.path + " (need 8-bit colour and 16-bit depth of equal size)";
+      *error = "cannot read " + text::quote_path(p.rgb.path) + " / " + text::quote_path(p.depth.path) +
+               " (need 8-bit colour and 16-bit depth of equal size)";
       return false;
     }
     cv::cvtColor(bgr_, gray_, cv::COLOR_BGR2GRAY);
@@ -304,51 +342,73 @@ class TumSource {
 
   bool load_detections(const std::string& path, std::string* error) {
     detail::DetectionLineErrors bad;
+    detail::DroppedBoxes dropped;
     std::error_code ec;
-    std::string text;
+    text::LineReaderOptions limits;
+    limits.max_lines = detail::kMaxListLines;
+    text::LineReader in;
+    std::string_view line;
+    const auto read_error = [&](text::LineStatus s) {
+      if (s != text::LineStatus::TooManyLines && s != text::LineStatus::ReadError) return false;
+      *error = "detections " + in.error();
+      return true;
+    };
     if (std::filesystem::is_directory(path, ec)) {
       // One label file per RGB image; YOLO writes none for an image without detections.
       for (const Pair& p : frames_) {
         const std::string key = detail::stem(p.rgb.path);
         const std::string file = path + "/" + key + ".txt";
         if (!std::filesystem::exists(file, ec)) continue;
-        if (!detail::read_text_file(file, &text, error)) return false;
-        detail::yolo_text_to_detections(text, camera_.width, camera_.height, file, 1, &detections_[key], &bad);
+        if (!in.open(file, limits)) {
+          *error = "detections " + in.error();
+          return false;
+        }
+        YoloParseResult<float> parsed;
+        for (text::LineStatus s; (s = in.next(&line)) != text::LineStatus::End;) {
+          if (read_error(s)) return false;
+          add_yolo_line(line, in.line_chars(), static_cast<int>(in.line_number()), file, &parsed);
+        }
+        detail::yolo_lines_to_detections(parsed, camera_.width, camera_.height, file, &detections_[key], &bad, &dropped);
       }
     } else {
-      if (!detail::read_text_file(path, &text, error)) return false;
       // One file for the sequence: the first field keys the RGB image, the rest is a YOLO line.
-      const std::string_view all(text);
-      int line_no = 0;
-      for (std::size_t pos = 0; pos < all.size();) {
-        std::size_t end = all.find('\n', pos);
-        if (end == std::string_view::npos) end = all.size();
-        const std::string_view line = all.substr(pos, end - pos);
-        pos = end + 1;
-        ++line_no;
+      if (!in.open(path, limits)) {
+        *error = "detections " + in.error();
+        return false;
+      }
+      const std::string shown = text::quote_path(path);
+      YoloParseResult<float> parsed;
+      for (text::LineStatus s; (s = in.next(&line)) != text::LineStatus::End;) {
+        if (read_error(s)) return false;
+        const int line_no = static_cast<int>(in.line_number());
         const std::size_t first = line.find_first_not_of(" \t\r");
-        if (first == std::string_view::npos || line[first] == '#') continue;
-        if (line.size() > text::kMaxLineChars) {
-          bad.add(path, line_no, "line is " + std::to_string(line.size()) + " bytes long (limit " +
-                                     std::to_string(text::kMaxLineChars) + ")");
+        if (first != std::string_view::npos && line[first] == '#') continue;
+        if (first == std::string_view::npos && s == text::LineStatus::Line) continue;
+        if (s == text::LineStatus::TooLong) {
+          bad.add(shown, line_no, "line is " + std::to_string(in.line_chars()) + " bytes long (limit " +
+                                      std::to_string(text::kMaxLineChars) + ")");
           continue;
         }
         const std::size_t split = line.find_first_of(" \t", first);
         const std::size_t rest = split == std::string_view::npos ? line.size() : line.find_first_not_of(" \t\r", split);
         if (rest == std::string_view::npos || rest >= line.size()) {
-          bad.add(path, line_no, "expected '<rgb timestamp or stem> class cx cy w h [conf]'");
+          bad.add(shown, line_no, "expected '<rgb timestamp or stem> class cx cy w h [conf]'");
           continue;
         }
         const std::string key(line.substr(first, std::min<std::size_t>(split, line.size()) - first));
-        detail::yolo_text_to_detections(line.substr(split), camera_.width, camera_.height, path, line_no,
-                                        &detections_[key], &bad);
+        parsed = YoloParseResult<float>();
+        const std::string_view yolo = line.substr(split);
+        add_yolo_line(yolo, yolo.size(), line_no, path, &parsed);
+        detail::yolo_lines_to_detections(parsed, camera_.width, camera_.height, path, &detections_[key], &bad, &dropped);
       }
     }
     bad_detection_lines_ = bad.count;
     if (bad.count > 0) {
-      *error = "detections " + path + ": " + bad.format();
+      *error = "detections " + text::quote_path(path) + ": " + bad.format();
       return false;
     }
+    dropped_boxes_ = dropped.count;
+    if (dropped.count > 0) detection_note_ = "detections " + text::quote_path(path) + ": " + dropped.format();
     return true;
   }
 
@@ -359,6 +419,8 @@ class TumSource {
   bool has_detections_ = false;
   std::size_t bad_detection_lines_ = 0;
   LiveDetector* live_ = nullptr;
+  std::size_t dropped_boxes_ = 0;
+  std::string detection_note_;
   cv::Mat bgr_, gray_, depth_;
 };
 

@@ -65,6 +65,28 @@ TEST(QuoteToken, IsBoundedAndEscapesBytesOutsidePrintableAscii) {
   EXPECT_EQ(q, "'" + std::string(kQuotedTokenChars, 'x') + "'... (1000 bytes)");
 }
 
+TEST(QuoteToken, PathsAreEscapedTheSameWayWithoutQuotes) {
+  EXPECT_EQ(quote_path("data/rgb.txt"), "data/rgb.txt");
+  EXPECT_EQ(quote_path("it's\x1b[2J"), "it's\\x1b[2J");
+  EXPECT_EQ(quote_token("a\\b"), "'a\\x5cb'");
+  const std::string long_path(5000, 'p');
+  EXPECT_EQ(quote_path(long_path), std::string(kQuotedPathChars, 'p') + "... (5000 bytes)");
+}
+
+TEST(IntegerInRange, ConvertsOnlyIntegersInsideTheBounds) {
+  long long n = -7;
+  EXPECT_TRUE(integer_in_range(1e15, 0, 1000000000000000LL, &n));
+  EXPECT_EQ(n, 1000000000000000LL);
+  EXPECT_TRUE(integer_in_range(-3.0, -5, 5, &n));
+  EXPECT_EQ(n, -3);
+  n = -7;
+  for (double bad : {1e15 + 1, 0.5, -1.0, std::nan(""), HUGE_VAL, -HUGE_VAL, 1e300, 9223372036854775808.0})
+    EXPECT_FALSE(integer_in_range(bad, 0, 1000000000000000LL, &n)) << bad;
+  // Bounds that round up in double never let 2^63 through.
+  EXPECT_FALSE(integer_in_range(9223372036854775808.0, 0, std::numeric_limits<long long>::max(), &n));
+  EXPECT_EQ(n, -7);
+}
+
 TEST(FitsScalar, NamesTheRangeOfEachType) {
   EXPECT_TRUE(fits_scalar<float>(3e38));
   EXPECT_FALSE(fits_scalar<float>(1e39));

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "support/locale.hpp"
+#include "support/special_files.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -222,6 +223,61 @@ TEST(TrajectoryIo, DirectoryIsIoError) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(TrajectoryIo, FifoAndDeviceAreRefusedPromptlyNamingThePath) {
+  test::ScratchDir dir;
+  const std::string fifo = dir / "est.txt";
+  if (!test::make_fifo(fifo)) return;
+  TrajectoryReadResult<double> r;
+  EXPECT_TRUE(test::returns_promptly([&] { r = read_tum_trajectory<double>(fifo); }, fifo)) << "blocked on a FIFO";
+  EXPECT_EQ(r.status, Status::IoError);
+  EXPECT_EQ(r.reason, fifo + ": is a FIFO (named pipe), not a regular file");
+  // /dev/zero has no newline and no end: refused before reading, not read until memory runs out.
+  r = read_tum_trajectory<double>("/dev/zero");
+  EXPECT_EQ(r.status, Status::IoError);
+  EXPECT_EQ(r.reason, "/dev/zero: is a character device, not a regular file");
+}
+
+TEST(TrajectoryIo, LinesBeyondMaxLinesAreAParseErrorInFileAndText) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "t.txt") << "# header\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n";
+  TrajectoryReadOptions o;
+  o.max_lines = 3;
+  const auto r = read_tum_trajectory<double>(dir / "t.txt", o);
+  EXPECT_EQ(r.status, Status::ParseError);
+  EXPECT_EQ(r.reason, dir / "t.txt" + ": more than 3 lines");
+  EXPECT_TRUE(r.trajectory.empty());
+  const auto p = parse_tum_trajectory<double>("# header\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n", "t", o);
+  EXPECT_EQ(p.status, Status::ParseError);
+  EXPECT_EQ(p.reason, "t: more than 3 lines");
+  o.max_lines = 4;
+  EXPECT_EQ(read_tum_trajectory<double>(dir / "t.txt", o).trajectory.size(), 3u);
+}
+
+TEST(TrajectoryIo, FileAndTextGiveTheSameResultLineForLine) {
+  test::ScratchDir dir;
+  const std::string text = "# c\r\n1 0 0 0 0 0 0 1\r\n\n  \t\n2,0,0,0,0,0,0,1\n3 0 0 0 0 0 0 0\n#" + std::string(20000, 'x') +
+                           "\n4 nan 0 0 0 0 0 1\n5 1 2 3 0 0 0 1";
+  std::ofstream(dir / "t.txt", std::ios::binary) << text;
+  const auto f = read_tum_trajectory<double>(dir / "t.txt");
+  const auto p = parse_tum_trajectory<double>(text, dir / "t.txt");
+  ASSERT_TRUE(f.ok()) << f.reason;
+  ASSERT_TRUE(p.ok()) << p.reason;
+  EXPECT_EQ(f.trajectory.stamps, p.trajectory.stamps);
+  EXPECT_EQ(f.num_skipped, 2u);
+  EXPECT_EQ(f.first_skipped, p.first_skipped);
+  EXPECT_EQ(f.first_skipped, dir / "t.txt" + ":6: zero quaternion");
+  std::ofstream(dir / "t.txt", std::ios::binary) << "1 0 0 0 0 0 0 1\n" << std::string(9000, '1') << "\n";
+  const auto g = read_tum_trajectory<double>(dir / "t.txt");
+  EXPECT_EQ(g.status, Status::ParseError);
+  EXPECT_EQ(g.reason, dir / "t.txt" + ":2: line is 9000 bytes long (limit 8192)");
+}
+
+TEST(TrajectoryIo, PathsInReasonsAreEscaped) {
+  const auto r = read_tum_trajectory<double>("/nonexistent/\x1b]0;title\x07.txt");
+  EXPECT_EQ(r.status, Status::IoError);
+  EXPECT_EQ(r.reason, "/nonexistent/\\x1b]0;title\\x07.txt: no such file");
+}
+
 TEST(TrajectoryIo, UnreadableFileIsIoError) {
   if (::geteuid() == 0) GTEST_SKIP() << "running as root: every file is readable";
   const std::string file = ::testing::TempDir() + "/dyncull_traj_noread_" + std::to_string(::getpid()) + ".txt";
@@ -393,12 +449,25 @@ TEST(Associate, NoOverlapEmptyAndBadOptionsAreStatuses) {
   EXPECT_EQ(associate(std::vector<double>{}, std::vector<double>{1.0}).status, Status::TooFewPoints);
   const AssociationResult nan_only =
       associate(std::vector<double>{std::nan("")}, std::vector<double>{std::nan("")});
-  EXPECT_EQ(nan_only.status, Status::TooFewPoints);
+  EXPECT_EQ(nan_only.status, Status::NonFinite);
   AssociationOptions bad;
   bad.max_difference_s = 0.0;
   EXPECT_EQ(associate(std::vector<double>{1.0}, std::vector<double>{1.0}, bad).status, Status::InvalidInput);
 }
 
+
+// A frame rate of 5e-324 Hz stamps every frame inf: the association refuses the stamps and names
+// them, instead of pairing nothing (or the finite rest) without a word.
+TEST(Associate, NonFiniteStampsAreRefusedNamingListIndexAndCount) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const AssociationResult r = associate(std::vector<double>{1.0, 2.0, 3.0}, std::vector<double>{1.0, inf, inf});
+  EXPECT_EQ(r.status, Status::NonFinite);
+  EXPECT_EQ(r.reason, "associate: second list's stamp 1 is inf (2 of 3 stamps are not finite)");
+  EXPECT_EQ(r.size(), 0u);
+  const AssociationResult g = associate(std::vector<double>{std::nan(""), 2.0}, std::vector<double>{2.0});
+  EXPECT_EQ(g.status, Status::NonFinite);
+  EXPECT_NE(g.reason.find("first list's stamp 0 is nan (1 of 2"), std::string::npos) << g.reason;
+}
 
 TEST(Associate, OptionsValidateNamesTheField) {
   std::string why;

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/special_files.hpp"
+
 #include <clocale>
 #include <cstdio>
 #include <cstdlib>
@@ -215,12 +217,61 @@ TYPED_TEST(YoloJsonTest, ReadsADirectoryOfFramesAndChecksTheirNumbers) {
 
   const YoloJsonFrame<T> missing = read_yolo_json<T>((dir / "nope.json").string());
   EXPECT_EQ(missing.status, Status::IoError);
-  EXPECT_NE(missing.reason.find("nope.json: cannot open"), std::string::npos);
+  EXPECT_NE(missing.reason.find("nope.json: no such file"), std::string::npos) << missing.reason;
   const YoloJsonFrame<T> directory = read_yolo_json<T>(dir.string());
   EXPECT_EQ(directory.status, Status::IoError) << directory.reason;
   const YoloJsonSequence<T> none = read_yolo_json_sequence<T>((dir / "empty").string());
   EXPECT_EQ(none.status, Status::IoError);
   fs::remove_all(dir);
+}
+
+// A directory has no size: tellg() gave -1 as 9223372036854775807 bytes "over the limit".
+TEST(YoloJson, DirectoryIsNamedAsADirectoryNotAsASize) {
+  test::ScratchDir dir;
+  const YoloJsonFrame<float> f = read_yolo_json<float>(dir.str());
+  EXPECT_EQ(f.status, Status::IoError);
+  EXPECT_EQ(f.reason, dir.str() + ": is a directory, not a regular file");
+  std::filesystem::create_directories(dir / "seq/000000.json");
+  const YoloJsonSequence<float> s = read_yolo_json_sequence<float>(dir / "seq");
+  EXPECT_EQ(s.status, Status::IoError);
+  EXPECT_EQ(s.reason, dir / "seq/000000.json" + ": is a directory, not a regular file");
+}
+
+TEST(YoloJson, FifoAndDeviceAreRefusedPromptly) {
+  test::ScratchDir dir;
+  std::filesystem::create_directories(dir / "seq");
+  const std::string fifo = dir / "seq/000000.json";
+  if (!test::make_fifo(fifo)) return;
+  YoloJsonFrame<double> f;
+  EXPECT_TRUE(test::returns_promptly([&] { f = read_yolo_json<double>(fifo); }, fifo)) << "blocked on a FIFO";
+  EXPECT_EQ(f.status, Status::IoError);
+  EXPECT_EQ(f.reason, fifo + ": is a FIFO (named pipe), not a regular file");
+  YoloJsonSequence<double> s;
+  EXPECT_TRUE(test::returns_promptly([&] { s = read_yolo_json_sequence<double>(dir / "seq"); }, fifo))
+      << "blocked on a FIFO";
+  EXPECT_EQ(s.status, Status::IoError);
+  EXPECT_EQ(s.reason, fifo + ": is a FIFO (named pipe), not a regular file");
+  f = read_yolo_json<double>("/dev/zero");
+  EXPECT_EQ(f.reason, "/dev/zero: is a character device, not a regular file");
+}
+
+TEST(YoloJson, IntegerFieldsTakeIntegralValuesAndNameTheirRangeAndWhy) {
+  const YoloJsonFrame<float> big = parse_yolo_json<float>(R"({"frame_id": 1e15, "timestamp": 1, "detections": []})");
+  ASSERT_TRUE(big.ok()) << big.reason;
+  EXPECT_EQ(big.frame_id, 1000000000000000LL);
+  const YoloJsonFrame<float> real = parse_yolo_json<float>(R"({"frame_id": 12.0, "timestamp": 1, "detections": []})");
+  ASSERT_TRUE(real.ok()) << real.reason;
+  EXPECT_EQ(real.frame_id, 12);
+  const YoloJsonFrame<float> over = parse_yolo_json<float>(R"({"frame_id": 1e16, "timestamp": 1, "detections": []})", "f.json");
+  EXPECT_EQ(over.status, Status::ParseError);
+  EXPECT_EQ(over.reason,
+            "f.json: byte 13 (line 1, column 14): frame_id must be an integer in [0, 1000000000000000] (a frame number "
+            "up to 10^15, exact in the double a JSON number is read as), got '1e16'");
+  const YoloJsonFrame<float> cls = parse_yolo_json<float>(
+      R"({"frame_id": 0, "timestamp": 1, "detections": [{"class_id": 2e6, "confidence": 0.5, "bbox": [1, 2, 3, 4]}]})");
+  EXPECT_NE(cls.reason.find("detections[0].class_id must be an integer in [0, 1000000] (a detector class index), got '2e6'"),
+            std::string::npos)
+      << cls.reason;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -633,6 +633,27 @@ TEST(DynamicVo, FamilySceneRunsThroughTheFrontEnd) {
   EXPECT_GT(report.runs[1].labels.true_positive, 0u) << "the seated person's moving parts are culled";
 }
 
+// The scene keys allow images from 1 x 1 px: the front end must run on any of them (no room for a
+// feature inside its 12 px border is no features, not an exception from the detection mask).
+TEST(DynamicVo, ImagesSmallerThanTheBorderRunWithoutFeatures) {
+  const auto all = vo::all_strategies();
+  for (const char* size : {"width=8,height=8", "width=1,height=1", "width=8192,height=8", "width=24,height=25"}) {
+    sim::SceneOptions so;
+    ASSERT_EQ(sim::apply_scene_assignments(&so, std::string(size) + ",motion=xyz,num_frames=3"), Status::Ok) << size;
+    vo::SimSource source(so);
+    vo::RunnerOptions ro;
+    ro.max_frames = 3;
+    ro.write_outputs = false;
+    ro.print_progress = false;
+    vo::SequenceReport report;
+    std::string error;
+    bool ran = false;
+    EXPECT_NO_THROW(ran = vo::run_sequence("tiny", source, {*find_spec(all, false), *find_spec(all, true)}, ro,
+                                           &report, &error))
+        << size;
+    EXPECT_TRUE(ran) << size << ": " << error;
+  }
+}
 
 // --diagnose names every instance the sim can render (the crowd's third and fourth walkers, the desk people
 // and clutter), so their labels are not lumped into "other".

@@ -6,6 +6,7 @@
 #ifdef DYNCULL_HAS_OPENCV
 
 #include "../../examples/vo/sources.hpp"
+#include "support/special_files.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -118,6 +119,59 @@ TEST_F(TumDetections, ImageListsAreCheckedLineByLine) {
   ASSERT_TRUE(open("", &error)) << error;
   vo::SequenceFrame f;
   EXPECT_TRUE(source_.load(0, &f, &error)) << error;
+}
+
+// A FIFO blocks a reader that opens it until a writer comes; /dev/zero never ends. Both are refused
+// by their kind before any read, naming the path.
+TEST_F(TumDetections, FifosAndDevicesAreRefusedPromptly) {
+  const std::string fifo = (dir_ / "dets.txt").string();
+  if (!test::make_fifo(fifo)) return;
+  std::string error;
+  bool opened = true;
+  EXPECT_TRUE(test::returns_promptly([&] { opened = open(fifo, &error); }, fifo)) << "blocked on --detections";
+  EXPECT_FALSE(opened);
+  EXPECT_EQ(error, "detections " + fifo + ": is a FIFO (named pipe), not a regular file");
+  EXPECT_FALSE(open("/dev/zero", &error));
+  EXPECT_EQ(error, "detections /dev/zero: is a character device, not a regular file");
+
+  std::filesystem::remove(dir_ / "rgb.txt");
+  const std::string rgb = (dir_ / "rgb.txt").string();
+  if (!test::make_fifo(rgb)) return;
+  EXPECT_TRUE(test::returns_promptly([&] { opened = open("", &error); }, rgb)) << "blocked on rgb.txt";
+  EXPECT_FALSE(opened);
+  EXPECT_EQ(error, rgb + ": is a FIFO (named pipe), not a regular file");
+
+  // An image the list names: imread would block on it.
+  std::filesystem::remove(dir_ / "rgb.txt");
+  std::ofstream(dir_ / "rgb.txt") << "1.000000 rgb/pipe.png\n";
+  const std::string image = (dir_ / "rgb/pipe.png").string();
+  if (!test::make_fifo(image)) return;
+  ASSERT_TRUE(open("", &error)) << error;
+  vo::SequenceFrame f;
+  bool loaded = true;
+  EXPECT_TRUE(test::returns_promptly([&] { loaded = source_.load(0, &f, &error); }, image)) << "blocked on an image";
+  EXPECT_FALSE(loaded);
+  EXPECT_NE(error.find("rgb/pipe.png: is a FIFO"), std::string::npos) << error;
+}
+
+// A box that parses but the filter drops (1e400 is inf, as in Python) is not dropped unseen: open()
+// succeeds and its note gives the count by reason and file:line.
+TEST_F(TumDetections, BoxesTheFilterDropsAreCountedAndNamed) {
+  const std::string file = (dir_ / "dets.txt").string();
+  std::ofstream(file) << "1.000000 0 0.5 0.5 0.25 0.5 0.9\n"
+                         "1.000000 0 1e400 0.5 0.25 0.5 0.9\n"
+                         "2.000000 0 0.5 0.5 0.25 0.5 0.01\n";
+  std::string error;
+  ASSERT_TRUE(open(file, &error)) << error;
+  EXPECT_EQ(source_.dropped_boxes(), 2u);
+  EXPECT_EQ(source_.detection_note(),
+            "detections " + file + ": 2 of 3 boxes dropped by the detection filter (1 non-finite coordinates, "
+            "1 confidence below the class threshold)\n  " + file + ":2: non-finite coordinates\n  " + file +
+            ":3: confidence below the class threshold");
+  std::ofstream(file) << "1.000000 0 0.5 0.5 0.25 0.5 0.9\n";
+  ASSERT_TRUE(open(file, &error)) << error;
+  EXPECT_EQ(source_.dropped_boxes(), 0u);
+  EXPECT_EQ(source_.detection_note(), "");
 }
 
 }  // namespace

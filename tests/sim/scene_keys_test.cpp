@@ -151,9 +151,9 @@ TEST(SceneKeys, BadKeysAndValuesAreRejectedWithTheExpectedTypeAndRange) {
       {"miss_rate", "", "number [0, 1]"},
       {"miss_rate", "0.2x", "number [0, 1]"},
       {"miss_rate", " 0.2", "number [0, 1]"},
-      {"fps", "0", "number (0, 1000]"},
-      {"fps", "nan", "number (0, 1000]"},
-      {"fps", "inf", "number (0, 1000]"},
+      {"fps", "0", "number [0.001, 1000]"},
+      {"fps", "nan", "number [0.001, 1000]"},
+      {"fps", "inf", "number [0.001, 1000]"},
       {"width", "1.5", "integer [1, 8192]"},
       {"width", "abc", "integer [1, 8192]"},
       {"width", "99999999999999999999", "integer [1, 8192]"},
@@ -189,6 +189,44 @@ TEST(SceneKeys, BadKeysAndValuesAreRejectedWithTheExpectedTypeAndRange) {
   EXPECT_NE(reason.find("'bogus'"), std::string::npos) << reason;
   EXPECT_EQ(set_scene_key(nullptr, "seed", "1", &reason), Status::InvalidInput);
   EXPECT_EQ(apply_scene_assignments(nullptr, "seed=1", &reason), Status::InvalidInput);
+}
+
+// Unknown keys and items without '=' are user text: quoted by text::quote_token (escaped, cut at 32
+// characters), so terminal escapes never reach the terminal, a NUL does not cut the reason and a
+// 5,000-character key does not fill the screen.
+TEST(SceneKeys, UnknownKeysAndItemsWithoutEqualsAreQuotedEscapedAndBounded) {
+  SceneOptions o;
+  std::string reason;
+  EXPECT_EQ(apply_scene_assignments(&o, "\x1b[2Jbad=1", &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "unknown scene key '\\x1b[2Jbad' (dynamic_vo --help lists the keys)");
+  EXPECT_EQ(apply_scene_assignments(&o, std::string("ke\0y=1", 7), &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "unknown scene key 'ke\\x00y' (dynamic_vo --help lists the keys)");
+  EXPECT_EQ(apply_scene_assignments(&o, std::string(5000, 'k') + "=1", &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "unknown scene key '" + std::string(32, 'k') + "'... (5000 bytes) (dynamic_vo --help lists the keys)");
+  EXPECT_EQ(apply_scene_assignments(&o, "seed=1,\x07" "bell\n", &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "scene assignment '\\x07bell\\x0a' is not key=value");
+  EXPECT_EQ(apply_scene_assignments(&o, "seed=1," + std::string(5000, 'x'), &reason), Status::InvalidInput);
+  EXPECT_LT(reason.size(), 100u) << reason.substr(0, 200);
+}
+
+// Frame i is stamped start_time_s + i / fps: a frame rate or a start time that makes the stamps
+// infinite or equal is refused with the bound, not run with infinite stamps and Ok frames.
+TEST(SceneKeys, FrameRateAndStartTimeKeepTheStampsFiniteAndDistinct) {
+  SceneOptions o;
+  std::string reason;
+  EXPECT_EQ(apply_scene_assignments(&o, "fps=5e-324", &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "scene key 'fps': expected number [0.001, 1000], got '5e-324' (frame rate, Hz; from 0.001 Hz the "
+                    "frame stamps start_time_s + i / fps stay finite)");
+  EXPECT_EQ(apply_scene_assignments(&o, "start_time_s=1e300", &reason), Status::InvalidInput);
+  EXPECT_EQ(reason, "scene key 'start_time_s': expected number [-4000000000, 4000000000], got '1e300' (timestamp of "
+                    "frame 0, s; within 4e9 s the stamps keep microseconds and stay distinct)");
+  ASSERT_EQ(apply_scene_assignments(&o, "fps=0.001,start_time_s=4e9,num_frames=1000000", &reason), Status::Ok) << reason;
+  const Scene slow(o);
+  EXPECT_TRUE(std::isfinite(slow.timestamp(999999)));
+  EXPECT_GT(slow.timestamp(999999), slow.timestamp(999998));
+  ASSERT_EQ(apply_scene_assignments(&o, "fps=1000,start_time_s=-4e9", &reason), Status::Ok) << reason;
+  const Scene fast(o);
+  EXPECT_GT(fast.timestamp(999999) - fast.timestamp(999998), 0.9e-3);
 }
 
 // Numbers follow Python's grammar, as every number dyncull reads: float() for real keys, int() for

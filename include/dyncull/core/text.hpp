@@ -128,15 +128,17 @@ inline NumberStatus parse_python_float(std::string_view token, double* out) {
   return NumberStatus::Ok;
 }
 
-/// A bad token for a reason: at most `max_chars` characters between single quotes, bytes outside
-/// printable ASCII (and the quote and backslash) as `\xHH`, then "... (N bytes)" when cut.
-inline std::string quote_token(std::string_view token, std::size_t max_chars = kQuotedTokenChars) {
+/// User text for a reason: the one quoting rule of every reader and command line (tokens, keys,
+/// arguments, paths). At most `max_chars` characters; bytes outside printable ASCII, the backslash and
+/// (when quoting) the single quote as `\xHH`, so terminal escapes, NULs and newlines never reach the
+/// reason; then "... (N bytes)" when cut. `quoted` wraps it in single quotes ('x,5').
+inline std::string quote_token(std::string_view token, std::size_t max_chars = kQuotedTokenChars, bool quoted = true) {
   static const char* const kHex = "0123456789abcdef";
-  std::string out = "'";
+  std::string out = quoted ? "'" : "";
   const std::size_t shown = token.size() < max_chars ? token.size() : max_chars;
   for (std::size_t i = 0; i < shown; ++i) {
     const unsigned char c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f && c != '\'' && c != '\\') {
+    if (c >= 0x20 && c < 0x7f && !(quoted && c == '\'') && c != '\\') {
       out += static_cast<char>(c);
     } else {
       out += "\\x";
@@ -144,9 +146,28 @@ inline std::string quote_token(std::string_view token, std::size_t max_chars = k
       out += kHex[c & 15];
     }
   }
-  out += '\'';
+  if (quoted) out += '\'';
   if (shown < token.size()) out += "... (" + std::to_string(token.size()) + " bytes)";
   return out;
+}
+
+/// Characters of a path shown in a reason (longer ones are cut as quote_token says).
+constexpr std::size_t kQuotedPathChars = 1024;
+
+/// A path for the "path:line: why" of a reason: quote_token's escaping without the quotes.
+inline std::string quote_path(std::string_view path) { return quote_token(path, kQuotedPathChars, false); }
+
+/// A real number read from user text as an integer: true and `*out` set when `v` is an integer in
+/// [lo, hi]; false (`*out` untouched) for NaN, Inf, a fraction or a value outside, so nothing is ever
+/// converted out of range. The test runs in double before the conversion.
+inline bool integer_in_range(double v, long long lo, long long hi, long long* out) {
+  if (!(v >= static_cast<double>(lo) && v <= static_cast<double>(hi)) || v != std::floor(v)) return false;
+  // lo and hi may round outward in double (|x| > 2^53): clamp after converting a value known to fit in 2^63.
+  if (!(std::abs(v) < 9223372036854775808.0)) return false;
+  const long long n = static_cast<long long>(v);
+  if (n < lo || n > hi) return false;
+  *out = n;
+  return true;
 }
 
 /// Name of a floating-point scalar type in reasons.

@@ -8,6 +8,7 @@
 ///   DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>&, int w, int h, const DetectionOptions<T>&);
 ///   DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& pixel_boxes, int w, int h, const DetectionOptions<T>&);
 ///   YoloParseResult<T> parse_yolo_lines(std::string_view text, const std::string& source = "");  // "class cx cy w h [conf]" per line
+///   add_yolo_line(line, line_chars, line_no, source, &result); finish_yolo_lines(&result);  // the same, streamed
 #pragma once
 
 #include "dyncull/core/box.hpp"
@@ -305,11 +306,12 @@ struct YoloParseResult {
 namespace detail {
 inline bool is_yolo_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
-/// Why one YOLO line does not parse ("" when it does; then *box holds it).
+/// Why one YOLO line does not parse ("" when it does; then *box holds it). `line_chars` is the line's
+/// full length when `line` holds only its first text::kMaxLineChars bytes.
 template <class T>
-std::string parse_yolo_line(std::string_view line, YoloBox<T>* box) {
-  if (line.size() > text::kMaxLineChars)
-    return "line is " + std::to_string(line.size()) + " bytes long (limit " + std::to_string(text::kMaxLineChars) + ")";
+std::string parse_yolo_line(std::string_view line, std::size_t line_chars, YoloBox<T>* box) {
+  if (line_chars > text::kMaxLineChars)
+    return "line is " + std::to_string(line_chars) + " bytes long (limit " + std::to_string(text::kMaxLineChars) + ")";
   static const char* const kNames[6] = {"class", "cx", "cy", "w", "h", "conf"};
   std::string_view tokens[6];
   std::size_t n = 0;
@@ -333,9 +335,10 @@ std::string parse_yolo_line(std::string_view line, YoloBox<T>* box) {
     if (c > 0 && !text::fits_scalar<T>(v[c]))
       return std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is out of range for " + text::scalar_name<T>();
   }
-  if (!(v[0] == std::floor(v[0]) && v[0] >= 0 && v[0] <= 1e6))
+  long long class_id = 0;
+  if (!text::integer_in_range(v[0], 0, 1000000, &class_id))
     return "class id " + text::quote_token(tokens[0]) + " must be an integer in [0, 1000000]";
-  box->class_id = static_cast<int>(v[0]);
+  box->class_id = static_cast<int>(class_id);
   box->cx = T(v[1]);
   box->cy = T(v[2]);
   box->w = T(v[3]);
@@ -345,50 +348,63 @@ std::string parse_yolo_line(std::string_view line, YoloBox<T>* box) {
 }
 }  // namespace detail
 
+/// One line of YOLO text into `r`: the streaming form of parse_yolo_lines, for a reader that hands
+/// over a file line by line (text::LineReader). `line_chars` is the line's full length when `line`
+/// holds only its first text::kMaxLineChars bytes; `line_no` is 1-based; `source` names the input in
+/// the reason. Call finish_yolo_lines(&r) after the last line.
+template <class T>
+void add_yolo_line(std::string_view line, std::size_t line_chars, int line_no, const std::string& source,
+                   YoloParseResult<T>* r) {
+  std::size_t first = 0;
+  while (first < line.size() && detail::is_yolo_space(line[first])) ++first;
+  if (first == line.size() && line_chars == line.size()) return;  // blank
+  if (first < line.size() && line[first] == '#') return;          // comment, whatever its length
+  YoloBox<T> b;
+  std::string why = detail::parse_yolo_line(line, line_chars, &b);
+  if (why.empty()) {
+    r->boxes.push_back(b);
+    r->line_of_box.push_back(line_no);
+    return;
+  }
+  if (r->num_bad_lines == 0) {
+    r->reason = (source.empty() ? "line " : text::quote_path(source) + ":") + std::to_string(line_no) + ": " + why;
+  }
+  ++r->num_bad_lines;
+  if (r->errors.size() < kYoloMaxListedErrors) r->errors.push_back(YoloParseError{line_no, std::move(why)});
+}
+
+/// Sets the status and the bad-line count of the reason after the last add_yolo_line().
+template <class T>
+void finish_yolo_lines(YoloParseResult<T>* r) {
+  if (r->num_bad_lines > 0) {
+    r->status = Status::ParseError;
+    r->reason += " (" + std::to_string(r->num_bad_lines) + (r->num_bad_lines == 1 ? " bad line)" : " bad lines)");
+  }
+}
+
 /// Parses YOLO text ("class cx cy w h [conf]" per line, space or tab separated; blank lines and '#'
 /// comments skipped). Numbers follow Python's float() whatever the C locale ("0,5" is an error, 1e400
 /// is inf). Bad lines are skipped, counted and the first kYoloMaxListedErrors listed; status is
 /// ParseError when any line failed (the good boxes are still returned), `reason` names the first as
-/// "source:line: why". Bounded: a line over text::kMaxLineChars or a number over text::kMaxNumberChars
-/// characters is a bad line, and reasons quote at most 32 escaped characters of a token. A value
-/// outside T's finite range (1e39 for float) is a bad line; validity of the numbers (w > 0, finite)
-/// is left to convert_yolo_detections, which reports it per box.
+/// "source:line: why" (`source` escaped by text::quote_path). Bounded: a line over
+/// text::kMaxLineChars or a number over text::kMaxNumberChars characters is a bad line, and reasons
+/// quote at most 32 escaped characters of a token. A value outside T's finite range (1e39 for float)
+/// is a bad line; validity of the numbers (w > 0, finite) is left to convert_yolo_detections, which
+/// reports it per box.
 template <class T>
 YoloParseResult<T> parse_yolo_lines(std::string_view text, const std::string& source = "") {
   YoloParseResult<T> r;
   std::size_t pos = 0;
   int line_no = 0;
-  while (pos <= text.size()) {
+  while (pos < text.size()) {
     std::size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
     const std::string_view line = text.substr(pos, end - pos);
-    ++line_no;
     pos = end + 1;
-    std::size_t first = 0;
-    while (first < line.size() && detail::is_yolo_space(line[first])) ++first;
-    if (first == line.size() || line[first] == '#') {
-      if (end == text.size()) break;
-      continue;
-    }
-    YoloBox<T> b;
-    std::string why = detail::parse_yolo_line(line, &b);
-    if (why.empty()) {
-      r.boxes.push_back(b);
-      r.line_of_box.push_back(line_no);
-    } else {
-      if (r.num_bad_lines == 0) {
-        r.reason = (source.empty() ? "line " + std::to_string(line_no) : source + ":" + std::to_string(line_no)) +
-                   ": " + why;
-      }
-      ++r.num_bad_lines;
-      if (r.errors.size() < kYoloMaxListedErrors) r.errors.push_back(YoloParseError{line_no, std::move(why)});
-    }
-    if (end == text.size()) break;
+    ++line_no;
+    add_yolo_line(line.substr(0, text::kMaxLineChars), line.size(), line_no, source, &r);
   }
-  if (r.num_bad_lines > 0) {
-    r.status = Status::ParseError;
-    r.reason += " (" + std::to_string(r.num_bad_lines) + (r.num_bad_lines == 1 ? " bad line)" : " bad lines)");
-  }
+  finish_yolo_lines(&r);
   return r;
 }
 

@@ -197,7 +197,7 @@ inline ParseArgsResult parse_eval_args(int argc, const char* const* argv) {
     } else if (arg == "--offset") {
       if (!value(&v) || !detail::parse_number_arg(v, &a.offset_s)) return fail("--offset needs a number of seconds");
     } else if (arg.size() > 1 && arg[0] == '-') {
-      return fail("unknown option '" + arg + "'");
+      return fail("unknown option " + text::quote_token(arg));
     } else {
       if (positional == 0) a.groundtruth_path = arg;
       if (positional == 1) a.estimate_path = arg;
@@ -239,7 +239,7 @@ inline EvalReport run_eval(const EvalCommandLine& args) {
   report.ate = evaluate_ate(gt.trajectory, est.trajectory, ate_options);
   if (!report.ate.ok()) {
     report.status = report.ate.status;
-    report.reason = args.estimate_path + " vs " + args.groundtruth_path + ": " + report.ate.reason;
+    report.reason = text::quote_path(args.estimate_path) + " vs " + text::quote_path(args.groundtruth_path) + ": " + report.ate.reason;
     return report;
   }
   if (args.rpe) {
@@ -252,7 +252,7 @@ inline EvalReport run_eval(const EvalCommandLine& args) {
     report.rpe = evaluate_rpe(gt.trajectory, est.trajectory, rpe_options);
     if (!report.rpe.ok()) {
       report.status = report.rpe.status;
-      report.reason = args.estimate_path + " vs " + args.groundtruth_path + ": " + report.rpe.reason;
+      report.reason = text::quote_path(args.estimate_path) + " vs " + text::quote_path(args.groundtruth_path) + ": " + report.rpe.reason;
     }
   }
   return report;

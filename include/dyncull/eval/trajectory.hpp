@@ -5,6 +5,7 @@
 
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/text.hpp"
+#include "dyncull/core/text_file.hpp"
 #include "dyncull/core/types.hpp"
 
 #include <Eigen/Geometry>
@@ -14,7 +15,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -55,6 +55,10 @@ struct TrajectoryReadOptions {
   /// translation is outside T's range are skipped and counted,
   /// as evaluate_rpe.py's read_trajectory does; false turns them into a ParseError.
   bool skip_invalid_poses = true;
+  /// Lines read at most (comments and blank lines included); more is a ParseError. Bounds the memory
+  /// of a file that is not a trajectory: a pose takes about 100 bytes, so 1,000,000 poses (2.8 hours
+  /// at 100 Hz) take about 100 MB.
+  std::size_t max_lines = 1000000;
 };
 
 template <class T>
@@ -118,14 +122,17 @@ struct AssociationResult {
 /// Python's float() whatever the locale (core/text.hpp): 1e400 is inf (the line is then skipped as
 /// non-finite), "1_000" is 1000, "+-5" is an error. Separators: space, tab, comma. A data line longer
 /// than text::kMaxLineChars or a number longer than text::kMaxNumberChars is a ParseError; reasons
-/// quote at most 32 characters of a bad token, escaped. A translation outside T's range (1e39 for
+/// quote at most 32 characters of a bad token, escaped (and `source` is escaped by text::quote_path).
+/// More than options.max_lines lines is a ParseError. A translation outside T's range (1e39 for
 /// float) is an invalid pose, skipped or rejected as TrajectoryReadOptions says.
 template <class T>
 TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::string& source = "<memory>",
                                              const TrajectoryReadOptions& options = {});
 
-/// Reads a TUM file; IoError when it is a directory or cannot be opened or read, ParseError with
-/// "path:line: ..." otherwise.
+/// Reads a TUM file line by line (text::LineReader: memory bounded by the line limit and
+/// options.max_lines, whatever the file holds). IoError when the path is not a regular file (a
+/// directory, a FIFO, a device such as /dev/zero: refused before reading) or cannot be opened or
+/// read; ParseError with "path:line: ..." otherwise, the path escaped as text::quote_path does.
 template <class T = double>
 TrajectoryReadResult<T> read_tum_trajectory(const std::string& path, const TrajectoryReadOptions& options = {});
 
@@ -148,8 +155,10 @@ WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& t
 
 /// associate.py: every (a, b) with |a - (b + offset)| < max_difference is a candidate; candidates are
 /// sorted by (difference, a, b) and taken greedily so each stamp is used once. Equal stamps within one
-/// list count as one stamp, the later entry winning (Python dict semantics). Non-finite stamps are
-/// ignored. TooFewPoints when nothing associates; InvalidInput when options.validate() fails.
+/// list count as one stamp, the later entry winning (Python dict semantics). NonFinite when a stamp is
+/// NaN or Inf (a file never gives one: the reader skips such lines), the reason naming the list, the
+/// index, the value and how many there are; TooFewPoints when nothing associates; InvalidInput when
+/// options.validate() fails.
 /// Cost: O((n + m) log(n + m) + k log k) for k candidates (TUM's script is O(n m)).
 inline AssociationResult associate(const double* first, std::size_t num_first, const double* second,
                                    std::size_t num_second, const AssociationOptions& options = {});
@@ -203,93 +212,110 @@ inline bool append_number(std::string* out, double v, std::chars_format format, 
 
 }  // namespace detail
 
+namespace detail {
+
+/// Reads one TUM line (`line` holds at most text::kMaxLineChars bytes of a line `line_chars` long) into
+/// `result`. False when reading must stop: `result` then holds the ParseError, its reason starting with
+/// where(). Blank and comment lines are skipped whatever their length.
+template <class T, class Where>
+bool add_tum_line(std::string_view line, std::size_t line_chars, const Where& where,
+                  const TrajectoryReadOptions& options, TrajectoryReadResult<T>* result) {
+  const auto fail = [&](const std::string& why) {
+    result->status = Status::ParseError;
+    result->reason = where() + why;
+    result->trajectory.clear();
+    return false;
+  };
+  std::string_view tokens[8];
+  std::size_t num_tokens = 0;
+  std::size_t k = 0;
+  while (k < line.size() && is_separator(line[k])) ++k;
+  if (k == line.size() && line_chars == line.size()) return true;  // blank line
+  if (k < line.size() && line[k] == '#') return true;               // comment
+  if (line_chars > text::kMaxLineChars) {
+    return fail("line is " + std::to_string(line_chars) + " bytes long (limit " + std::to_string(text::kMaxLineChars) +
+                ")");
+  }
+  while (k < line.size()) {
+    const std::size_t start = k;
+    while (k < line.size() && !is_separator(line[k])) ++k;
+    if (num_tokens < 8) tokens[num_tokens] = line.substr(start, k - start);
+    ++num_tokens;
+    while (k < line.size() && is_separator(line[k])) ++k;
+  }
+  if (num_tokens != 8) {
+    return fail("expected 8 values (timestamp tx ty tz qx qy qz qw), found " + std::to_string(num_tokens));
+  }
+  double v[8];
+  static const char* const kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+  for (int c = 0; c < 8; ++c) {
+    const text::NumberStatus parsed = text::parse_python_float(tokens[c], &v[c]);
+    if (parsed == text::NumberStatus::TooLong) {
+      return fail(std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is longer than " +
+                  std::to_string(text::kMaxNumberChars) + " characters");
+    }
+    if (parsed != text::NumberStatus::Ok) {
+      return fail(std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is not a number");
+    }
+  }
+  std::string invalid;
+  bool finite = true;
+  for (double x : v) finite = finite && std::isfinite(x);
+  const double qnorm2 = v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7];
+  if (!finite) {
+    invalid = "non-finite value";
+  } else if (!(qnorm2 > 1e-12)) {
+    // TUM skips all-zero quaternions (a common "lost tracking" marker); a near-zero one has no
+    // meaningful direction either.
+    invalid = "zero quaternion";
+  } else {
+    for (int c = 1; c < 4 && invalid.empty(); ++c) {
+      // A finite double beyond T's range would become inf (undefined behaviour in the cast).
+      if (!text::fits_scalar<T>(v[c])) {
+        invalid = std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is out of range for " +
+                  text::scalar_name<T>();
+      }
+    }
+  }
+  if (!invalid.empty()) {
+    if (!options.skip_invalid_poses) return fail(invalid);
+    if (result->num_skipped == 0) result->first_skipped = where() + invalid;
+    ++result->num_skipped;
+    return true;
+  }
+  // Rotation in double from the normalised quaternion (transform44 in evaluate_rpe.py), then cast.
+  const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+  Rigid3<double> pose;
+  pose.R = q.normalized().toRotationMatrix();
+  pose.t = Vec3<double>(v[1], v[2], v[3]);
+  result->trajectory.push_back(v[0], pose.template cast<T>());
+  return true;
+}
+
+}  // namespace detail
+
 template <class T>
 TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::string& source,
                                              const TrajectoryReadOptions& options) {
   TrajectoryReadResult<T> result;
+  const std::string shown = text::quote_path(source);
   std::size_t line_number = 0;
+  const auto where = [&]() { return shown + ":" + std::to_string(line_number) + ": "; };
   std::size_t pos = 0;
-  std::string_view tokens[8];
-  const auto where = [&]() { return source + ":" + std::to_string(line_number) + ": "; };
-  const auto fail = [&](const std::string& why) {
-    result.status = Status::ParseError;
-    result.reason = where() + why;
-    result.trajectory.clear();
-    return result;
-  };
-  while (pos <= text.size()) {
+  while (pos < text.size()) {
     std::size_t eol = text.find('\n', pos);
     if (eol == std::string_view::npos) eol = text.size();
     const std::string_view line = text.substr(pos, eol - pos);
     pos = eol + 1;
+    if (line_number >= options.max_lines) {
+      result.status = Status::ParseError;
+      result.reason = shown + ": more than " + std::to_string(options.max_lines) + " lines";
+      result.trajectory.clear();
+      return result;
+    }
     ++line_number;
-
-    std::size_t num_tokens = 0;
-    std::size_t k = 0;
-    while (k < line.size() && detail::is_separator(line[k])) ++k;
-    if (k == line.size() || line[k] == '#') {
-      if (eol == text.size()) break;
-      continue;  // blank line or comment
-    }
-    if (line.size() > text::kMaxLineChars) {
-      return fail("line is " + std::to_string(line.size()) + " bytes long (limit " +
-                  std::to_string(text::kMaxLineChars) + ")");
-    }
-    while (k < line.size()) {
-      const std::size_t start = k;
-      while (k < line.size() && !detail::is_separator(line[k])) ++k;
-      if (num_tokens < 8) tokens[num_tokens] = line.substr(start, k - start);
-      ++num_tokens;
-      while (k < line.size() && detail::is_separator(line[k])) ++k;
-    }
-    if (num_tokens != 8) {
-      return fail("expected 8 values (timestamp tx ty tz qx qy qz qw), found " + std::to_string(num_tokens));
-    }
-    double v[8];
-    static const char* const kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
-    for (int c = 0; c < 8; ++c) {
-      const text::NumberStatus parsed = text::parse_python_float(tokens[c], &v[c]);
-      if (parsed == text::NumberStatus::TooLong) {
-        return fail(std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is longer than " +
-                    std::to_string(text::kMaxNumberChars) + " characters");
-      }
-      if (parsed != text::NumberStatus::Ok) {
-        return fail(std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is not a number");
-      }
-    }
-    std::string invalid;
-    bool finite = true;
-    for (double x : v) finite = finite && std::isfinite(x);
-    const double qnorm2 = v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7];
-    if (!finite) {
-      invalid = "non-finite value";
-    } else if (!(qnorm2 > 1e-12)) {
-      // TUM skips all-zero quaternions (a common "lost tracking" marker); a near-zero one has no
-      // meaningful direction either.
-      invalid = "zero quaternion";
-    } else {
-      for (int c = 1; c < 4 && invalid.empty(); ++c) {
-        // A finite double beyond T's range would become inf (undefined behaviour in the cast).
-        if (!text::fits_scalar<T>(v[c])) {
-          invalid = std::string(kNames[c]) + " " + text::quote_token(tokens[c]) + " is out of range for " +
-                    text::scalar_name<T>();
-        }
-      }
-    }
-    if (!invalid.empty()) {
-      if (!options.skip_invalid_poses) return fail(invalid);
-      if (result.num_skipped == 0) result.first_skipped = where() + invalid;
-      ++result.num_skipped;
-      if (eol == text.size()) break;
-      continue;
-    }
-    // Rotation in double from the normalised quaternion (transform44 in evaluate_rpe.py), then cast.
-    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    Rigid3<double> pose;
-    pose.R = q.normalized().toRotationMatrix();
-    pose.t = Vec3<double>(v[1], v[2], v[3]);
-    result.trajectory.push_back(v[0], pose.template cast<T>());
-    if (eol == text.size()) break;
+    // What a LineReader would hand over: the first kMaxLineChars bytes and the length.
+    if (!detail::add_tum_line(line.substr(0, text::kMaxLineChars), line.size(), where, options, &result)) return result;
   }
   return result;
 }
@@ -297,26 +323,26 @@ TrajectoryReadResult<T> parse_tum_trajectory(std::string_view text, const std::s
 template <class T>
 TrajectoryReadResult<T> read_tum_trajectory(const std::string& path, const TrajectoryReadOptions& options) {
   TrajectoryReadResult<T> result;
-  result.status = Status::IoError;
-  std::error_code ec;
-  // An ifstream opens a directory on POSIX and then reads nothing: that is not an empty trajectory.
-  if (std::filesystem::is_directory(path, ec)) {
-    result.reason = path + ": is a directory, not a trajectory file";
+  text::LineReaderOptions limits;
+  limits.max_lines = options.max_lines;
+  text::LineReader in;
+  if (!in.open(path, limits)) {
+    result.status = Status::IoError;
+    result.reason = in.error();
     return result;
   }
-  std::ifstream file(path, std::ios::in | std::ios::binary);
-  if (!file) {
-    result.reason = path + ": cannot open for reading";
-    return result;
+  const auto where = [&]() { return text::line_location(in); };
+  std::string_view line;
+  for (text::LineStatus s; (s = in.next(&line)) != text::LineStatus::End;) {
+    if (s == text::LineStatus::TooManyLines || s == text::LineStatus::ReadError) {
+      result.status = s == text::LineStatus::ReadError ? Status::IoError : Status::ParseError;
+      result.reason = in.error();
+      result.trajectory.clear();
+      return result;
+    }
+    if (!detail::add_tum_line(line, in.line_chars(), where, options, &result)) return result;
   }
-  std::string text;
-  char chunk[1 << 16];
-  while (file.read(chunk, sizeof(chunk)) || file.gcount() > 0) text.append(chunk, static_cast<std::size_t>(file.gcount()));
-  if (file.bad() || !file.eof()) {
-    result.reason = path + ": read error";
-    return result;
-  }
-  return parse_tum_trajectory<T>(text, path, options);
+  return result;
 }
 
 template <class T>
@@ -397,20 +423,20 @@ WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& t
   std::string text;
   WriteResult result = format_tum_trajectory(trajectory, &text, options);
   if (!result.ok()) {
-    result.reason = path + ": " + result.reason;
+    result.reason = text::quote_path(path) + ": " + result.reason;
     return result;  // nothing written
   }
   std::ofstream file(path, std::ios::out | std::ios::binary | std::ios::trunc);
   if (!file) {
     result.status = Status::IoError;
-    result.reason = path + ": cannot open for writing";
+    result.reason = text::quote_path(path) + ": cannot open for writing";
     return result;
   }
   file << "# timestamp tx ty tz qx qy qz qw\n" << text;
   file.flush();
   if (!file) {
     result.status = Status::IoError;
-    result.reason = path + ": write error";
+    result.reason = text::quote_path(path) + ": write error";
   }
   return result;
 }
@@ -425,6 +451,23 @@ inline AssociationResult associate(const double* first, std::size_t num_first, c
       result.reason = "associate: " + why;
       return result;
     }
+  }
+  // A non-finite stamp (a frame rate of 5e-324 Hz gives inf) would silently drop its pose.
+  for (int list = 0; list < 2; ++list) {
+    const double* stamps = list == 0 ? first : second;
+    const std::size_t n = list == 0 ? num_first : num_second;
+    std::size_t bad = 0, first_bad = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (std::isfinite(stamps[i])) continue;
+      if (bad++ == 0) first_bad = i;
+    }
+    if (bad == 0) continue;
+    std::ostringstream why;
+    why << "associate: " << (list == 0 ? "first" : "second") << " list's stamp " << first_bad << " is "
+        << stamps[first_bad] << " (" << bad << " of " << n << " stamps are not finite)";
+    result.status = Status::NonFinite;
+    result.reason = why.str();
+    return result;
   }
   std::vector<std::uint32_t> a;
   std::vector<std::uint32_t> b;

@@ -12,15 +12,17 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/text.hpp"
+#include "dyncull/core/text_file.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -64,6 +66,13 @@ namespace detail {
 template <class T>
 class YoloJsonParser {
  public:
+  /// frame_id: a frame number, exact in the double a JSON number is read as (2^53 is 9.0e15).
+  static constexpr long long kMaxFrameId = 1000000000000000LL;
+  static constexpr const char* kFrameIdRange = "a frame number up to 10^15, exact in the double a JSON number is read as";
+  /// class_id: far above any detector's class count, small enough for an int.
+  static constexpr long long kMaxClassId = 1000000;
+  static constexpr const char* kClassIdRange = "a detector class index";
+
   YoloJsonParser(std::string_view text, const YoloJsonOptions& options) : s_(text), o_(options) {}
 
   /// Fills `out` (frame_id, timestamp, detections); false with error() set on the first problem.
@@ -72,7 +81,7 @@ class YoloJsonParser {
     if (!expect('{', "the file must hold one JSON object")) return false;
     bool has_id = false, has_stamp = false, has_dets = false;
     if (!object_members([&](const std::string& key) {
-          if (key == "frame_id") return unique(&has_id, key) && integer(&out->frame_id, 0, 1e15, key);
+          if (key == "frame_id") return unique(&has_id, key) && integer(&out->frame_id, 0, kMaxFrameId, key, kFrameIdRange);
           if (key == "timestamp") return unique(&has_stamp, key) && number(&out->timestamp, key);
           if (key == "detections") return unique(&has_dets, key) && detections(&out->detections);
           return skip_value(1);
@@ -246,15 +255,16 @@ class YoloJsonParser {
     return number_token(out, &integral, what);
   }
 
-  bool integer(long long* out, double lo, double hi, const std::string& what) {
+  /// A number whose value is an integer in [lo, hi], in any notation (1e3 and 1000.0 are 1000, as
+  /// Python's json reads them); `why_range` says where the bounds come from.
+  bool integer(long long* out, long long lo, long long hi, const std::string& what, const char* why_range) {
     const std::size_t start = pos_;
     double v = 0;
     bool integral = false;
     if (!number_token(&v, &integral, what)) return false;
-    if (!integral || v < lo || v > hi)
-      return fail_at(start, what + " must be an integer in [" + std::to_string(static_cast<long long>(lo)) + ", " +
-                                std::to_string(static_cast<long long>(hi)) + "]");
-    *out = static_cast<long long>(v);
+    if (!text::integer_in_range(v, lo, hi, out))
+      return fail_at(start, what + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (" +
+                                why_range + "), got " + text::quote_token(s_.substr(start, pos_ - start)));
     return true;
   }
 
@@ -285,7 +295,7 @@ class YoloJsonParser {
       if (!object_members([&](const std::string& key) {
             if (key == "class_id") {
               long long c = -1;
-              if (!unique(&has_class, index + "." + key) || !integer(&c, 0, 1e6, index + ".class_id")) return false;
+              if (!unique(&has_class, index + "." + key) || !integer(&c, 0, kMaxClassId, index + ".class_id", kClassIdRange)) return false;
               d.class_id = static_cast<int>(c);
               return true;
             }
@@ -386,7 +396,7 @@ YoloJsonFrame<T> parse_yolo_json(std::string_view text, const std::string& sourc
   YoloJsonFrame<T> out;
   if (text.size() > options.max_bytes) {
     out.status = Status::ParseError;
-    out.reason = source + ": " + std::to_string(text.size()) + " bytes, over the limit of " +
+    out.reason = text::quote_path(source) + ": " + std::to_string(text.size()) + " bytes, over the limit of " +
                  std::to_string(options.max_bytes);
     return out;
   }
@@ -394,37 +404,21 @@ YoloJsonFrame<T> parse_yolo_json(std::string_view text, const std::string& sourc
   if (!parser.parse(&out)) {
     YoloJsonFrame<T> bad;
     bad.status = Status::ParseError;
-    bad.reason = source + ": " + detail::json_position(text, parser.error_pos()) + ": " + parser.error();
+    bad.reason = text::quote_path(source) + ": " + detail::json_position(text, parser.error_pos()) + ": " + parser.error();
     return bad;
   }
   return out;
 }
 
-/// Reads and parses one file (IoError when it cannot be read or is over options.max_bytes).
+/// Reads and parses one file: IoError when the path is not a regular file (a directory, a FIFO, a
+/// device: refused before reading, named), cannot be read, or is over options.max_bytes (never reads
+/// more than that).
 template <class T>
 YoloJsonFrame<T> read_yolo_json(const std::string& path, const YoloJsonOptions& options = {}) {
   YoloJsonFrame<T> out;
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
+  std::string text;
+  if (!text::read_small_file(path, options.max_bytes, &text, &out.reason)) {
     out.status = Status::IoError;
-    out.reason = path + ": cannot open";
-    return out;
-  }
-  file.seekg(0, std::ios::end);
-  const std::streamoff size = file.tellg();
-  if (size < 0 || static_cast<unsigned long long>(size) > options.max_bytes) {
-    out.status = Status::IoError;
-    out.reason = path + ": " + (size < 0 ? std::string("cannot tell its size")
-                                         : std::to_string(size) + " bytes, over the limit of " +
-                                               std::to_string(options.max_bytes));
-    return out;
-  }
-  file.seekg(0, std::ios::beg);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (size > 0) file.read(&text[0], size);
-  if (!file) {
-    out.status = Status::IoError;
-    out.reason = path + ": read failed";
     return out;
   }
   return parse_yolo_json<T>(text, path, options);
@@ -439,7 +433,8 @@ YoloJsonSequence<T> read_yolo_json_sequence(const std::string& dir, const YoloJs
     char name[32];
     std::snprintf(name, sizeof name, "/%06zu.json", k);
     const std::string path = dir + name;
-    if (!std::ifstream(path, std::ios::binary)) break;
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) break;  // opening it to find out would block on a FIFO
     YoloJsonFrame<T> f = read_yolo_json<T>(path, options);
     if (!f.ok()) {
       seq.status = f.status;
@@ -448,14 +443,14 @@ YoloJsonSequence<T> read_yolo_json_sequence(const std::string& dir, const YoloJs
     }
     if (f.frame_id != static_cast<long long>(k)) {
       seq.status = Status::ParseError;
-      seq.reason = path + ": frame_id " + std::to_string(f.frame_id) + " differs from the file's number " + std::to_string(k);
+      seq.reason = text::quote_path(path) + ": frame_id " + std::to_string(f.frame_id) + " differs from the file's number " + std::to_string(k);
       return seq;
     }
     seq.frames.push_back(std::move(f));
   }
   if (seq.frames.empty()) {
     seq.status = Status::IoError;
-    seq.reason = dir + ": no 000000.json";
+    seq.reason = text::quote_path(dir) + ": no 000000.json";
   }
   return seq;
 }

@@ -4,6 +4,7 @@
 /// room, a noisy detector), so culling claims are measured over a suite of scenes. No paper equation.
 #pragma once
 
+#include "dyncull/core/text.hpp"
 #include "dyncull/sim/scene.hpp"
 #include "dyncull/sim/scene_keys.hpp"
 
@@ -90,7 +91,7 @@ inline bool find_scene_family(const std::string& name, SceneFamily* out, std::st
     }
     names += (names.empty() ? "" : ", ") + f.name;
   }
-  if (reason) *reason = "unknown scene family '" + name + "' (families: " + names + ")";
+  if (reason) *reason = "unknown scene family " + text::quote_token(name) + " (families: " + names + ")";
   return false;
 }
 

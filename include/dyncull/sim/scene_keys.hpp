@@ -69,7 +69,8 @@ inline const std::vector<SceneKey>& scene_keys();
 inline const SceneKey* find_scene_key(const std::string& name);
 
 /// Sets one key; InvalidInput with a reason naming the key (unknown, or the value's expected type and
-/// range) leaves `options` unchanged.
+/// range and what the key is) leaves `options` unchanged. User text in reasons (unknown keys, values,
+/// items without '=') is quoted by text::quote_token: escaped and cut at 32 characters.
 inline Status set_scene_key(SceneOptions* options, const std::string& key, const std::string& value,
                      std::string* reason = nullptr);
 /// Applies "key=value[,key=value...]" left to right (a later key wins), then SceneOptions::validate().
@@ -177,7 +178,9 @@ const F& read_field(FieldRef<F> ref, const SceneOptions& o) {
 }
 
 inline bool fail(const SceneKey& k, const std::string& value, std::string* reason) {
-  if (reason) *reason = "scene key '" + k.name + "': expected " + k.expected() + ", got " + text::quote_token(value);
+  if (reason)
+    *reason = "scene key '" + k.name + "': expected " + k.expected() + ", got " + text::quote_token(value) + " (" +
+              k.help + ")";
   return false;
 }
 
@@ -269,12 +272,16 @@ SceneKey enum_key(const char* name, FieldRef<E> ref, const std::vector<E>& value
 
 inline std::vector<SceneKey> make_scene_keys() {
   using O = SceneOptions;
-  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kMinFps = 1e-3;
+  constexpr double kMaxStartTimeS = 4e9;
   std::vector<SceneKey> k;
   // Top level.
   k.push_back(int_key("width", [](O& o) -> int& { return o.width; }, 1, 8192, "image width, px"));
   k.push_back(int_key("height", [](O& o) -> int& { return o.height; }, 1, 8192, "image height, px"));
-  k.push_back(number_key("fps", [](O& o) -> double& { return o.fps; }, 0, 1000, true, "frame rate, Hz"));
+  // Frame i is stamped start_time_s + i / fps: at least 0.001 Hz keeps a million frames' stamps
+  // finite and microseconds apart from the start time (5e-324 Hz would stamp every frame inf).
+  k.push_back(number_key("fps", [](O& o) -> double& { return o.fps; }, kMinFps, 1000, false,
+                         "frame rate, Hz; from 0.001 Hz the frame stamps start_time_s + i / fps stay finite"));
   k.push_back(int_key("num_frames", [](O& o) -> int& { return o.num_frames; }, 0, 1000000, "frames in the sequence"));
   k.push_back(enum_key<CameraMotion>("motion", [](O& o) -> CameraMotion& { return o.motion; },
                                      {CameraMotion::Static, CameraMotion::Xyz, CameraMotion::Rpy,
@@ -290,8 +297,11 @@ inline std::vector<SceneKey> make_scene_keys() {
                          "probability per frame of one spurious detection"));
   k.push_back(int_key("min_detection_pixels", [](O& o) -> int& { return o.min_detection_pixels; }, 0, 100000000,
                       "instances with fewer visible pixels are not detected"));
-  k.push_back(number_key("start_time_s", [](O& o) -> double& { return o.start_time_s; }, -kInf, kInf, false,
-                         "timestamp of frame 0, s"));
+  // Within 4e9 s (TUM's are 1.3e9) a double resolves a microsecond (its spacing there is 4.8e-7 s), so
+  // frames 1 ms apart (1000 Hz) keep distinct stamps; at 1e300 every frame would get the same stamp.
+  k.push_back(number_key("start_time_s", [](O& o) -> double& { return o.start_time_s; }, -kMaxStartTimeS,
+                         kMaxStartTimeS, false,
+                         "timestamp of frame 0, s; within 4e9 s the stamps keep microseconds and stay distinct"));
   k.push_back(number_key("near_m", [](O& o) -> double& { return o.near_m; }, 0, 100, true,
                          "surfaces closer than this are clipped, m"));
   // Depth noise model.
@@ -434,7 +444,7 @@ inline Status set_scene_key(SceneOptions* options, const std::string& key, const
   }
   const SceneKey* k = find_scene_key(key);
   if (k == nullptr) {
-    if (reason) *reason = "unknown scene key '" + key + "' (dynamic_vo --help lists the keys)";
+    if (reason) *reason = "unknown scene key " + text::quote_token(key) + " (dynamic_vo --help lists the keys)";
     return Status::InvalidInput;
   }
   if (!k->set(*options, value, reason)) return Status::InvalidInput;
@@ -456,7 +466,7 @@ inline Status apply_scene_assignments(SceneOptions* options, const std::string& 
     if (item.empty()) continue;
     const std::size_t eq = item.find('=');
     if (eq == std::string::npos) {
-      if (reason) *reason = "scene assignment '" + item + "' is not key=value";
+      if (reason) *reason = "scene assignment " + text::quote_token(item) + " is not key=value";
       return Status::InvalidInput;
     }
     const Status s = set_scene_key(options, item.substr(0, eq), item.substr(eq + 1), reason);
