@@ -126,7 +126,7 @@ TEST_F(SequenceFolder, BadListsNameFileAndLine) {
   write("rgb.txt", "1.0 rgb/1.0.png\n");
   s = eval::read_sequence(dir_.string());
   EXPECT_EQ(s.status, Status::IoError);
-  EXPECT_NE(s.reason.find("depth.txt: not a regular file"), std::string::npos) << s.reason;
+  EXPECT_NE(s.reason.find("depth.txt: is a directory, not a regular file"), std::string::npos) << s.reason;
 
   s = eval::read_sequence(path("nowhere"));
   EXPECT_EQ(s.status, Status::IoError);

@@ -16,6 +16,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/text.hpp"
+#include "dyncull/core/text_file.hpp"
 #include "dyncull/culling/detections.hpp"
 #include "dyncull/eval/trajectory.hpp"
 #include "dyncull/eval/yolo_json.hpp"
@@ -132,57 +133,34 @@ struct SequenceDetections {
 
 namespace detail {
 
-/// Calls line(number, text) for each line of a regular file, '\r' stripped. IoError for a missing,
-/// non-regular or unreadable file; ParseError "path:line: ..." for a line over max_chars (read in pieces,
-/// never held whole). `line` returns false to stop with its own reason.
+/// Calls line(number, text) for each line of a regular file (text::LineReader: streaming, bounded),
+/// '\r' stripped. IoError for a missing, non-regular or unreadable file; ParseError "path:line: ..." for
+/// a data line over max_chars or past the line limit. `line` returns false to stop with its own reason.
 template <class Fn>
 Status for_each_line(const std::string& path, std::size_t max_chars, std::string* reason, Fn&& line) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(st)) {
-    *reason = path + ": does not exist";
+  text::LineReader in;
+  if (!in.open(path, text::LineReaderOptions{max_chars, text::LineReaderOptions{}.max_lines})) {
+    *reason = in.error();
     return Status::IoError;
   }
-  if (!std::filesystem::is_regular_file(st)) {
-    *reason = path + ": not a regular file";
-    return Status::IoError;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *reason = path + ": cannot open for reading";
-    return Status::IoError;
-  }
-  std::string buf;
-  std::size_t number = 0;
-  while (true) {
-    buf.clear();
-    // getline into a bounded buffer: read at most max_chars + 1 characters of the line.
-    char c = 0;
-    bool any = false, too_long = false;
-    while (in.get(c)) {
-      any = true;
-      if (c == '\n') break;
-      if (buf.size() > max_chars) {
-        too_long = true;
-        continue;  // skip the rest of the line without storing it
-      }
-      buf.push_back(c);
-    }
-    if (!any) break;
-    ++number;
-    if (!buf.empty() && buf.back() == '\r') buf.pop_back();
-    const std::size_t first = buf.find_first_not_of(" \t");
-    const bool comment = first == std::string::npos || buf[first] == '#';
-    if ((too_long || buf.size() > max_chars) && !comment) {
-      *reason = path + ":" + std::to_string(number) + ": line longer than " + std::to_string(max_chars) + " characters";
+  std::string_view text;
+  for (text::LineStatus s; (s = in.next(&text)) != text::LineStatus::End;) {
+    if (s == text::LineStatus::TooManyLines) {
+      *reason = in.error();
       return Status::ParseError;
     }
-    if (!line(number, std::string_view(buf), reason)) return Status::ParseError;
-    if (in.eof()) break;
-  }
-  if (in.bad()) {
-    *reason = path + ": read error";
-    return Status::IoError;
+    if (s == text::LineStatus::ReadError) {
+      *reason = in.error();
+      return Status::IoError;
+    }
+    if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
+    const std::size_t first = text.find_first_not_of(" \t");
+    const bool comment = first == std::string_view::npos || text[first] == '#';
+    if (s == text::LineStatus::TooLong && !comment) {
+      *reason = text::line_location(in) + "line longer than " + std::to_string(max_chars) + " characters";
+      return Status::ParseError;
+    }
+    if (!line(in.line_number(), text, reason)) return Status::ParseError;
   }
   return Status::Ok;
 }
