@@ -256,6 +256,22 @@ TEST_F(SequenceFolder, YoloTextByStampOrStemAndBadLinesNamed) {
   EXPECT_EQ(eval::read_sequence_detections(path("nothing"), s, 640, 480).status, Status::IoError);
 }
 
+TEST_F(SequenceFolder, YoloBoxTheFilterCannotUseIsCountedAndNamed) {
+  lists({"10.000", "10.033"}, {"10.001", "10.034"});
+  // 1e400 parses as infinity: the line is well formed, the box is not usable.
+  write("yolo.txt", "10.000 0 0.5 0.5 0.25 0.5 0.9\n10.033 0 0.5 0.5 1e400 0.5 0.9\n");
+  const eval::SequenceIndex s = eval::read_sequence(dir_.string());
+  ASSERT_TRUE(s.ok()) << s.reason;
+  const eval::SequenceDetections d = eval::read_sequence_detections(path("yolo.txt"), s, 640, 480);
+  ASSERT_TRUE(d.ok()) << d.reason;
+  EXPECT_EQ(d.boxes_read, 2u);
+  EXPECT_EQ(d.boxes_dropped, 1u);
+  EXPECT_TRUE(d.per_frame[1].empty());
+  std::string all;
+  for (const std::string& n : d.notes.first) all += n + "\n";
+  EXPECT_NE(all.find("yolo.txt:2: box dropped"), std::string::npos) << all;
+}
+
 // The real sequence: 464 frames of Bonn crowd (Palazzolo et al. 2019), a person first detected at frame
 // 57. Three depth files of the span are not published (stamps 1548339819.855, 826.762, 834.304), yet
 // associate.py's rule still pairs every grey frame: the depth clock drifts against the rgb clock (depth -

@@ -519,6 +519,10 @@ inline void read_yolo_text(const std::string& path, const SequenceIndex& s, int 
     const DetectionsResult<float> c = convert_yolo_detections<float>(r.boxes, width, height, options.detection_filter);
     d->boxes_read += 1;
     d->boxes_dropped += 1 - c.detections.size();
+    // Low confidence is the filter's ordinary work; a box it cannot use at all is worth naming.
+    if (c.detections.empty() && !c.rejections.empty() && c.rejections.front() != BoxRejection::LowConfidence)
+      d->notes.add(file + ":" + std::to_string(number) + ": box dropped (" + to_string(c.rejections.front()) + ")",
+                   options.max_notes);
     d->per_frame[i].insert(d->per_frame[i].end(), c.detections.begin(), c.detections.end());
     d->has_file[i] = 1;
     return true;
