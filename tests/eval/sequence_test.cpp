@@ -2,6 +2,7 @@
 // files reported and run without depth, camera.txt and command-line intrinsics, detections by stamp; and
 // the real Bonn crowd_part1 folder through DYNCULL_DATA_DIR (skipped loudly without it).
 #include "dyncull/eval/sequence.hpp"
+#include "support/special_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -270,6 +271,27 @@ TEST_F(SequenceFolder, YoloBoxTheFilterCannotUseIsCountedAndNamed) {
   std::string all;
   for (const std::string& n : d.notes.first) all += n + "\n";
   EXPECT_NE(all.find("yolo.txt:2: box dropped"), std::string::npos) << all;
+}
+
+TEST_F(SequenceFolder, FifosAndDevicesAreRefusedPromptly) {
+  lists({"10.000", "10.033"}, {"10.001", "10.034"});
+  const eval::SequenceIndex s = eval::read_sequence(dir_.string());
+  ASSERT_TRUE(s.ok()) << s.reason;
+  const std::string fifo = path("dets.txt");
+  if (!test::make_fifo(fifo)) return;
+  eval::SequenceDetections d;
+  EXPECT_TRUE(test::returns_promptly([&] { d = eval::read_sequence_detections(fifo, s, 640, 480); }, fifo));
+  EXPECT_EQ(d.status, Status::IoError);
+  EXPECT_NE(d.reason.find("is a FIFO"), std::string::npos) << d.reason;
+  EXPECT_EQ(eval::read_sequence_detections("/dev/zero", s, 640, 480).status, Status::IoError);
+
+  fs::remove(path("rgb.txt"));
+  const std::string rgb = path("rgb.txt");
+  if (!test::make_fifo(rgb)) return;
+  eval::SequenceIndex blocked;
+  EXPECT_TRUE(test::returns_promptly([&] { blocked = eval::read_sequence(dir_.string()); }, rgb));
+  EXPECT_EQ(blocked.status, Status::IoError);
+  EXPECT_NE(blocked.reason.find("rgb.txt: is a FIFO"), std::string::npos) << blocked.reason;
 }
 
 // The real sequence: 464 frames of Bonn crowd (Palazzolo et al. 2019), a person first detected at frame

@@ -461,42 +461,6 @@ TEST(DynamicVo, KeyframeAfterTenCentimetresOfTravel) {
   EXPECT_EQ(front_end.frames_since_keyframe(), 0);
 }
 
-TEST(DynamicVo, TumSourceReadsDirectory) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "dyncull_dynamic_vo_test_tum";
-  std::filesystem::create_directories(dir / "rgb");
-  std::filesystem::create_directories(dir / "depth");
-  cv::Mat rgb(48, 64, CV_8UC3, cv::Scalar(10, 20, 30));
-  cv::Mat depth(48, 64, CV_16UC1, cv::Scalar(5000));  // 1 m
-  ASSERT_TRUE(cv::imwrite((dir / "rgb/1.000000.png").string(), rgb));
-  ASSERT_TRUE(cv::imwrite((dir / "rgb/2.000000.png").string(), rgb));
-  ASSERT_TRUE(cv::imwrite((dir / "depth/1.010000.png").string(), depth));
-  ASSERT_TRUE(cv::imwrite((dir / "depth/2.500000.png").string(), depth));
-  std::ofstream(dir / "rgb.txt") << "# color images\n1.000000 rgb/1.000000.png\n2.000000 rgb/2.000000.png\n";
-  std::ofstream(dir / "depth.txt") << "# depth maps\n1.010000 depth/1.010000.png\n2.500000 depth/2.500000.png\n";
-  std::ofstream(dir / "dets.txt") << "1.000000 0 0.5 0.5 0.25 0.5 0.9\n1.000000 0 nan 0.5 0.25 0.5 0.9\n";
-
-  vo::TumSource src;
-  std::string error;
-  PinholeCamera<double> cam{50, 50, 31.5, 23.5, 64, 48};
-  ASSERT_TRUE(src.open(dir.string(), (dir / "dets.txt").string(), cam, &error)) << error;
-  EXPECT_EQ(src.size(), 1);  // the second RGB image has no depth within 0.02 s
-  EXPECT_TRUE(src.has_detections());
-  vo::SequenceFrame f;
-  ASSERT_TRUE(src.load(0, &f, &error)) << error;
-  EXPECT_DOUBLE_EQ(f.timestamp, 1.0);
-  EXPECT_EQ(f.gray.type(), CV_8UC1);
-  EXPECT_FLOAT_EQ(f.depth_m.at<float>(5, 5), 1.0f);
-  ASSERT_EQ(f.detections.size(), 1u);  // the NaN box is rejected
-  EXPECT_EQ(f.detections[0].class_id, 0);
-  EXPECT_NEAR(f.detections[0].box.centre().x(), 32.0, 1.0);
-
-  vo::TumSource missing;
-  EXPECT_FALSE(missing.open((dir / "nope").string(), "", cam, &error));
-  EXPECT_NE(error.find("rgb.txt"), std::string::npos);
-  std::filesystem::remove_all(dir);
-}
-
-
 // Per family: median ATE over its motions x seeds for each strategy, the recommended / oracle and
 // recommended / none ratios of those medians, the worst motion's ratio, and labels pooled over the runs.
 TEST(DynamicVo, FamilySummaryGivesMediansRatiosAndPooledLabels) {
