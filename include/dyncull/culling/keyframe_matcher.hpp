@@ -16,6 +16,7 @@
 #pragma once
 
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -191,10 +192,7 @@ struct KfmWork {
 /// Cell index along one axis, clamped in the floating type before the int conversion (NaN -> 0).
 template <class T>
 inline int kfm_cell(T v, T origin, T cell, int count) {
-  const T c = (v - origin) / cell;
-  if (!(c >= T(0))) return 0;
-  if (c >= T(count - 1)) return count - 1;
-  return static_cast<int>(c);
+  return clamped_int((v - origin) / cell, 0, count - 1);
 }
 
 /// Hamming distance of two rows; kWords > 0 fixes the length at compile time (ORB: 4 words, no tail).
@@ -465,10 +463,8 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
     if (spread > c) c = spread;
     if (std::isfinite(c) && c <= static_cast<double>(std::numeric_limits<T>::max())) {
       cell = static_cast<T>(c);
-      cols = static_cast<int>(ex / c) + 1;
-      rows = static_cast<int>(ey / c) + 1;
-      cols = cols > kMaxCellsPerSide ? kMaxCellsPerSide : cols;
-      rows = rows > kMaxCellsPerSide ? kMaxCellsPerSide : rows;
+      cols = clamped_int(ex / c, 0, kMaxCellsPerSide - 1) + 1;
+      rows = clamped_int(ey / c, 0, kMaxCellsPerSide - 1) + 1;
     } else {
       x0 = y0 = T(0);
       cell = std::numeric_limits<T>::max();

@@ -133,7 +133,8 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   const double survivor_fraction =
       options.guard.min_fraction >= 0 ? std::min(options.guard.min_fraction, 1.0) : 0.0;
   const std::size_t need =
-      std::max(options.guard.min_survivors, static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));
+      std::max(options.guard.min_survivors,
+               static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));  // checked: fraction in [0, 1]
   if (options.guard.enabled && survivors < need && n > 0) {
     std::size_t soft = 0;
     for (std::size_t i = 0; i < n; ++i) soft += r->labels[i] == FeatureLabel::Dynamic && is_soft_cull(r->reasons[i]);
