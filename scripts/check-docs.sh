@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Checks that the documentation, code comments and test names describe what dyncull does rather than how
-# it was developed (that belongs in git log), and that relative links in README.md and docs/*.md resolve.
+# it was developed (that belongs in git log), that relative links in README.md and docs/*.md resolve, and
+# (scripts/check-casts.sh) that no float-to-int conversion in include/ and src/ is raw.
 # Prints file:line: text for every hit and exits 1 if there is any. Usage: scripts/check-docs.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -73,5 +74,13 @@ then
   status=1
 fi
 
-if [[ $status -eq 0 ]]; then echo "check-docs: no development history, all relative links resolve, README snippet current"; fi
+# Every float-to-int conversion of user data goes through core/pixel.hpp's checked helpers, or says why it
+# is in range (scripts/check-casts.sh).
+if ! scripts/check-casts.sh; then
+  status=1
+fi
+
+if [[ $status -eq 0 ]]; then
+  echo "check-docs: no development history, all relative links resolve, README snippet current, no raw float-to-int"
+fi
 exit $status

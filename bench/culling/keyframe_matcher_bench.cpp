@@ -3,7 +3,8 @@
 // against the front end's own costs in the same binary: cv::ORB detectAndCompute of those features,
 // cv::BFMatcher(NORM_HAMMING) knn matching of the same sets and cv::calcOpticalFlowPyrLK of the same
 // points. Counter `vs_orb` = time per call / ORB detectAndCompute's on the same frame (target < 0.1);
-// `inliers` = share of matches the true motion confirms within 3 px.
+// `inliers` = share of matches the true motion confirms within 3 px. BM_KeyframeMatcherClustered: the
+// same matcher on keypoints clustered in a 20 px patch, its worst case.
 #include "dyncull/culling/keyframe_matcher.hpp"
 
 #include "dyncull/core/random.hpp"
@@ -169,10 +170,43 @@ void BM_KeyframeMatcher(benchmark::State& state) {
   state.counters["matched"] = double(r.matched);
   state.counters["inliers"] = inlier_share(d, r);
   state.counters["candidates"] = mean_candidates(d, ws, o);
+  state.counters["capped"] = double(r.searches_capped);  // searches subsampled by max_candidates: 0 here
   if (d.orb_seconds > 0) state.counters["vs_orb"] = per_call / d.orb_seconds;
   state.SetLabel(mode == 0 ? "pose + depth" : (mode == 1 ? "pose, no depth" : "no pose"));
 }
 BENCHMARK(BM_KeyframeMatcher)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+
+/// The worst case of a per-disc search: range(0) keyframe and as many current keypoints, all in one 20 px
+/// patch, random descriptors, no pose (every disc holds the whole patch). KeyframeMatchOptions::max_candidates
+/// bounds each search, so the time grows linearly with the keypoints. Counters: `examined` = current
+/// keypoints examined per keyframe point, `capped` = share of searches that were subsampled.
+void BM_KeyframeMatcherClustered(benchmark::State& state) {
+  const std::size_t n = static_cast<std::size_t>(state.range(0));
+  dyncull::Random rng(7);
+  std::vector<Vec2<float>> kf, cur;
+  for (std::size_t i = 0; i < n; ++i) {
+    kf.emplace_back(float(300 + rng.uniform(0, 20)), float(200 + rng.uniform(0, 20)));
+    cur.emplace_back(float(300 + rng.uniform(0, 20)), float(200 + rng.uniform(0, 20)));
+  }
+  std::vector<std::uint8_t> kd(32 * n), cd(32 * n);
+  for (auto& b : kd) b = static_cast<std::uint8_t>(rng.next() >> 56);
+  for (auto& b : cd) b = static_cast<std::uint8_t>(rng.next() >> 56);
+  const std::vector<Vec3<float>> no_depth;
+  const auto camera = dyncull::PinholeCamera<float>::tum_fr3();
+  dyncull::KeyframeMatchWorkspace<float> ws;
+  dyncull::KeyframeMatchResult<float> r;
+  const dyncull::KeyframeMatchOptions o;
+  for (auto _ : state) {
+    dyncull::match_to_keyframe(kf, no_depth, dyncull::DescriptorRows(kd.data(), n), cur,
+                               dyncull::DescriptorRows(cd.data(), n), camera, nullptr, o, ws, &r);
+    benchmark::DoNotOptimize(r.keyframe_index.data());
+  }
+  state.counters["keypoints"] = double(n);
+  state.counters["examined"] = double(r.examined) / double(n);
+  state.counters["capped"] = double(r.searches_capped) / double(n);
+  state.SetLabel("20 px patch, no pose");
+}
+BENCHMARK(BM_KeyframeMatcherClustered)->Arg(1000)->Arg(5000)->Arg(20000)->Unit(benchmark::kMillisecond);
 
 #ifdef DYNCULL_HAS_OPENCV
 void BM_OpenCvOrbDetectAndCompute(benchmark::State& state) {

@@ -97,6 +97,14 @@ TEST(DepthView, ValidateNamesTheBadField) {
   EXPECT_NE(why.find("units_per_metre"), std::string::npos) << why;
   view.units_per_metre = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  for (float units : {1e-40f, 1e-4f, 2e6f, 1e9f}) {  // no sensor has these units
+    view.units_per_metre = units;
+    EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput) << units;
+    EXPECT_NE(why.find("units_per_metre"), std::string::npos) << why;
+  }
+  view = dyncull::tum_depth_view(raw.data(), 2, 2, 0.f, 0.f);  // no depth can be valid
+  EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);
+  EXPECT_NE(why.find("max_m"), std::string::npos) << why;
   view = dyncull::tum_depth_view(raw.data(), 2, 2);
   view.stride = 1;
   EXPECT_EQ(view.validate(&why), dyncull::Status::InvalidInput);

@@ -61,4 +61,41 @@ TYPED_TEST(PixelTest, OutsideNonFiniteAndHugeCoordinatesHaveNoPixel) {
   EXPECT_FALSE(pixel_index(T(2147483648.0), INT_MAX, &u));
 }
 
+TYPED_TEST(PixelTest, ClampedIntTruncatesInsideTheRangeAndClampsOutside) {
+  using T = TypeParam;
+  const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+  EXPECT_EQ(clamped_int(T(3.9), 0, 10), 3);
+  EXPECT_EQ(clamped_int(T(-2.5), -5, 10), -2);  // toward zero, as static_cast<int>
+  EXPECT_EQ(clamped_int(T(0), 0, 10), 0);
+  EXPECT_EQ(clamped_int(T(9.99), 0, 10), 9);
+  EXPECT_EQ(clamped_int(T(10), 0, 10), 10);
+  EXPECT_EQ(clamped_int(T(-0.5), 0, 10), 0);
+  for (const T x : {inf, std::numeric_limits<T>::max(), T(4294967306.0), T(2147483648.0)}) {
+    EXPECT_EQ(clamped_int(x, 0, 255), 255) << x;
+    EXPECT_EQ(clamped_int(x, INT_MIN, INT_MAX), INT_MAX) << x;
+  }
+  for (const T x : {nan, -inf, std::numeric_limits<T>::lowest(), T(-4294967286.0)}) {
+    EXPECT_EQ(clamped_int(x, 1, 255), 1) << x;
+    EXPECT_EQ(clamped_int(x, INT_MIN, INT_MAX), INT_MIN) << x;
+  }
+}
+
+TYPED_TEST(PixelTest, CheckedIntRefusesNonFiniteAndOutOfRangeValues) {
+  using T = TypeParam;
+  const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+  int v = -7;
+  EXPECT_TRUE(checked_int(T(79.9), 0, 79, &v));
+  EXPECT_EQ(v, 79);
+  EXPECT_TRUE(checked_int(T(-1.5), -1, 79, &v));
+  EXPECT_EQ(v, -1);
+  v = -7;
+  for (const T x : {nan, inf, -inf, T(80), T(-2), T(4294967296.0), T(1e30), std::numeric_limits<T>::lowest()}) {
+    EXPECT_FALSE(checked_int(x, -1, 79, &v)) << x;
+    EXPECT_EQ(v, -7) << x;  // untouched
+  }
+  EXPECT_TRUE(checked_int(T(-2147483648.0), INT_MIN, INT_MAX, &v));
+  EXPECT_EQ(v, INT_MIN);
+  EXPECT_FALSE(checked_int(T(2147483648.0), INT_MIN, INT_MAX, &v));
+}
+
 }  // namespace

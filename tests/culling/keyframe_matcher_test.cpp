@@ -1,8 +1,9 @@
 // Tests of culling/keyframe_matcher.hpp: guided Hamming matching of current keypoints to a keyframe on
 // synthetic views with known motion (depth + pose, rotation only, no pose), the ratio, distance and
 // mutual tests, bad inputs (NaN keypoints, empty sets, mismatched sizes, missing depth, bad options,
-// non-finite pose) with defined results and reasons, no allocation after warm-up, and a property test
-// against a brute-force oracle on random input.
+// non-finite pose) with defined results and reasons, no allocation after warm-up, a property test
+// against a brute-force oracle on random input, and keypoints clustered in a few pixels matched in work
+// linear in the keypoints.
 #include "dyncull/culling/keyframe_matcher.hpp"
 
 #include "dyncull/core/random.hpp"
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bitset>
+#include <ctime>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -343,6 +345,8 @@ TYPED_TEST(KeyframeMatcherTyped, BadOptionsCameraAndPoseAreReported) {
       {"ratio", [](KeyframeMatchOptions& o) { o.ratio = std::nan(""); }},
       {"grid_cell_px", [](KeyframeMatchOptions& o) { o.grid_cell_px = 0.5; }},
       {"grid_cell_px", [](KeyframeMatchOptions& o) { o.grid_cell_px = std::nan(""); }},
+      {"max_candidates", [](KeyframeMatchOptions& o) { o.max_candidates = 0; }},
+      {"max_candidates", [](KeyframeMatchOptions& o) { o.max_candidates = std::size_t(1) << 21; }},
   };
   for (const Case& c : cases) {
     KeyframeMatchOptions o;
@@ -498,6 +502,111 @@ TEST(KeyframeMatcher, NoAllocationAfterWarmUp) {
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_TRUE(r.ok());
   EXPECT_GT(r.matched, 900u);
+}
+
+/// n keyframe and n current keypoints inside a side x side pixel patch (no pose: every search disc holds
+/// the whole patch), random descriptors: the worst case of a per-disc search.
+struct ClusteredViews {
+  dyncull::PinholeCamera<float> camera = dyncull::PinholeCamera<float>::tum_fr3();
+  std::vector<Vec2<float>> kf_kp, cur_kp;
+  std::vector<std::uint8_t> kf_desc, cur_desc;
+  ClusteredViews(std::size_t n, double side, std::uint64_t seed) {
+    dyncull::Random rng(seed);
+    for (std::size_t i = 0; i < n; ++i) {
+      kf_kp.emplace_back(float(300 + rng.uniform(0, side)), float(200 + rng.uniform(0, side)));
+      cur_kp.emplace_back(float(300 + rng.uniform(0, side)), float(200 + rng.uniform(0, side)));
+    }
+    kf_desc.resize(32 * n);
+    cur_desc.resize(32 * n);
+    for (auto& b : kf_desc) b = static_cast<std::uint8_t>(rng.next() >> 56);
+    for (auto& b : cur_desc) b = static_cast<std::uint8_t>(rng.next() >> 56);
+  }
+  void match(const KeyframeMatchOptions& o, KeyframeMatchWorkspace<float>& ws, KeyframeMatchResult<float>* r) const {
+    const std::vector<Vec3<float>> no_depth;
+    dyncull::match_to_keyframe(kf_kp, no_depth, DescriptorRows(kf_desc.data(), kf_kp.size()), cur_kp,
+                               DescriptorRows(cur_desc.data(), cur_kp.size()), camera, nullptr, o, ws, r);
+  }
+};
+
+// Generous: 0.1-0.4 s in a Release build; comparing every pair took 3-5 s (25 s under ASan + UBSan).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kClusteredFrameSeconds = 15.0;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(undefined_behavior_sanitizer)
+constexpr double kClusteredFrameSeconds = 15.0;
+#else
+constexpr double kClusteredFrameSeconds = 2.0;
+#endif
+#else
+constexpr double kClusteredFrameSeconds = 2.0;
+#endif
+
+// 20,000 keypoints in a 20 px patch on both sides: each search examines at most max_candidates keypoints
+// (an even subsample of its cells), so the work doubles with the keypoints instead of quadrupling, and the
+// frame takes well under a second (every pair was compared before: 4e8 descriptor distances).
+TEST(KeyframeMatcher, ClusteredKeypointsAreMatchedInLinearWork) {
+  const KeyframeMatchOptions o;
+  KeyframeMatchWorkspace<float> ws;
+  KeyframeMatchResult<float> half, full;
+  const ClusteredViews a(10000, 20.0, 41), b(20000, 20.0, 42);
+  a.match(o, ws, &half);
+  const std::clock_t t0 = std::clock();  // processor time: other processes on the machine do not count
+  b.match(o, ws, &full);
+  const double seconds = double(std::clock() - t0) / CLOCKS_PER_SEC;
+  ASSERT_TRUE(half.ok()) << half.reason;
+  ASSERT_TRUE(full.ok()) << full.reason;
+  EXPECT_EQ(full.searches_capped, 20000u);
+  EXPECT_LE(full.examined, 20000u * o.max_candidates);
+  EXPECT_GE(full.examined, 20000u * (o.max_candidates / 2)) << "a capped search examines about max_candidates";
+  EXPECT_LE(double(full.examined), 2.05 * double(half.examined)) << "work linear in the keypoints";
+  EXPECT_LT(seconds, kClusteredFrameSeconds) << "one clustered frame of 20,000 keypoints";
+  // Whatever was compared, a match is a pair within the radius at its true distance, each keypoint once.
+  std::vector<int> used(b.kf_kp.size(), 0);
+  for (std::size_t i = 0; i < full.keyframe_index.size(); ++i) {
+    const int k = full.keyframe_index[i];
+    if (k < 0) continue;
+    EXPECT_EQ(full.distance[i], naive_hamming(&b.kf_desc[32 * std::size_t(k)], &b.cur_desc[32 * i], 32));
+    EXPECT_LE((b.kf_kp[std::size_t(k)] - b.cur_kp[i]).norm(), float(o.radius_unpredicted_px));
+    EXPECT_EQ(++used[std::size_t(k)], 1);
+  }
+}
+
+// On ordinary input no search reaches the bound: the results are those of an unbounded search.
+TYPED_TEST(KeyframeMatcherTyped, TheCandidateBoundLeavesOrdinaryInputUnchanged) {
+  using T = TypeParam;
+  const TwoViews<T> v(2000, pose_from<T>(0.01, 0.02, 0, 0.05, 0, 0.02), 77);
+  KeyframeMatchOptions unbounded;
+  unbounded.max_candidates = KeyframeMatchOptions::kMaxCandidatesLimit;
+  for (int mode = 0; mode < 3; ++mode) {
+    const std::vector<Vec3<T>> no_depth;
+    const std::vector<Vec3<T>>& pts = mode == 0 ? v.kf_pts : no_depth;
+    const dyncull::Rigid3<T>* pose = mode == 2 ? nullptr : &v.cam_from_kf;
+    const auto bounded = v.match(pts, pose);
+    const auto all = v.match(pts, pose, unbounded);
+    ASSERT_TRUE(bounded.ok()) << bounded.reason;
+    EXPECT_EQ(bounded.searches_capped, 0u) << mode;
+    EXPECT_EQ(bounded.keyframe_index, all.keyframe_index) << mode;
+    EXPECT_EQ(bounded.examined, all.examined) << mode;
+    EXPECT_GT(bounded.matched, 1000u) << mode;
+  }
+}
+
+// A bound below a disc's population subsamples it: fewer keypoints examined, each search counted.
+TEST(KeyframeMatcher, ASmallCandidateBoundSubsamplesEachSearch) {
+  const ClusteredViews c(500, 10.0, 43);
+  KeyframeMatchOptions o;
+  o.max_candidates = 50;
+  KeyframeMatchWorkspace<float> ws;
+  KeyframeMatchResult<float> r;
+  c.match(o, ws, &r);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.searches_capped, 500u);
+  EXPECT_LE(r.examined, 500u * 50u);
+  EXPECT_GE(r.examined, 500u * 25u);
+  o.max_candidates = 500;
+  c.match(o, ws, &r);
+  EXPECT_EQ(r.searches_capped, 0u);
+  EXPECT_EQ(r.examined, 500u * 500u);
 }
 
 // Brute-force oracle: every pair, the same prediction, radius, distance, ratio and mutual rules.

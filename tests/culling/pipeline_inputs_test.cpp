@@ -306,6 +306,107 @@ TYPED_TEST(PipelineInputsTest, InvalidDepthViewIsInvalidInput) {
   expect_nothing_culled(cull_frame(frame, presets::recommended<T>(), &state), s.size(), "units_per_metre");
 }
 
+// Units no depth sensor has (a denormal float passed every check, and no depth read as valid) and a
+// range that holds no depth are refused at entry, naming the field.
+TYPED_TEST(PipelineInputsTest, DepthUnitsNoSensorHasAndANonPositiveMaxDepthAreInvalidInput) {
+  using T = TypeParam;
+  const auto s = test::make_culling_scene<T>();
+  const auto dets = detections_of(s);
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.depth_mask.enabled = true;
+  for (float units : {1e-40f, 1e-9f, 1e-4f, 1e7f, 1e9f}) {
+    auto frame = frame_of(s, dets);
+    frame.depth.units_per_metre = units;
+    PipelineState<T> state;
+    expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "units_per_metre");
+  }
+  for (float max_m : {0.f, -1.f}) {
+    auto frame = frame_of(s, dets);
+    frame.depth.max_m = max_m;
+    PipelineState<T> state;
+    expect_nothing_culled(cull_frame(frame, o, &state), s.size(), "max_m");
+  }
+  auto frame = frame_of(s, dets);
+  frame.depth.units_per_metre = 1e6f;  // the bounds themselves are sensors' units
+  PipelineState<T> state;
+  EXPECT_TRUE(cull_frame(frame, o, &state).labelled()) << state.result.reason;
+  frame.depth.units_per_metre = 1e-3f;
+  EXPECT_TRUE(cull_frame(frame, o, &state).labelled()) << state.result.reason;
+}
+
+TYPED_TEST(PipelineInputsTest, ZeroReferenceKeyframesIsInvalidInput) {
+  using T = TypeParam;
+  const FullFrame<T> full;
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.multiview.enabled = true;
+  o.multiview.max_reference_keyframes = 0;
+  std::string why;
+  EXPECT_EQ(o.validate(&why), Status::InvalidInput);
+  EXPECT_EQ(why, "multiview.max_reference_keyframes must be in [1, 64]");
+  PipelineState<T> state;
+  full.prime(&state, true);
+  expect_nothing_culled(cull_frame(full.frame(), o, &state), full.scene.size(), "multiview.max_reference_keyframes");
+  o.multiview.max_reference_keyframes = 1;
+  full.prime(&state, true);
+  EXPECT_EQ(cull_frame(full.frame(), o, &state).status, Status::Ok) << state.result.reason;
+}
+
+// The frame status is the worst of its enabled stages': a stage that ran but could not do its job gives
+// the frame its status and its name, outranking a missing input; the other stages' labels stand.
+TYPED_TEST(PipelineInputsTest, AStageThatCouldNotDoItsJobGivesTheFrameItsStatusAndName) {
+  using T = TypeParam;
+  const FullFrame<T> full;
+  const std::size_t n = full.scene.size();
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.depth_mask.enabled = true;
+  o.multiview.enabled = true;
+  PipelineState<T> state;
+  full.prime(&state, true);
+  const PipelineResult<T>& good = cull_frame(full.frame(), o, &state);
+  ASSERT_EQ(good.status, Status::Ok) << good.reason;
+  EXPECT_TRUE(good.reason.empty()) << good.reason;
+  const std::size_t culled_when_good = good.num_dynamic;
+  ASSERT_GT(culled_when_good, 0u);
+
+  // The only keyframe has no depth: no keyframe point can be compared (multiview: TooFewPoints).
+  const std::vector<T> no_depth(full.keyframe.depth_m.size(), T(0));
+  state.reset();
+  state.keyframes.push(full.keyframe.cam_from_world, full.keyframe.keypoints, no_depth);
+  const PipelineResult<T>& mv = cull_frame(full.frame(), o, &state);
+  EXPECT_EQ(mv.multiview.status, Status::TooFewPoints);
+  EXPECT_EQ(mv.status, Status::TooFewPoints) << mv.reason;
+  EXPECT_NE(mv.reason.find("multiview: no keyframe point could be compared"), std::string::npos) << mv.reason;
+  EXPECT_TRUE(mv.labelled());
+  ASSERT_EQ(mv.keep.size(), n);
+  EXPECT_GT(mv.num_dynamic, 0u) << "the other stages still cull";
+
+  // TUM units with a range no 16-bit value reaches (the depth masks: InvalidInput), and no points_3d for
+  // the reprojection check (MissingInput): the failure sets the status, both are named.
+  const std::vector<std::uint16_t> raw = full.scene.depth_tum();
+  const auto f = full.frame();
+  CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t> tum;
+  tum.keypoints = f.keypoints;
+  tum.prev_keypoints = f.prev_keypoints;
+  tum.track_valid = f.track_valid;
+  tum.track_ids = f.track_ids;
+  tum.detections = f.detections;
+  tum.camera = f.camera;
+  tum.cam_from_world = f.cam_from_world;
+  tum.depth = tum_depth_view(raw.data(), full.scene.width, full.scene.height, 20.f);
+  ASSERT_EQ(tum.depth.validate(), Status::Ok);
+  o.multiview.enabled = false;
+  full.prime(&state, true);
+  const PipelineResult<T>& dm = cull_frame(tum, o, &state);
+  EXPECT_EQ(dm.depth_mask.status, Status::InvalidInput);
+  EXPECT_EQ(dm.status, Status::InvalidInput) << dm.reason;
+  EXPECT_NE(dm.reason.find("depth_mask: depth min_m and max_m leave no raw depth value valid"), std::string::npos)
+      << dm.reason;
+  EXPECT_NE(dm.reason.find("reprojection: no points_3d given"), std::string::npos) << dm.reason;
+  EXPECT_TRUE(dm.labelled());
+  ASSERT_EQ(dm.keep.size(), n);
+  EXPECT_GT(dm.num_dynamic, 0u) << "the box rule still culls";
+}
+
 TYPED_TEST(PipelineInputsTest, HugeFloatDepthThroughTheRecommendedPreset) {
   using T = TypeParam;
   auto s = test::make_culling_scene<T>();

@@ -63,9 +63,9 @@ PixelRect pixel_rect(const Box<T>& box, int width, int height) {
   if (!box.valid() || width <= 0 || height <= 0) return r;
   using std::ceil;
   using std::floor;
-  // Clamped to [0, size] in double before the cast: corners beyond the int range are finite
-  // user input, and casting them would be undefined. Double holds every float, double and int.
-  auto index = [](double v, int size) { return static_cast<int>(std::min(std::max(v, 0.0), double(size))); };
+  // Clamped to [0, size] before the conversion: corners beyond the int range are finite user input,
+  // and converting them raw would be undefined. Double holds every float, double and int.
+  auto index = [](double v, int size) { return clamped_int(v, 0, size); };
   r.c0 = index(static_cast<double>(ceil(box.x0)), width);
   r.r0 = index(static_cast<double>(ceil(box.y0)), height);
   r.c1 = index(static_cast<double>(floor(box.x1)) + 1.0, width);

@@ -29,9 +29,13 @@ struct DepthView {
   float max_m = 1e30f;
 
   bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
+  /// Raw units per metre a depth sensor can have: from kilometres (1e-3) to micrometres (1e6).
+  static constexpr float kMinUnitsPerMetre = 1e-3f, kMaxUnitsPerMetre = 1e6f;
+
   /// InvalidInput with the field in `reason` when the view cannot be read as documented: negative size,
-  /// a stride shorter than a row, units_per_metre not in (0, 1e9], min_m not finite and >= 0, max_m NaN or
-  /// below min_m. An empty view (no data) is valid: it means "no depth image".
+  /// a stride shorter than a row, units_per_metre not in [1e-3, 1e6], min_m not finite and >= 0, max_m
+  /// NaN, not positive or below min_m (no depth could be valid). An empty view (no data) is valid: it
+  /// means "no depth image".
   Status validate(std::string* reason = nullptr) const {
     auto bad = [&](const char* why) {
       if (reason) *reason = why;
@@ -39,10 +43,11 @@ struct DepthView {
     };
     if (width < 0 || height < 0) return bad("depth width and height must be >= 0");
     if (stride < 0 || (stride > 0 && stride < width)) return bad("depth stride must be 0 or at least the width");
-    if (!(units_per_metre > 0.f) || !(units_per_metre <= 1e9f))
-      return bad("depth units_per_metre must be positive and at most 1e9");
+    if (!(units_per_metre >= kMinUnitsPerMetre) || !(units_per_metre <= kMaxUnitsPerMetre))
+      return bad("depth units_per_metre must be in [1e-3, 1e6] (metres: 1, millimetres: 1000, TUM: 5000)");
     if (!(min_m >= 0.f) || !std::isfinite(min_m)) return bad("depth min_m must be >= 0 and finite");
-    if (!(max_m >= min_m)) return bad("depth max_m must be >= min_m (not NaN)");
+    if (!(max_m > 0.f)) return bad("depth max_m must be positive (not NaN)");
+    if (!(max_m >= min_m)) return bad("depth max_m must be >= min_m");
     if (reason) reason->clear();
     return Status::Ok;
   }

@@ -16,6 +16,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/mask.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/culling/labels.hpp"
@@ -232,11 +233,12 @@ RawRange<Raw> valid_raw_range(const DepthView<Raw>& v) {
     // lo is capped at top + 1 (then no raw value is valid) before any conversion to Raw.
     double lo = std::min(top + 1, std::max(1.0, std::ceil(static_cast<double>(v.min_m) * upm)));
     double hi = std::min(top, std::floor(static_cast<double>(v.max_m) * upm));
-    // Float rounding in to_metres: nudge the integer bounds until they agree with it.
-    while (lo > 1 && v.to_metres(static_cast<Raw>(lo - 1)) > 0.f) lo -= 1;
-    while (lo <= hi && v.to_metres(static_cast<Raw>(lo)) <= 0.f) lo += 1;
-    while (hi < top && v.to_metres(static_cast<Raw>(hi + 1)) > 0.f) hi += 1;
-    while (hi >= lo && v.to_metres(static_cast<Raw>(hi)) <= 0.f) hi -= 1;
+    // Float rounding in to_metres: nudge the integer bounds until they agree with it. checked: each
+    // conversion below is of a value in [0, top] (lo >= 1 and hi <= top, tested first).
+    while (lo > 1 && v.to_metres(static_cast<Raw>(lo - 1)) > 0.f) lo -= 1;      // checked: above
+    while (lo <= hi && v.to_metres(static_cast<Raw>(lo)) <= 0.f) lo += 1;       // checked: above
+    while (hi < top && v.to_metres(static_cast<Raw>(hi + 1)) > 0.f) hi += 1;    // checked: above
+    while (hi >= lo && v.to_metres(static_cast<Raw>(hi)) <= 0.f) hi -= 1;       // checked: above
     r.lo = lo;
     r.hi = hi;
   } else {
@@ -250,10 +252,7 @@ RawRange<Raw> valid_raw_range(const DepthView<Raw>& v) {
 }
 
 /// Bin of a non-negative position in bins, clamped to [0, nb - 1] before the conversion to int (NaN: 0).
-inline int clamped_bin(double position, int nb) {
-  const double top = static_cast<double>(nb - 1);
-  return position >= 0 ? static_cast<int>(std::min(position, top)) : 0;
-}
+inline int clamped_bin(double position, int nb) { return clamped_int(position, 0, nb - 1); }
 
 template <class Raw>
 bool raw_valid(Raw d, const RawRange<Raw>& range) {
@@ -307,10 +306,12 @@ std::size_t rasterise_pass(const DepthView<Raw>& v, const RawRange<Raw>& range, 
   }
   if constexpr (std::is_same<Raw, std::uint16_t>::value) {
     // Single unsigned compares: d in [lo, hi) <=> (uint16)(d - lo) < hi - lo.
-    const auto lo = static_cast<std::uint16_t>(band.lo);
-    const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));
-    const auto vlo = static_cast<std::uint16_t>(range.lo);
-    const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);
+    // checked: for uint16 raw the band and the valid range lie in [1, 65536] with lo <= hi
+    // (valid_raw_range, plan_band): every bound and span below fits 16 bits.
+    const auto lo = static_cast<std::uint16_t>(band.lo);                               // checked: above
+    const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));  // checked: above
+    const auto vlo = static_cast<std::uint16_t>(range.lo);                           // checked: above
+    const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);              // checked: above
     const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
     for (int y = r0; y < r1; ++y) {
       const std::uint16_t* d = v.row(y);
@@ -423,10 +424,11 @@ bool nearest_measured_in_band(const DepthView<Raw>& v, const RawRange<Raw>& rang
 template <class Raw>
 void classify_row(const Raw* d, int w, const RawRange<Raw>& range, const DepthBand& band, std::uint8_t* cls) {
   if constexpr (std::is_same<Raw, std::uint16_t>::value) {
-    const auto lo = static_cast<std::uint16_t>(band.lo);
-    const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));
-    const auto vlo = static_cast<std::uint16_t>(range.lo);
-    const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);
+    // checked: as in rasterise_pass, every bound and span fits 16 bits.
+    const auto lo = static_cast<std::uint16_t>(band.lo);                               // checked: above
+    const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));  // checked: above
+    const auto vlo = static_cast<std::uint16_t>(range.lo);                           // checked: above
+    const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);              // checked: above
     for (int x = 0; x < w; ++x) {
       const bool valid = static_cast<std::uint16_t>(d[x] - vlo) <= vspan;
       const bool in = static_cast<std::uint16_t>(d[x] - lo) < span;
@@ -760,7 +762,8 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
   } else {
     // Histogram fallback: the foreground cluster that holds d_c (or the nearest big cluster).
     const double bin_raw = std::max(o.histogram_bin_m, 1e-3) * upm;
-    const int nb = std::max(1, static_cast<int>(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3))));
+    const int nb = clamped_int(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3)), 1,
+                               std::numeric_limits<int>::max() - 1);
     // One extra bin collects invalid pixels, so the scatter loop has no branch. Neighbouring pixels
     // mostly fall in the same bin, so a single histogram serialises on its own increments (store to
     // load forwarding); four interleaved copies, summed afterwards, let them overlap.
@@ -769,7 +772,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     int step = o.histogram_stride_px;
     if (step <= 0) {
       const double per_sample = static_cast<double>(rc.area()) / std::max(1, o.histogram_target_samples);
-      step = std::max(1, static_cast<int>(std::ceil(std::sqrt(per_sample))));
+      step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
     }
     const float inv_bin = static_cast<float>(1.0 / bin_raw);
     const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
@@ -778,7 +781,8 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     auto bin_of = [&](Raw r) {
       const float f = static_cast<float>(r);
       const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
-      return static_cast<std::size_t>(ok ? static_cast<int>(std::min(last_bin, f * inv_bin)) : nb);
+      // checked: f >= vlo >= 0 when ok, clamped to last_bin in float: hot loop, no helper call.
+      return static_cast<std::size_t>(ok ? static_cast<int>(std::min(last_bin, f * inv_bin)) : nb);  // checked: above
     };
     std::uint32_t* h0 = hist4.data();
     std::uint32_t* h1 = h0 + nh;
@@ -805,14 +809,15 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
       whole_box();
       info.reason = "too few pixels with depth: whole box";
     } else {
+      // checked: a fraction in [0, 1] (validate) of the valid pixel count, which fits 32 bits.
       const auto occupied = static_cast<std::uint32_t>(
-          std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));
+          std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));  // checked: above
       int start = -1;
       if (dc > 0) {
         start = detail::clamped_bin(dc * inv_bin, nb);
       } else {
         // No centre depth: the nearest bin holding 5 % of the valid pixels seeds the cluster.
-        const auto seed = static_cast<std::uint32_t>(std::max(1.0, 0.05 * static_cast<double>(valid)));
+        const auto seed = static_cast<std::uint32_t>(std::max(1.0, 0.05 * static_cast<double>(valid)));  // checked: 5 % of a count
         for (int b = 0; b < nb && start < 0; ++b)
           if (hist[static_cast<std::size_t>(b)] >= seed) start = b;
         if (start < 0) start = 0;
@@ -849,10 +854,10 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
   // Samples of b outside a, about 4096 of them, in a histogram of 0.1 m bins up to histogram_max_m.
   const double upm = static_cast<double>(v.units_per_metre);
   const double bin_m = std::max(o.histogram_bin_m, 1e-3);
-  const int nb = std::max(3, static_cast<int>(std::ceil(o.histogram_max_m / bin_m)));
+  const int nb = clamped_int(std::ceil(o.histogram_max_m / bin_m), 3, std::numeric_limits<int>::max());
   std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb), 0u);
   const double per_sample = static_cast<double>(rb.area()) / std::max(1, o.histogram_target_samples);
-  const int step = std::max(1, static_cast<int>(std::ceil(std::sqrt(per_sample))));
+  const int step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
   std::size_t valid = 0, near_centre = 0;
   for (int y = rb.r0; y < rb.r1; y += step) {
     const Raw* d = v.row(y);

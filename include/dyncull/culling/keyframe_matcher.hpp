@@ -4,7 +4,8 @@
 /// depth, u = pi(R X + t) (Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-B, the guided search of the
 /// previous frame's points), then matched by Hamming distance (Rublee et al. 2011, ORB) among the
 /// current keypoints within a radius, with the nearest / second-nearest ratio test (Lowe 2004) and a
-/// mutual check.
+/// mutual check. A search examines at most max_candidates keypoints, so the cost stays linear in the
+/// keypoints however they cluster (ORB-SLAM's extractor bounds the features per grid cell for the same end).
 ///
 /// API:
 ///   KeyframeMatchWorkspace<float> ws;  KeyframeMatchResult<float> r;   // reused every frame
@@ -15,6 +16,7 @@
 #pragma once
 
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -74,6 +76,14 @@ struct KeyframeMatchOptions {
   /// Side (px) of the grid cells the current keypoints are bucketed in; a radius of about a cell visits
   /// 3 x 3 cells. The grid has at most 256 cells per side: a larger keypoint spread widens the cells. In [1, 4096].
   double grid_cell_px = 16.0;
+  /// Most current keypoints one keyframe point's search examines: when the grid cells its disc overlaps
+  /// hold more, an even subsample of them (every k-th in cell order) is examined instead, and the search
+  /// is counted in KeyframeMatchResult::searches_capped. Bounds the work by n_kf * max_candidates when
+  /// keypoints cluster (thousands in a few pixels); cv::ORB's 1000 features of a 640 x 480 frame put at
+  /// most 512 in the cells of one 40 px search. In [1, 2^20].
+  std::size_t max_candidates = 1024;
+
+  static constexpr std::size_t kMaxCandidatesLimit = std::size_t(1) << 20;
 
   /// Ok, or InvalidInput with the reason naming the field.
   Status validate(std::string* reason = nullptr) const {
@@ -87,6 +97,8 @@ struct KeyframeMatchOptions {
     if (max_hamming < 0 || max_hamming > 2048) return bad("max_hamming", "must be in [0, 2048]");
     if (!(ratio > 0.0 && ratio <= 1.0)) return bad("ratio", "must be in (0, 1]");
     if (!(grid_cell_px >= 1.0 && grid_cell_px <= 4096.0)) return bad("grid_cell_px", "must be in [1, 4096]");
+    if (max_candidates < 1 || max_candidates > kMaxCandidatesLimit)
+      return bad("max_candidates", "must be in [1, 2^20]");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -110,7 +122,9 @@ struct KeyframeMatchResult {
   std::size_t behind_camera = 0;          ///< keyframe points the predicted pose puts behind the camera
   std::size_t keyframe_nonfinite = 0;     ///< keyframe keypoints with a NaN / Inf coordinate (not matched)
   std::size_t current_nonfinite = 0;      ///< current keypoints with a NaN / Inf coordinate (not matched)
-  bool used_pose = false;                 ///< a predicted pose was given and used
+  std::size_t examined = 0;         ///< current keypoints the searches examined (at most n_kf * max_candidates)
+  std::size_t searches_capped = 0;  ///< searches that examined a subsample of their cells (max_candidates)
+  bool used_pose = false;           ///< a predicted pose was given and used
 };
 
 /// Buffers reused across calls: after the first frames of a sequence no call allocates.
@@ -167,15 +181,18 @@ struct KfmScan {
   int* kf_second_dist;
   int* cur_best_kf;  // by sorted position
   int* cur_best_dist;
+  std::uint32_t max_candidates;  // most sorted positions one search examines
+};
+
+/// The work of a scan: positions examined, searches subsampled.
+struct KfmWork {
+  std::size_t examined = 0, capped = 0;
 };
 
 /// Cell index along one axis, clamped in the floating type before the int conversion (NaN -> 0).
 template <class T>
 inline int kfm_cell(T v, T origin, T cell, int count) {
-  const T c = (v - origin) / cell;
-  if (!(c >= T(0))) return 0;
-  if (c >= T(count - 1)) return count - 1;
-  return static_cast<int>(c);
+  return clamped_int((v - origin) / cell, 0, count - 1);
 }
 
 /// Hamming distance of two rows; kWords > 0 fixes the length at compile time (ORB: 4 words, no tail).
@@ -194,12 +211,14 @@ inline int kfm_hamming(const std::uint8_t* a, const std::uint8_t* b, std::size_t
 
 /// For every keyframe point: the nearest (ties: lowest current index) and second-nearest current
 /// keypoints in its search disc; for every current keypoint: the nearest keyframe point (ties: lowest
-/// index) among those whose disc held it.
+/// index) among those whose disc held it. A search whose cells hold more than max_candidates keypoints
+/// examines every step-th of them (step = ceil(held / max_candidates)).
 template <class T, bool UseBuiltin, int kWords>
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((always_inline))
 #endif
-inline void kfm_scan_impl(const KfmScan<T>& s) {
+inline KfmWork kfm_scan_impl(const KfmScan<T>& s) {
+  KfmWork work;
   for (std::size_t k = 0; k < s.n_kf; ++k) {
     const T px = s.pred_x[k], py = s.pred_y[k];
     if (!(px == px) || !(py == py)) continue;  // NaN: not searched
@@ -213,53 +232,72 @@ inline void kfm_scan_impl(const KfmScan<T>& s) {
     std::uint64_t best = std::numeric_limits<std::uint64_t>::max();
     int best_d = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max(), best_pos = -1;
     std::uint32_t hits[64];
-    for (int q = q0; q <= q1; ++q) {
-      // Cells c0..c1 of one grid row are one contiguous run of sorted positions.
-      const std::size_t row0 = static_cast<std::size_t>(q) * static_cast<std::size_t>(s.cols);
-      const std::uint32_t end = s.cell_start[row0 + static_cast<std::size_t>(c1) + 1];
-      for (std::uint32_t a = s.cell_start[row0 + static_cast<std::size_t>(c0)]; a < end; a += 64) {
-        const std::uint32_t b = end - a > 64 ? a + 64 : end;
-        // Branch-free compaction of the keypoints inside the disc.
-        std::uint32_t nh = 0;
-        for (std::uint32_t i = a; i < b; ++i) {
+    // Cells c0..c1 of grid row q are one contiguous run of sorted positions.
+    auto run_begin = [&](int q) { return s.cell_start[static_cast<std::size_t>(q) * std::size_t(s.cols) + std::size_t(c0)]; };
+    auto run_end = [&](int q) { return s.cell_start[static_cast<std::size_t>(q) * std::size_t(s.cols) + std::size_t(c1) + 1]; };
+    std::size_t held = 0;
+    for (int q = q0; q <= q1; ++q) held += run_end(q) - run_begin(q);
+    const std::size_t step = held > s.max_candidates ? (held + s.max_candidates - 1) / s.max_candidates : 1;
+    auto compare = [&](std::uint32_t i) {
+      const int d = kfm_hamming<UseBuiltin, kWords>(kd, s.cur_desc + std::size_t(i) * s.row_bytes, s.row_bytes);
+      const std::uint64_t key = (static_cast<std::uint64_t>(d) << 32) | s.cur_index[i];
+      const bool better = key < best;
+      const int loser = better ? best_d : d;  // best_d <= second always
+      second = loser < second ? loser : second;
+      best = better ? key : best;
+      best_d = better ? d : best_d;
+      best_pos = better ? static_cast<int>(i) : best_pos;
+      // Keyframe points come in ascending order: ties keep the lower one.
+      const int cur = s.cur_best_dist[i];
+      const bool nearer = d < cur;
+      s.cur_best_dist[i] = nearer ? d : cur;
+      s.cur_best_kf[i] = nearer ? static_cast<int>(k) : s.cur_best_kf[i];
+    };
+    if (step == 1) {
+      work.examined += held;
+      for (int q = q0; q <= q1; ++q) {
+        const std::uint32_t end = run_end(q);
+        for (std::uint32_t a = run_begin(q); a < end; a += 64) {
+          const std::uint32_t b = end - a > 64 ? a + 64 : end;
+          // Branch-free compaction of the keypoints inside the disc.
+          std::uint32_t nh = 0;
+          for (std::uint32_t i = a; i < b; ++i) {
+            const T dx = s.cur_x[i] - px, dy = s.cur_y[i] - py;
+            hits[nh] = i;
+            nh += (dx * dx + dy * dy <= r2) ? 1u : 0u;
+          }
+          for (std::uint32_t h = 0; h < nh; ++h) compare(hits[h]);
+        }
+      }
+    } else {
+      // Every step-th position of the runs taken end to end: at most max_candidates, spread over the disc.
+      ++work.capped;
+      std::size_t offset = 0;  // into the next run, carried over from the last
+      for (int q = q0; q <= q1; ++q) {
+        const std::size_t begin = run_begin(q), end = run_end(q);
+        std::size_t i = begin + offset;
+        for (; i < end; i += step) {
+          ++work.examined;
           const T dx = s.cur_x[i] - px, dy = s.cur_y[i] - py;
-          hits[nh] = i;
-          nh += (dx * dx + dy * dy <= r2) ? 1u : 0u;
+          if (dx * dx + dy * dy <= r2) compare(static_cast<std::uint32_t>(i));
         }
-        for (std::uint32_t h = 0; h < nh; ++h) {
-          const std::uint32_t i = hits[h];
-          const int d = kfm_hamming<UseBuiltin, kWords>(kd, s.cur_desc + std::size_t(i) * s.row_bytes, s.row_bytes);
-          const std::uint64_t key = (static_cast<std::uint64_t>(d) << 32) | s.cur_index[i];
-          const bool better = key < best;
-          const int loser = better ? best_d : d;  // best_d <= second always
-          second = loser < second ? loser : second;
-          best = better ? key : best;
-          best_d = better ? d : best_d;
-          best_pos = better ? static_cast<int>(i) : best_pos;
-          // Keyframe points come in ascending order: ties keep the lower one.
-          const int cur = s.cur_best_dist[i];
-          const bool nearer = d < cur;
-          s.cur_best_dist[i] = nearer ? d : cur;
-          s.cur_best_kf[i] = nearer ? static_cast<int>(k) : s.cur_best_kf[i];
-        }
+        offset = i - end;  // i >= end here
       }
     }
     s.kf_best_cur[k] = best_pos;
     s.kf_best_dist[k] = best_pos >= 0 ? best_d : -1;
     s.kf_second_dist[k] = second;
   }
+  return work;
 }
 
 template <class T, bool UseBuiltin>
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((always_inline))
 #endif
-inline void kfm_scan_words(const KfmScan<T>& s) {
-  if (s.row_bytes == 32) {
-    kfm_scan_impl<T, UseBuiltin, 4>(s);
-  } else {
-    kfm_scan_impl<T, UseBuiltin, 0>(s);
-  }
+inline KfmWork kfm_scan_words(const KfmScan<T>& s) {
+  if (s.row_bytes == 32) return kfm_scan_impl<T, UseBuiltin, 4>(s);
+  return kfm_scan_impl<T, UseBuiltin, 0>(s);
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__POPCNT__)
@@ -267,12 +305,12 @@ inline void kfm_scan_words(const KfmScan<T>& s) {
 // Baseline x86-64 has no POPCNT: __builtin_popcountll would call a library routine. The scan is compiled
 // twice and the POPCNT one chosen at run time.
 template <class T>
-__attribute__((target("popcnt"))) void kfm_scan_popcnt(const KfmScan<T>& s) {
-  kfm_scan_words<T, true>(s);
+__attribute__((target("popcnt"))) KfmWork kfm_scan_popcnt(const KfmScan<T>& s) {
+  return kfm_scan_words<T, true>(s);
 }
 template <class T>
-void kfm_scan_portable(const KfmScan<T>& s) {
-  kfm_scan_words<T, false>(s);
+KfmWork kfm_scan_portable(const KfmScan<T>& s) {
+  return kfm_scan_words<T, false>(s);
 }
 inline bool kfm_cpu_has_popcnt() {
   static const bool has = __builtin_cpu_supports("popcnt");
@@ -281,15 +319,12 @@ inline bool kfm_cpu_has_popcnt() {
 #endif
 
 template <class T>
-void kfm_scan(const KfmScan<T>& s) {
+KfmWork kfm_scan(const KfmScan<T>& s) {
 #ifdef DYNCULL_KFM_POPCNT_DISPATCH
-  if (kfm_cpu_has_popcnt()) {
-    kfm_scan_popcnt<T>(s);
-  } else {
-    kfm_scan_portable<T>(s);
-  }
+  if (kfm_cpu_has_popcnt()) return kfm_scan_popcnt<T>(s);
+  return kfm_scan_portable<T>(s);
 #else
-  kfm_scan_words<T, true>(s);
+  return kfm_scan_words<T, true>(s);
 #endif
 }
 
@@ -361,6 +396,7 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
   r.reason.clear();
   r.matched = r.predicted_by_depth = r.predicted_without_depth = r.behind_camera = 0;
   r.keyframe_nonfinite = r.current_nonfinite = 0;
+  r.examined = r.searches_capped = 0;
   r.used_pose = false;
   const T nan = std::numeric_limits<T>::quiet_NaN();
   detail::kfm_fill(r.keyframe_index, n, -1);
@@ -427,10 +463,8 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
     if (spread > c) c = spread;
     if (std::isfinite(c) && c <= static_cast<double>(std::numeric_limits<T>::max())) {
       cell = static_cast<T>(c);
-      cols = static_cast<int>(ex / c) + 1;
-      rows = static_cast<int>(ey / c) + 1;
-      cols = cols > kMaxCellsPerSide ? kMaxCellsPerSide : cols;
-      rows = rows > kMaxCellsPerSide ? kMaxCellsPerSide : rows;
+      cols = clamped_int(ex / c, 0, kMaxCellsPerSide - 1) + 1;
+      rows = clamped_int(ey / c, 0, kMaxCellsPerSide - 1) + 1;
     } else {
       x0 = y0 = T(0);
       cell = std::numeric_limits<T>::max();
@@ -567,7 +601,10 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
   s.kf_second_dist = ws.kf_second_dist.data();
   s.cur_best_kf = ws.cur_best_kf.data();
   s.cur_best_dist = ws.cur_best_dist.data();
-  detail::kfm_scan(s);
+  s.max_candidates = static_cast<std::uint32_t>(options.max_candidates);  // at most 2^20 (validate)
+  const detail::KfmWork work = detail::kfm_scan(s);
+  r.examined = work.examined;
+  r.searches_capped = work.capped;
 
   // Accept: distance and ratio per keyframe point, then one keyframe point per current keypoint.
   const int* second = ws.kf_second_dist.data();

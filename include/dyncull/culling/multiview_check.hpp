@@ -138,9 +138,10 @@ struct RawDepthRange<Raw, true> {
   long long lo, hi;
   RawDepthRange(double l, double h) {
     const double top = static_cast<double>(std::numeric_limits<Raw>::max());
-    lo = static_cast<long long>(std::ceil(std::min(std::max(l, 0.0), top + 1)));
-    hi = static_cast<long long>(std::floor(std::min(std::max(h, -1.0), top)));
+    lo = static_cast<long long>(std::ceil(std::min(std::max(l, 0.0), top + 1)));    // checked: clamped first
+    hi = static_cast<long long>(std::floor(std::min(std::max(h, -1.0), top)));      // checked: clamped first
   }
+  // checked: Raw is an integer type in this specialisation.
   bool contains(Raw r) const { return static_cast<long long>(r) >= lo && static_cast<long long>(r) <= hi; }
 };
 

@@ -22,10 +22,14 @@ namespace dyncull {
 /// depth, points_3d, cam_from_world, detections, track_ids, or no reference keyframe yet) does not run:
 /// its report says MissingInput, and so does the frame's status, with "stage: input" in the reason; the
 /// labels and keep mask are those of the stages that ran (labelled() is true). A stage with nothing to
-/// do (a frame without boxes, detections given as an empty vector) is not missing input. Options that
-/// fail PipelineOptions::validate, an invalid depth view (DepthView::validate) or a given per-keypoint
+/// do (a frame without boxes, detections given as an empty vector) is not missing input. An enabled stage
+/// that ran but could not do its job (its own InvalidInput, TooFewPoints, Degenerate, NonFinite, ...)
+/// gives the frame that status, outranking MissingInput, with "stage: why" in the reason; the labels are
+/// still those of the other stages. Ok means every enabled stage did its job. Options that fail
+/// PipelineOptions::validate, an invalid depth view (DepthView::validate) or a given per-keypoint
 /// input (prev_keypoints, track_valid, track_ids, points_3d) whose size is not the keypoints' give status
-/// InvalidInput with the reason and cull nothing: every keypoint is labelled Static and kept.
+/// InvalidInput with the reason and cull nothing (refused, labelled() false): every keypoint is labelled
+/// Static and kept.
 ///
 /// Each stage reads the earlier stages' outputs and writes only its own (stages/context.hpp):
 ///   boxes -> semantic evidence (box rule, depth masks) -> geometric evidence (tracks, 3-D points)
@@ -53,7 +57,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   detail::combine_evidence(options, w, &r);
   detail::apply_static_history(frame, options, w.geometric, &s.static_history, &w.still_frames, &w.history_kept, &r);
   detail::guard_survivors(options, &r);
-  detail::report_missing_inputs(&r);
+  detail::report_stage_outcomes(&r);
   detail::trace_features(w, &r);
   detail::store_keyframe(frame, r, &w.keypoint_depth, &s.keyframes);
   return r;

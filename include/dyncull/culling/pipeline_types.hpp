@@ -214,8 +214,8 @@ struct MultiViewStageOptions : MultiViewOptions<T> {
   /// MultiViewOptions::validate, then max_reference_keyframes in [1, 64].
   Status validate(std::string* reason = nullptr) const {
     if (MultiViewOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
-    if (max_reference_keyframes > kMaxReferenceKeyframes)
-      return detail::invalid_option(reason, "max_reference_keyframes", "must be at most 64");
+    if (max_reference_keyframes < 1 || max_reference_keyframes > kMaxReferenceKeyframes)
+      return detail::invalid_option(reason, "max_reference_keyframes", "must be in [1, 64]");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -307,16 +307,20 @@ struct FeatureTrace {
 };
 
 /// Per-frame result: labels for the caller's keypoint vector (same order), why, and per-stage counts.
-/// status: Ok; MissingInput when an enabled stage could not run for lack of an input of the frame (reason:
-/// "stage: input" for each, as the stage's option is named, joined with "; "), the labels and keep mask then
-/// being those of the stages that ran; InvalidInput when the frame could not be culled at all (nothing
-/// culled). labelled(): the labels are usable (Ok or MissingInput).
+/// status is the worst of the enabled stages': Ok only when every enabled stage did its job (ran, or had
+/// nothing to do); else the status of the first enabled stage, in front-end order, that failed
+/// (InvalidInput, TooFewPoints, Degenerate, NonFinite, ...), or MissingInput when stages only lacked an
+/// input of the frame. The reason then says "stage: why" for each such stage, as the stage's option is
+/// named, joined with "; ", and the labels and keep mask are those of the stages that did their job
+/// (labelled() is true). A frame refused at entry (invalid options, depth view or sizes: refused is true)
+/// is InvalidInput with nothing culled and labelled() false.
 template <class T>
 struct PipelineResult {
   Status status = Status::Ok;
   std::string reason;
+  bool refused = false;  ///< the frame could not be culled at all: every keypoint Static and kept
   bool ok() const { return status == Status::Ok; }
-  bool labelled() const { return status == Status::Ok || status == Status::MissingInput; }
+  bool labelled() const { return !refused; }
 
   std::vector<FeatureLabel> labels;  ///< Static or Dynamic (Candidates are resolved by CandidatePolicy)
   std::vector<CullReason> reasons;   ///< deciding strategy (None for untouched statics)

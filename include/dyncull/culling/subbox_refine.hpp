@@ -6,6 +6,7 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/flags.hpp"
 #include "dyncull/core/mask.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -122,8 +123,7 @@ int subbox_index(T p, T lo, T hi, int grid) {
   if (!(span > T(0))) return 0;
   T c = off * T(grid);
   c = std::isfinite(c) ? c / span : off / span * T(grid);
-  if (!(c > T(0))) return 0;
-  return c < T(grid - 1) ? static_cast<int>(c) : grid - 1;
+  return clamped_int(c, 0, grid - 1);
 }
 
 template <class T>

@@ -4,6 +4,7 @@
 /// the 7-point minimal solver (cubic det constraint, up to 3 solutions) and LO-RANSAC on Sampson error (px).
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/precompiled.hpp"
 #include "dyncull/core/random.hpp"
 #include "dyncull/core/status.hpp"
@@ -744,7 +745,7 @@ FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& po
         options.ransac.seed);
     if (r.homography_inlier_fraction >= options.degenerate_homography_fraction) {
       r.status = Status::Degenerate;
-      r.reason = "one homography explains " + std::to_string(int(100 * r.homography_inlier_fraction + 0.5)) +
+      r.reason = "one homography explains " + std::to_string(clamped_int(100 * r.homography_inlier_fraction + 0.5, 0, 100)) +
                  "% of the inliers (planar scene, pure rotation or no motion): F is not determined by the data";
     }
   }

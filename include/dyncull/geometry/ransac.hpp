@@ -87,7 +87,7 @@ inline std::size_t ransac_required_iterations(double inlier_ratio, int sample_si
   if (!(denom < 0.0)) return cap;
   const double k = std::ceil(std::log1p(-confidence) / denom);
   if (!(k < static_cast<double>(cap))) return cap;
-  return std::max<std::size_t>(1, static_cast<std::size_t>(k));
+  return std::max<std::size_t>(1, static_cast<std::size_t>(k));  // checked: 0 < k < cap
 }
 
 namespace detail {
@@ -224,7 +224,7 @@ class RansacRunner {
         required = ransac_required_iterations(w, kSampleSize, opt_.confidence, opt_.max_iterations);
         const double d = static_cast<double>(kProbe);
         const double bound = w * d - 3.5 * std::sqrt(d * w * (1.0 - w));
-        probe_min = bound > 0 ? static_cast<std::size_t>(bound) : 0;
+        probe_min = bound > 0 ? static_cast<std::size_t>(bound) : 0;  // checked: bound <= w * kProbe
       }
     }
     result.iterations = it;

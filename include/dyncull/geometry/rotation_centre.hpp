@@ -504,7 +504,7 @@ auto estimate_rotation_centre(
   }
   res.num_inliers = inliers;
   const std::size_t by_fraction =
-      static_cast<std::size_t>(std::ceil(options.min_inlier_fraction * static_cast<double>(lines.size())));
+      static_cast<std::size_t>(std::ceil(options.min_inlier_fraction * static_cast<double>(lines.size())));  // checked: fraction in [0, 1] (validate)
   const std::size_t need_inliers = std::max<std::size_t>({options.min_inliers, by_fraction, std::size_t{1}});
   if (inliers < need_inliers) {
     return fail(Status::TooFewPoints, "rotation centre: only " + std::to_string(inliers) + " of " +

@@ -93,7 +93,8 @@ inline void apply_depth_noise(float* depth, int width, int height, const DepthNo
       const double noisy = z + kinect_depth_sigma_m(z, options) * detail::approx_normal(bits);
       // Round half up by truncation (noisy > 0 here): std::round is a library call without SSE4.1.
       const double units = noisy * options.units_per_metre + 0.5;
-      d = units >= 1.0 ? static_cast<float>(static_cast<double>(static_cast<std::int64_t>(units)) * metres_per_unit)
+      // checked: units in [1, 2^63): a depth of a ray-cast scene times at most 1e6 units per metre.
+      d = units >= 1.0 ? static_cast<float>(static_cast<double>(static_cast<std::int64_t>(units)) * metres_per_unit)  // checked: above
                        : 0.f;
     }
   }

@@ -471,10 +471,11 @@ inline void Scene::render(int index, FrameData* out) const {
       const double g = 255.0 * texture * shade;
       const double r8 = std::min(255.0, albedo.x() * g), g8 = std::min(255.0, albedo.y() * g),
                    b8 = std::min(255.0, albedo.z() * g);
-      out->rgb[3 * i] = static_cast<std::uint8_t>(r8 + 0.5);
-      out->rgb[3 * i + 1] = static_cast<std::uint8_t>(g8 + 0.5);
-      out->rgb[3 * i + 2] = static_cast<std::uint8_t>(b8 + 0.5);
-      out->gray[i] = static_cast<std::uint8_t>(std::min(255.0, 0.299 * r8 + 0.587 * g8 + 0.114 * b8 + 0.5));
+      // checked: albedo, texture and shade are non-negative and each channel is capped at 255.
+      out->rgb[3 * i] = static_cast<std::uint8_t>(r8 + 0.5);      // checked: above
+      out->rgb[3 * i + 1] = static_cast<std::uint8_t>(g8 + 0.5);  // checked: above
+      out->rgb[3 * i + 2] = static_cast<std::uint8_t>(b8 + 0.5);  // checked: above
+      out->gray[i] = static_cast<std::uint8_t>(std::min(255.0, 0.299 * r8 + 0.587 * g8 + 0.114 * b8 + 0.5));  // checked: above
       out->instance[i] = p.instance;
       out->moving[i] = p.moving;
       out->motion_m[i] =

@@ -4,10 +4,12 @@
 /// corner for FAST / goodFeaturesToTrack and the pattern moves rigidly with its primitive.
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/types.hpp"
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 namespace dyncull::sim {
 
@@ -30,9 +32,11 @@ inline std::uint32_t hash_cell(std::int32_t x, std::int32_t y, std::int32_t z, s
 /// Uniform value in [0, 1) of the cell containing p (cell edge `cell_m`).
 inline double cell_value(const Vec3<double>& p, double cell_m, std::uint32_t seed) {
   const double inv = 1.0 / cell_m;
-  const auto ix = static_cast<std::int32_t>(std::floor(p.x() * inv));
-  const auto iy = static_cast<std::int32_t>(std::floor(p.y() * inv));
-  const auto iz = static_cast<std::int32_t>(std::floor(p.z() * inv));
+  // Cells beyond the int range (a point far off, or a tiny cell) share the outermost cell's value.
+  constexpr int lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+  const std::int32_t ix = clamped_int(std::floor(p.x() * inv), lo, hi);
+  const std::int32_t iy = clamped_int(std::floor(p.y() * inv), lo, hi);
+  const std::int32_t iz = clamped_int(std::floor(p.z() * inv), lo, hi);
   return static_cast<double>(hash_cell(ix, iy, iz, seed) >> 8) * (1.0 / 16777216.0);
 }
 

@@ -133,7 +133,8 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   const double survivor_fraction =
       options.guard.min_fraction >= 0 ? std::min(options.guard.min_fraction, 1.0) : 0.0;
   const std::size_t need =
-      std::max(options.guard.min_survivors, static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));
+      std::max(options.guard.min_survivors,
+               static_cast<std::size_t>(std::ceil(survivor_fraction * double(n))));  // checked: fraction in [0, 1]
   if (options.guard.enabled && survivors < need && n > 0) {
     std::size_t soft = 0;
     for (std::size_t i = 0; i < n; ++i) soft += r->labels[i] == FeatureLabel::Dynamic && is_soft_cull(r->reasons[i]);
@@ -166,10 +167,12 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   for (std::size_t i = 0; i < n; ++i) r->keep[i] = r->labels[i] == FeatureLabel::Static;
 }
 
-/// The frame's status: MissingInput, and "stage: input" in the reason (after the guard's, if any), for each
-/// enabled stage that lacked an input; the labels stay those of the stages that ran.
+/// The frame's status, the worst of its enabled stages': the first stage (front-end order) that failed
+/// (a status other than Ok, Skipped and MissingInput), else MissingInput when a stage lacked an input of
+/// the frame, else Ok. The reason (after the guard's, if any) says "stage: why" for each of them; the
+/// labels stay those of the stages that did their job.
 template <class T>
-void report_missing_inputs(PipelineResult<T>* r) {
+void report_stage_outcomes(PipelineResult<T>* r) {
   const std::pair<const char*, const StageReport*> stages[] = {
       {"detections", &r->detections},       {"tracker", &r->tracker},
       {"box_rule", &r->box_rule},           {"depth_mask", &r->depth_mask},
@@ -177,14 +180,21 @@ void report_missing_inputs(PipelineResult<T>* r) {
       {"reprojection", &r->reprojection},   {"coherent_motion", &r->coherent_motion},
       {"subbox", &r->subbox},               {"multiview", &r->multiview},
       {"static_history", &r->static_history}};
+  Status failed = Status::Ok;
   for (const auto& st : stages) {
-    if (!st.second->enabled || st.second->status != Status::MissingInput) continue;
-    r->status = Status::MissingInput;
+    const Status s = st.second->status;
+    if (!st.second->enabled || s == Status::Ok || s == Status::Skipped) continue;
+    if (s != Status::MissingInput && failed == Status::Ok) failed = s;
+    if (r->status == Status::Ok) r->status = Status::MissingInput;
     if (!r->reason.empty()) r->reason += "; ";
     r->reason += st.first;
     r->reason += ": ";
-    r->reason += st.second->reason;
+    if (st.second->reason.empty())
+      r->reason += to_string(s);
+    else
+      r->reason += st.second->reason;
   }
+  if (failed != Status::Ok) r->status = failed;
 }
 
 /// r.trace: what the stages saw of each feature.

@@ -125,7 +125,7 @@ template <class T>
 PipelineWork<T>& work_of(PipelineState<T>* state);
 
 /// An enabled stage that cannot run this frame because an input of the frame was not given (the frame's
-/// status then says so: report_missing_inputs). `what` names the input as CullingFrame does.
+/// status then says so: report_stage_outcomes). `what` names the input as CullingFrame does.
 inline void lacks_input(StageReport* stage, const char* what) {
   stage->status = Status::MissingInput;
   stage->reason.assign(what);

@@ -15,6 +15,7 @@ template <class T>
 void begin_frame(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   r->status = Status::Ok;
   r->reason.clear();
+  r->refused = false;
   r->guard = GuardAction::None;
   r->guard_restored = 0;
   r->history_kept = 0;
@@ -48,6 +49,7 @@ template <class T, class Frame>
 bool accept_inputs(const Frame& frame, const PipelineOptions<T>& options, PipelineResult<T>* r) {
   if (!frame.keypoints) {
     r->status = Status::InvalidInput;
+    r->refused = true;
     r->reason = "no keypoints given";
     r->labels.clear();
     r->reasons.clear();
@@ -77,6 +79,7 @@ bool accept_inputs(const Frame& frame, const PipelineOptions<T>& options, Pipeli
     return true;
   }
   r->status = Status::InvalidInput;
+  r->refused = true;
   r->reason = why;
   r->keep.assign(n, 1);
   r->trace.assign(n, FeatureTrace{});
