@@ -164,7 +164,7 @@ inline bool integer_in_range(double v, long long lo, long long hi, long long* ou
   if (!(v >= static_cast<double>(lo) && v <= static_cast<double>(hi)) || v != std::floor(v)) return false;
   // lo and hi may round outward in double (|x| > 2^53): clamp after converting a value known to fit in 2^63.
   if (!(std::abs(v) < 9223372036854775808.0)) return false;
-  const long long n = static_cast<long long>(v);
+  const long long n = static_cast<long long>(v);  // checked: integral and |v| < 2^63 above
   if (n < lo || n > hi) return false;
   *out = n;
   return true;

@@ -314,7 +314,7 @@ inline CameraResult read_camera_file(const std::string& path, const SequenceOpti
             *why = where + key + " must be a whole number of pixels in [1, 100000]";
             return false;
           }
-          (i == 10 ? c.width : c.height) = static_cast<int>(v);
+          (i == 10 ? c.width : c.height) = static_cast<int>(v);  // checked: a whole number in [1, 100000]
         }
         return true;
       });

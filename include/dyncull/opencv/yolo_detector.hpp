@@ -16,6 +16,7 @@
 #pragma once
 
 #include "dyncull/core/box.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 
 #include <opencv2/core.hpp>
@@ -27,6 +28,7 @@
 #include <cstddef>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -119,16 +121,16 @@ struct YoloInputGeometry {
     YoloInputGeometry g = plain(image_w, image_h, in_w, in_h);
     if (image_w <= 0 || image_h <= 0) return g;
     const double s = std::min(double(in_w) / image_w, double(in_h) / image_h);
-    const int w = std::max(1, std::min(in_w, static_cast<int>(std::lround(image_w * s))));
-    const int h = std::max(1, std::min(in_h, static_cast<int>(std::lround(image_h * s))));
+    const int w = clamped_int(std::round(image_w * s), 1, std::max(1, in_w));
+    const int h = clamped_int(std::round(image_h * s), 1, std::max(1, in_h));
     g.scale_x = double(w) / image_w;
     g.scale_y = double(h) / image_h;
     g.offset_x = (in_w - w) / 2;
     g.offset_y = (in_h - h) / 2;
     return g;
   }
-  int scaled_width() const { return static_cast<int>(std::lround(image_width * scale_x)); }
-  int scaled_height() const { return static_cast<int>(std::lround(image_height * scale_y)); }
+  int scaled_width() const { return clamped_int(std::round(image_width * scale_x), 0, std::numeric_limits<int>::max()); }
+  int scaled_height() const { return clamped_int(std::round(image_height * scale_y), 0, std::numeric_limits<int>::max()); }
 };
 
 /// One frame's detections. On error status says which kind (InvalidInput: the image or the options;
@@ -501,6 +503,7 @@ class YoloDetector {
     if (options_.resize == YoloResize::Letterbox) {
       input_.create(in_h, in_w, CV_8UC3);
       input_.setTo(cv::Scalar::all(options_.letterbox_fill));
+      // checked: letterbox() sets the offsets from whole pixels in [0, input size]
       const cv::Rect inner(static_cast<int>(g.offset_x), static_cast<int>(g.offset_y), g.scaled_width(), g.scaled_height());
       cv::Mat roi = input_(inner);
       cv::resize(bgr, roi, inner.size(), 0, 0, cv::INTER_LINEAR);
