@@ -156,15 +156,15 @@ inline Status check_points(const PointsView& v, const char* name, std::string* w
 /// (orthonormal with det +1 within kRotationTolerance: a zero, scaled, sheared or reflected R). The
 /// reason names `name`.
 inline Status check_pose(const double R[9], const double t[3], const char* name, std::string* why) {
-  const std::string n(name);
+  const auto n = [name] { return std::string(name); };  // text only on failure: no allocation per frame
   for (int k = 0; k < 12; ++k) {
     const double v = k < 9 ? R[k] : t[k - 9];
-    if (!std::isfinite(v)) return (*why = n + " has a NaN or Inf entry", Status::NonFinite);
+    if (!std::isfinite(v)) return (*why = n() + " has a NaN or Inf entry", Status::NonFinite);
   }
   for (int k = 0; k < 12; ++k) {
     const double v = k < 9 ? R[k] : t[k - 9];
     if (std::abs(v) > kMaxPoseEntry)
-      return (*why = n + " has an entry of " + number(v) + ", out of the range [-1e8, 1e8] of a pose",
+      return (*why = n() + " has an entry of " + number(v) + ", out of the range [-1e8, 1e8] of a pose",
               Status::InvalidInput);
   }
   double deviation = 0;
@@ -178,7 +178,7 @@ inline Status check_pose(const double R[9], const double t[3], const char* name,
   const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
                      R[2] * (R[3] * R[7] - R[4] * R[6]);
   if (deviation > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance)
-    return (*why = n + "'s rotation is not a rotation (R^T R differs from I by " + number(deviation) +
+    return (*why = n() + "'s rotation is not a rotation (R^T R differs from I by " + number(deviation) +
                    ", det R = " + number(det) + "; a rigid pose has 0 and 1 within 1e-3)",
             Status::InvalidInput);
   return Status::Ok;
