@@ -55,7 +55,9 @@ class FrameCuller {
   /// Keep mask parallel to `keys` (1 = static); result() says why. `descriptors`: one CV_8U row per key
   /// (empty: none); `depth`: the frame's depth at the image size (empty: monocular); `predicted_Tcw`: 4x4
   /// cam_from_world (CV_32F / CV_64F), e.g. the motion model's, or null. `undistorted`: the host's
-  /// undistorted copy of keys, or null to undistort here when the camera has distortion.
+  /// undistorted copy of keys, or null to undistort here when the camera has distortion. The checks and
+  /// statuses are Culler::cull's (a rigid pose, NaN / Inf keypoints culled, descriptor widths): the same
+  /// frame gets the same result as from Culler<float> and CompiledCuller.
   const std::vector<std::uint8_t>& cull(const std::vector<cv::KeyPoint>& keys, const cv::Mat& descriptors,
                                         const cv::Mat& depth, const std::vector<Detection<float>>& detections,
                                         const cv::Mat* predicted_Tcw = nullptr,
