@@ -5,7 +5,7 @@
 # broken invariant; the input is saved as build/fuzz/crashes/<name>-crash-<sha1> (add it to the seed
 # corpus or turn it into a regression test once fixed).
 #   scripts/fuzz.sh [seconds per target]     (default 60; also DYNCULL_FUZZ_SECONDS)
-#   DYNCULL_FUZZ_TARGETS="tum yolo"          run only these targets
+#   DYNCULL_FUZZ_TARGETS="tum yolo"          run only these targets (culler needs OpenCV 4)
 #   DYNCULL_FUZZ_SEED=N                      libFuzzer's -seed (default: a random seed each run; .ci/run fixes
 #                                            it so that a failure in CI reproduces with the same command)
 set -euo pipefail
@@ -20,9 +20,14 @@ if [[ -z "$cxx" ]]; then
 fi
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="" -DCMAKE_CXX_COMPILER="$cxx" \
   -DDYNCULL_WERROR=ON -DDYNCULL_BUILD_FUZZERS=ON -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_BENCHMARKS=OFF \
-  -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=OFF -DDYNCULL_WITH_CERES=OFF >/dev/null
+  -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=ON -DDYNCULL_WITH_CERES=OFF >/dev/null
 
-targets=${DYNCULL_FUZZ_TARGETS:-$(cd "$root/tests/fuzz" && ls *_fuzz.cpp | sed 's/_fuzz\.cpp$//')}
+# Every target this configuration builds (the culler target needs OpenCV: fuzz.sh says when it is left out).
+targets=${DYNCULL_FUZZ_TARGETS:-$(cat "$build/tests/fuzz/targets.txt")}
+for src in "$root"/tests/fuzz/*_fuzz.cpp; do
+  t=$(basename "$src" _fuzz.cpp)
+  grep -qx "$t" "$build/tests/fuzz/targets.txt" || echo "fuzz.sh: $t not built (needs OpenCV)" >&2
+done
 cmake --build "$build" -j "$jobs" --target $(for t in $targets; do printf '%s_fuzz ' "$t"; done)
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1

@@ -3,6 +3,7 @@
 // buffer (the culler reads positions only), so all three overloads run the same compiled code.
 #include "dyncull/opencv/compiled_culler.hpp"
 
+#include "dyncull/core/text.hpp"
 #include "dyncull/culling/presets.hpp"
 #include "dyncull/opencv/culler.hpp"
 
@@ -62,13 +63,6 @@ void convert_all(const std::vector<From>& in, std::vector<To>* out) {
   for (std::size_t i = 0; i < in.size(); ++i) (*out)[i] = static_cast<To>(in[i]);
 }
 
-/// Index of the first point with a non-finite coordinate, or -1.
-long first_non_finite(const std::vector<cv::KeyPoint>& keys) {
-  for (std::size_t i = 0; i < keys.size(); ++i)
-    if (!std::isfinite(keys[i].pt.x) || !std::isfinite(keys[i].pt.y)) return static_cast<long>(i);
-  return -1;
-}
-
 }  // namespace
 
 struct CompiledCuller::Impl {
@@ -82,41 +76,17 @@ struct CompiledCuller::Impl {
   std::vector<Detection<float>> detections;
   std::vector<cv::KeyPoint> keys, undistorted;
 
+  // Every refusal goes through the templated culler's, so that all forms fill the result alike.
   const std::vector<std::uint8_t>& refuse(Status s, const std::string& why, std::size_t n) {
-    result.status = s;
-    result.reason = why;
-    result.keep.assign(n, 1);
-    result.labels.assign(n, Label::Static);
-    result.reasons.assign(n, Reason::None);
-    result.track_ids.assign(n, -1);
-    result.num_features = result.num_kept = n;
-    result.matched = 0;
-    result.frames_since_keyframe = 0;
-    result.keyframe = false;
-    return result.keep;
+    culler.culler().refuse_frame(static_cast<dyncull::Status>(static_cast<int>(s)), why, n);
+    return take_result();
   }
 
-  const std::vector<std::uint8_t>& cull(const std::vector<cv::KeyPoint>& k, const cv::Mat& descriptors,
-                                        const cv::Mat& depth, const std::vector<DetectedBox>& boxes,
-                                        const cv::Mat* Tcw, const std::vector<cv::KeyPoint>* und) {
-    if (status != Status::Ok) return refuse(status, reason, k.size());
-    long bad = first_non_finite(k);
-    if (bad >= 0)
-      return refuse(Status::NonFinite, "keypoints[" + std::to_string(bad) + "] has a NaN or Inf coordinate", k.size());
-    if (und && (bad = first_non_finite(*und)) >= 0)
-      return refuse(Status::NonFinite, "undistorted keypoints[" + std::to_string(bad) + "] has a NaN or Inf coordinate",
-                    k.size());
-    detections.resize(boxes.size());
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      const DetectedBox& b = boxes[i];
-      detections[i].box = Box<float>{b.x0, b.y0, b.x1, b.y1};
-      detections[i].class_id = b.class_id;
-      detections[i].confidence = b.confidence;
-    }
-    culler.cull(k, descriptors, depth, detections, Tcw, und);
+  const std::vector<std::uint8_t>& take_result() {
     const CullerResult& r = culler.result();
     result.status = static_cast<Status>(static_cast<int>(r.status));
     result.reason = r.reason;
+    result.refused = r.refused;
     result.keep = r.keep;
     convert_all(r.labels, &result.labels);
     convert_all(r.reasons, &result.reasons);
@@ -127,6 +97,21 @@ struct CompiledCuller::Impl {
     result.frames_since_keyframe = r.frames_since_keyframe;
     result.keyframe = r.keyframe;
     return result.keep;
+  }
+
+  const std::vector<std::uint8_t>& cull(const std::vector<cv::KeyPoint>& k, const cv::Mat& descriptors,
+                                        const cv::Mat& depth, const std::vector<DetectedBox>& boxes,
+                                        const cv::Mat* Tcw, const std::vector<cv::KeyPoint>* und) {
+    if (status != Status::Ok) return refuse(status, reason, k.size());
+    detections.resize(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      const DetectedBox& b = boxes[i];
+      detections[i].box = Box<float>{b.x0, b.y0, b.x1, b.y1};
+      detections[i].class_id = b.class_id;
+      detections[i].confidence = b.confidence;
+    }
+    culler.cull(k, descriptors, depth, detections, Tcw, und);
+    return take_result();
   }
 };
 
@@ -139,8 +124,8 @@ CompiledCuller::CompiledCuller(const cv::Mat& K, cv::Size image_size, const cv::
     impl_->reason = impl_->culler.reason();
   } else if (!preset_known) {
     impl_->status = Status::InvalidInput;
-    impl_->reason = "Options::preset '" + options.preset +
-                    "' is not one of none, dld_slam, rtd_slam, zhu_2024, dfd_slam, zhang_2023, recommended";
+    impl_->reason = "Options::preset " + text::quote_token(options.preset) +
+                    " is not one of none, dld_slam, rtd_slam, zhu_2024, dfd_slam, zhang_2023, recommended";
   }
 }
 
@@ -158,6 +143,7 @@ const CompiledCuller::Result& moved_from_result() {
     CompiledCuller::Result x;
     x.status = CompiledCuller::Status::InvalidInput;
     x.reason = moved_from_reason();
+    x.refused = true;
     return x;
   }();
   return r;
@@ -168,13 +154,27 @@ CompiledCuller::Status CompiledCuller::status() const { return impl_ ? impl_->st
 const std::string& CompiledCuller::reason() const { return impl_ ? impl_->reason : moved_from_reason(); }
 const CompiledCuller::Result& CompiledCuller::result() const { return impl_ ? impl_->result : moved_from_result(); }
 
+void CompiledCuller::reset() {
+  if (impl_) impl_->culler.reset();
+}
+
+CompiledCuller::Impl& CompiledCuller::impl() {
+  if (!impl_) {
+    // Moved from: a culler without a camera that refuses every frame, so that the keep mask stays
+    // parallel to the keys.
+    bool preset_known = true;
+    impl_.reset(new Impl(cv::Mat(), cv::Size(), cv::Mat(), Options(), &preset_known));
+    impl_->status = Status::InvalidInput;
+    impl_->reason = moved_from_reason();
+  }
+  return *impl_;
+}
+
 const std::vector<std::uint8_t>& CompiledCuller::cull(const std::vector<cv::KeyPoint>& keys, const cv::Mat& descriptors,
                                                       const cv::Mat& depth, const std::vector<DetectedBox>& detections,
                                                       const cv::Mat* predicted_Tcw,
                                                       const std::vector<cv::KeyPoint>* undistorted) {
-  static const std::vector<std::uint8_t> none;
-  if (!impl_) return none;
-  return impl_->cull(keys, descriptors, depth, detections, predicted_Tcw, undistorted);
+  return impl().cull(keys, descriptors, depth, detections, predicted_Tcw, undistorted);
 }
 
 const std::vector<std::uint8_t>& CompiledCuller::cull(const std::vector<cv::Point2f>& points,
@@ -182,9 +182,7 @@ const std::vector<std::uint8_t>& CompiledCuller::cull(const std::vector<cv::Poin
                                                       const std::vector<DetectedBox>& detections,
                                                       const cv::Mat* predicted_Tcw,
                                                       const std::vector<cv::Point2f>* undistorted) {
-  static const std::vector<std::uint8_t> none;
-  if (!impl_) return none;
-  Impl& m = *impl_;
+  Impl& m = impl();
   m.keys.resize(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) m.keys[i].pt = points[i];
   if (undistorted) {
@@ -198,23 +196,15 @@ const std::vector<std::uint8_t>& CompiledCuller::cull(const float* xy, std::size
                                                       const cv::Mat& descriptors, const cv::Mat& depth,
                                                       const std::vector<DetectedBox>& detections,
                                                       const cv::Mat* predicted_Tcw) {
-  static const std::vector<std::uint8_t> none;
-  if (!impl_) return none;
-  Impl& m = *impl_;
-  if (count > 0 && xy == nullptr)
-    return m.refuse(Status::InvalidInput, "keypoints: null xy with a count of " + std::to_string(count), count);
-  const std::size_t stride = stride_bytes ? stride_bytes : 2 * sizeof(float);
-  if (stride < 2 * sizeof(float))
-    return m.refuse(Status::InvalidInput,
-                    "keypoints: stride_bytes " + std::to_string(stride_bytes) + " is below the 8 bytes of an x, y pair",
-                    count);
+  Impl& m = impl();
+  if (m.status != Status::Ok) return m.refuse(m.status, m.reason, count);
+  const PointsView view = PointsView::of(xy, count, stride_bytes);
+  std::string why;
+  const dyncull::Status s = culler_checks::check_points(view, "keypoints", &why);
+  if (s != dyncull::Status::Ok) return m.refuse(static_cast<Status>(static_cast<int>(s)), why, count);
   m.keys.resize(count);
-  const unsigned char* p = reinterpret_cast<const unsigned char*>(xy);
-  for (std::size_t i = 0; i < count; ++i) {
-    float v[2];
-    std::memcpy(v, p + i * stride, sizeof v);
-    m.keys[i].pt = cv::Point2f(v[0], v[1]);
-  }
+  for (std::size_t i = 0; i < count; ++i)
+    m.keys[i].pt = cv::Point2f(static_cast<float>(view.x(i)), static_cast<float>(view.y(i)));
   return m.cull(m.keys, descriptors, depth, detections, predicted_Tcw, nullptr);
 }
 

@@ -5,12 +5,15 @@
 #include "dyncull/culling/culler.hpp"
 
 #include "dyncull/core/random.hpp"
+#include "dyncull/culling/presets.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -324,7 +327,7 @@ TYPED_TEST(CullerTest, MismatchedSizesAreNamed) {
     f.depth_m.width = 320;
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::InvalidInput);
-    EXPECT_NE(r.reason.find("depth is 320x480"), std::string::npos) << r.reason;
+    EXPECT_NE(r.reason.find("depth: 320x480 for an image of 640x480"), std::string::npos) << r.reason;
   }
   {
     Culler<T> culler(PinholeCamera<T>::tum_fr3());
@@ -404,6 +407,242 @@ TYPED_TEST(CullerTest, PointsViewReadsPackedAndStridedPoints) {
   const std::vector<Key> empty;
   EXPECT_TRUE(points_view(empty).given);
   EXPECT_EQ(points_view(empty).count, 0u);
+}
+
+// --- The frame contract under bad input -------------------------------------------------------------
+
+template <class T>
+CullerOptions<T> none_preset() {
+  CullerOptions<T> o;
+  o.pipeline = presets::none<T>();
+  return o;
+}
+
+TYPED_TEST(CullerTest, NonFiniteKeypointIsCulledAndNamedWhileTheFrameStaysUsable) {
+  using T = TypeParam;
+  for (const bool none : {false, true}) {
+    SCOPED_TRACE(none ? "preset none" : "preset recommended");
+    Culler<T> culler(PinholeCamera<T>::tum_fr3(), none ? none_preset<T>() : CullerOptions<T>());
+    culler.cull(wall_view<T>(0).frame());
+    WallView<T> v = wall_view<T>(0.01);
+    v.keypoints[5].x() = std::numeric_limits<T>::quiet_NaN();
+    v.keypoints[9].y() = std::numeric_limits<T>::infinity();
+    const CullerResult& r = culler.cull(v.frame());
+    EXPECT_EQ(r.status, Status::MissingInput) << r.reason;
+    EXPECT_NE(r.reason.find("keypoints[5] and 1 other have a NaN or Inf coordinate: culled"), std::string::npos)
+        << r.reason;
+    ASSERT_EQ(r.keep.size(), v.keypoints.size());
+    for (std::size_t i : {std::size_t(5), std::size_t(9)}) {
+      EXPECT_EQ(r.keep[i], 0) << i;
+      EXPECT_EQ(r.labels[i], FeatureLabel::Dynamic) << i;
+      EXPECT_EQ(r.reasons[i], CullReason::InvalidInput) << i;
+    }
+    EXPECT_GT(r.matched, v.keypoints.size() / 2);  // the other keypoints were matched and judged
+    std::size_t kept = 0;
+    for (std::uint8_t k : r.keep) kept += k;
+    EXPECT_EQ(r.num_kept, kept);
+    const CullerResult& next = culler.cull(wall_view<T>(0.02).frame());
+    EXPECT_TRUE(next.ok()) << next.reason;
+  }
+}
+
+TYPED_TEST(CullerTest, NonFiniteUndistortedKeypointIsCulledAndNamedByItsArgument) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3(), none_preset<T>());
+  culler.cull(wall_view<T>(0).frame());
+  const WallView<T> v = wall_view<T>(0.01);
+  std::vector<Vec2<T>> undistorted = v.keypoints;
+  undistorted[7].y() = std::numeric_limits<T>::quiet_NaN();
+  CullerFrame<T> f = v.frame();
+  f.undistorted_keypoints = points_view(undistorted);
+  const CullerResult& r = culler.cull(f);
+  EXPECT_EQ(r.status, Status::MissingInput) << r.reason;
+  EXPECT_NE(r.reason.find("undistorted_keypoints[7] has a NaN or Inf coordinate: culled"), std::string::npos)
+      << r.reason;
+  ASSERT_EQ(r.keep.size(), v.keypoints.size());
+  EXPECT_EQ(r.keep[7], 0);
+  EXPECT_EQ(r.num_kept, v.keypoints.size() - 1);  // preset none culls nothing else
+}
+
+TYPED_TEST(CullerTest, DescriptorWidthChangeStartsANewKeyframeNamingTheDescriptors) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  culler.cull(wall_view<T>(0).frame());
+  for (const std::size_t width : {std::size_t(64), std::size_t(33)}) {
+    SCOPED_TRACE("rows of " + std::to_string(width) + " bytes");
+    const WallView<T> v = wall_view<T>(0.01);
+    std::vector<std::uint8_t> wide(v.keypoints.size() * width);
+    for (std::size_t i = 0; i < v.keypoints.size(); ++i)
+      for (std::size_t b = 0; b < width; ++b) wide[i * width + b] = v.descriptors[i * 32 + b % 32];
+    CullerFrame<T> f = v.frame();
+    f.descriptors = DescriptorRows(wide.data(), v.keypoints.size(), 0, width);
+    const CullerResult& r = culler.cull(f);
+    EXPECT_EQ(r.status, Status::MissingInput) << r.reason;
+    EXPECT_NE(r.reason.find("descriptors: rows of " + std::to_string(width) + " bytes where the keyframe's have"),
+              std::string::npos)
+        << r.reason;
+    EXPECT_EQ(r.reason.find("kf_desc"), std::string::npos) << r.reason;
+    EXPECT_TRUE(r.keyframe);
+    EXPECT_EQ(r.keep.size(), v.keypoints.size());
+    // The next frame of the same width matches the new keyframe.
+    const WallView<T> v2 = wall_view<T>(0.02);
+    CullerFrame<T> f2 = v2.frame();
+    std::vector<std::uint8_t> wide2(v2.keypoints.size() * width);
+    for (std::size_t i = 0; i < v2.keypoints.size(); ++i)
+      for (std::size_t b = 0; b < width; ++b) wide2[i * width + b] = v2.descriptors[i * 32 + b % 32];
+    f2.descriptors = DescriptorRows(wide2.data(), v2.keypoints.size(), 0, width);
+    const CullerResult& r2 = culler.cull(f2);
+    EXPECT_TRUE(r2.ok()) << r2.reason;
+    EXPECT_GT(r2.matched, v2.keypoints.size() / 2);
+  }
+}
+
+TYPED_TEST(CullerTest, DescriptorRowsWiderThanTheMatcherTakesAreRefusedWithoutPoisoningLaterFrames) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  const WallView<T> v = wall_view<T>(0);
+  std::vector<std::uint8_t> wide(v.keypoints.size() * 300, 7);
+  CullerFrame<T> f = v.frame();
+  f.descriptors = DescriptorRows(wide.data(), v.keypoints.size(), 0, 300);
+  const CullerResult& r = culler.cull(f);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("descriptors: rows of 300 bytes"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.keep, std::vector<std::uint8_t>(v.keypoints.size(), 1));
+  culler.cull(wall_view<T>(0.01).frame());
+  const CullerResult& later = culler.cull(wall_view<T>(0.02).frame());
+  EXPECT_TRUE(later.ok()) << later.reason;
+  EXPECT_GT(later.matched, v.keypoints.size() / 2);
+}
+
+TYPED_TEST(CullerTest, ResetForgetsTheKeyframeAndTheTracks) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  culler.cull(wall_view<T>(0).frame());
+  culler.cull(wall_view<T>(0.01).frame());
+  ASSERT_TRUE(culler.has_keyframe());
+  culler.reset();
+  EXPECT_FALSE(culler.has_keyframe());
+  const CullerResult& r = culler.cull(wall_view<T>(0.02).frame());
+  EXPECT_TRUE(r.keyframe);
+  EXPECT_EQ(r.frames_since_keyframe, 0);
+  EXPECT_EQ(r.matched, 0u);
+  EXPECT_EQ(r.track_ids.front(), 0);  // ids start again
+  EXPECT_NE(r.reason.find("first frame"), std::string::npos) << r.reason;
+}
+
+TYPED_TEST(CullerTest, PredictedPoseThatIsNotRigidIsRefusedNamingThePose) {
+  using T = TypeParam;
+  const WallView<T> v = wall_view<T>(0);
+  Mat3<T> reflection = Mat3<T>::Identity();
+  reflection(2, 2) = T(-1);
+  Mat3<T> shear = Mat3<T>::Identity();
+  shear(0, 1) = T(0.5);
+  const std::pair<const char*, Mat3<T>> bad[] = {{"zero", Mat3<T>::Zero()},
+                                                 {"doubled", T(2) * Mat3<T>::Identity()},
+                                                 {"reflection", reflection},
+                                                 {"shear", shear}};
+  for (const auto& b : bad) {
+    SCOPED_TRACE(b.first);
+    Culler<T> culler(PinholeCamera<T>::tum_fr3());
+    Rigid3<T> pose = v.cam_from_world;
+    pose.R = b.second;
+    CullerFrame<T> f = v.frame();
+    f.cam_from_world = &pose;
+    const CullerResult& r = culler.cull(f);
+    EXPECT_EQ(r.status, Status::InvalidInput) << r.reason;
+    EXPECT_NE(r.reason.find("cam_from_world's rotation is not a rotation"), std::string::npos) << r.reason;
+    EXPECT_EQ(r.keep, std::vector<std::uint8_t>(v.keypoints.size(), 1));
+    EXPECT_FALSE(culler.has_keyframe());
+  }
+  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  Rigid3<T> far = v.cam_from_world;
+  far.t.x() = T(1e30);
+  CullerFrame<T> f = v.frame();
+  f.cam_from_world = &far;
+  const CullerResult& r = culler.cull(f);
+  EXPECT_EQ(r.status, Status::InvalidInput) << r.reason;
+  EXPECT_NE(r.reason.find("out of the range"), std::string::npos) << r.reason;
+  // A rotation off by float rounding is rigid.
+  Rigid3<T> rounded = v.cam_from_world;
+  rounded.R = Eigen::AngleAxis<T>(T(0.3), Vec3<T>(T(0.6), T(0.8), T(0)).normalized()).toRotationMatrix();
+  rounded.R(0, 0) += T(2e-6);
+  f.cam_from_world = &rounded;
+  EXPECT_NE(culler.cull(f).status, Status::InvalidInput) << culler.result().reason;
+}
+
+TYPED_TEST(CullerTest, AbsurdIntrinsicsAreRefusedNamingTheField) {
+  using T = TypeParam;
+  const std::pair<const char*, PinholeCamera<T>> cameras[] = {
+      {"fx", PinholeCamera<T>{T(1e-30), T(525), T(319.5), T(239.5), 640, 480}},
+      {"fy", PinholeCamera<T>{T(525), T(1e30), T(319.5), T(239.5), 640, 480}},
+      {"cx", PinholeCamera<T>{T(525), T(525), T(1e30), T(239.5), 640, 480}},
+      {"cy", PinholeCamera<T>{T(525), T(525), T(319.5), T(-2000), 640, 480}}};
+  for (const auto& c : cameras) {
+    SCOPED_TRACE(c.first);
+    EXPECT_FALSE(c.second.valid());
+    Culler<T> culler(c.second);
+    EXPECT_EQ(culler.status(), Status::InvalidInput);
+    EXPECT_NE(culler.reason().find(std::string(c.first) + " = "), std::string::npos) << culler.reason();
+  }
+  EXPECT_TRUE(PinholeCamera<T>::tum_fr3().valid());
+  EXPECT_TRUE((PinholeCamera<T>{T(5), T(5), T(-600), T(900), 640, 480}.valid()));  // wide, off-centre: exists
+}
+
+TYPED_TEST(CullerTest, FrameWithoutKeypointsLacksNoDescriptors) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  culler.cull(wall_view<T>(0).frame());
+  const WallView<T> v = wall_view<T>(0.01);
+  const std::vector<Vec2<T>> none;
+  CullerFrame<T> f = v.frame();
+  f.keypoints = points_view(none);
+  f.descriptors = DescriptorRows{};
+  const CullerResult& r = culler.cull(f);
+  EXPECT_FALSE(r.missing.descriptors) << r.reason;
+  EXPECT_EQ(r.reason.find("descriptors"), std::string::npos) << r.reason;
+  EXPECT_TRUE(r.keep.empty());
+}
+
+TYPED_TEST(CullerTest, PointsViewStrideBelowOnePairIsRefused) {
+  using T = TypeParam;
+  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  const WallView<T> v = wall_view<T>(0);
+  CullerFrame<T> f = v.frame();
+  f.keypoints = PointsView::of(v.keypoints[0].data(), v.keypoints.size(), sizeof(T));
+  const CullerResult& r = culler.cull(f);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.reason.find("keypoints: stride_bytes " + std::to_string(sizeof(T)) + " is below the " +
+                          std::to_string(2 * sizeof(T)) + " bytes of an x, y pair"),
+            std::string::npos)
+      << r.reason;
+  EXPECT_EQ(r.keep, std::vector<std::uint8_t>(v.keypoints.size(), 1));
+}
+
+// A keyframe keypoint at u = 2^32 + 512 is off the image: it has no depth (an int conversion without a
+// range check would wrap it to pixel 512 and give it that pixel's depth). Without depth the next frame
+// searches it around its ray, where it is; with a wrong depth, around a projection shifted by the motion.
+TEST(CullerKeyframe, KeypointBeyondTheIntRangeGetsNoDepthFromAWrappedPixel) {
+  const PinholeCamera<double> camera = PinholeCamera<double>::tum_fr3();
+  Culler<double> culler(camera, host_keyframes<double>());
+  const double far_u = 4294967296.0 + 512.0;
+  const std::vector<double> xy = {far_u, 240.0, 100.0, 100.0, 500.0, 300.0};
+  std::vector<std::uint8_t> desc(3 * 32);
+  for (std::size_t i = 0; i < desc.size(); ++i) desc[i] = static_cast<std::uint8_t>(i * 37 + 11);
+  const std::vector<float> depth(640 * 480, 2.f);
+  std::vector<Detection<double>> boxes;
+  Rigid3<double> pose;
+  CullerFrame<double> f;
+  f.keypoints = PointsView::of(xy.data(), 3);
+  f.descriptors = DescriptorRows(desc.data(), 3, 0, 32);
+  f.depth_m = DepthView<float>{depth.data(), 640, 480, 0, 1.f, 0.f, 1e30f};
+  f.detections = &boxes;
+  f.cam_from_world = &pose;
+  const CullerResult& first = culler.cull(f);
+  ASSERT_TRUE(first.keyframe) << first.reason;
+  const std::int64_t far_id = first.track_ids[0];
+  pose.t = Vec3<double>(-0.1, 0, 0);  // 0.1 m sideways: a point 2 m deep would move 26 px
+  const CullerResult& second = culler.cull(f);
+  EXPECT_EQ(second.track_ids[0], far_id) << second.reason;
 }
 
 }  // namespace

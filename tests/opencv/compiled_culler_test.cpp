@@ -184,29 +184,36 @@ TEST(CompiledCuller, EmptyOrBadCalibrationIsNamedAndEveryCullKeepsAll) {
   EXPECT_NE(zero_scale.reason().find("depth_units_per_metre"), std::string::npos) << zero_scale.reason();
 }
 
-TEST(CompiledCuller, NonFiniteKeypointIsRefusedNamingItsIndexOnEveryOverload) {
+TEST(CompiledCuller, NonFiniteKeypointIsCulledNamingItsIndexOnEveryOverload) {
   BadInputFixture in;
   CompiledCuller culler(in.K, cv::Size(640, 480));
   in.keys[3].pt.y = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_EQ(culler.cull(in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw), std::vector<std::uint8_t>(40, 1));
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::NonFinite);
-  EXPECT_NE(culler.result().reason.find("keypoints[3]"), std::string::npos) << culler.result().reason;
+  const std::vector<std::uint8_t>& keep = culler.cull(in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw);
+  ASSERT_EQ(keep.size(), 40u);
+  EXPECT_EQ(keep[3], 0);
+  EXPECT_EQ(culler.result().status, CompiledCuller::Status::MissingInput);
+  EXPECT_EQ(culler.result().reasons[3], CompiledCuller::Reason::InvalidInput);
+  EXPECT_NE(culler.result().reason.find("keypoints[3] has a NaN or Inf coordinate: culled"), std::string::npos)
+      << culler.result().reason;
 
   std::vector<cv::Point2f> points;
   cv::KeyPoint::convert(in.keys, points);
   points[3].y = 100.f;
   points[7].x = std::numeric_limits<float>::infinity();
   culler.cull(points, in.descriptors, in.depth, in.boxes, &in.Tcw);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::NonFinite);
+  EXPECT_EQ(culler.result().status, CompiledCuller::Status::MissingInput);
   EXPECT_NE(culler.result().reason.find("keypoints[7]"), std::string::npos) << culler.result().reason;
+  EXPECT_EQ(culler.result().keep[7], 0);
+  EXPECT_EQ(culler.result().keep[3], 1);
 
   culler.cull(&points[0].x, points.size(), 0, in.descriptors, in.depth, in.boxes, &in.Tcw);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::NonFinite);
+  EXPECT_EQ(culler.result().status, CompiledCuller::Status::MissingInput);
   EXPECT_NE(culler.result().reason.find("keypoints[7]"), std::string::npos) << culler.result().reason;
 
   culler.cull(nullptr, 5, 0, cv::Mat(), in.depth, in.boxes, &in.Tcw);
   EXPECT_EQ(culler.result().status, CompiledCuller::Status::InvalidInput);
-  EXPECT_NE(culler.result().reason.find("null xy"), std::string::npos) << culler.result().reason;
+  EXPECT_NE(culler.result().reason.find("keypoints: null data with a count of 5"), std::string::npos)
+      << culler.result().reason;
   EXPECT_EQ(culler.result().keep, std::vector<std::uint8_t>(5, 1));
 
   culler.cull(&points[0].x, points.size(), 4, in.descriptors, in.depth, in.boxes, &in.Tcw);
@@ -220,7 +227,7 @@ TEST(CompiledCuller, MovedFromCullerRefusesInsteadOfCrashing) {
   EXPECT_TRUE(b.ok());
   EXPECT_FALSE(a.ok());  // NOLINT(bugprone-use-after-move): the moved-from state is what is tested
   EXPECT_NE(a.reason().find("moved from"), std::string::npos);
-  EXPECT_TRUE(a.cull(in.keys, in.descriptors, in.depth, in.boxes).empty());
+  EXPECT_EQ(a.cull(in.keys, in.descriptors, in.depth, in.boxes), std::vector<std::uint8_t>(40, 1));
 }
 
 TEST(CompiledCuller, CompactShrinksDescriptorsWithEveryParallelVector) {

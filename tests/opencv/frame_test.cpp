@@ -175,11 +175,39 @@ TYPED_TEST(OpenCvFrameTyped, BadKSizeOrDistortionAreNamed) {
   cv::Mat nan_dist = cv::Mat::zeros(1, 5, CV_64F);
   nan_dist.at<double>(0, 4) = std::numeric_limits<double>::infinity();
   expect_bad(cva::camera_from_K<T>(K, vga, nan_dist), Status::NonFinite, "distortion");
-  if (std::is_same<T, float>::value) {
-    bad = K.clone();
-    bad.at<double>(0, 0) = 1e300;  // finite in K, infinite as a float
-    expect_bad(cva::camera_from_K<T>(bad, vga), Status::InvalidInput, "scalar");
+  bad = K.clone();
+  bad.at<double>(0, 0) = 1e300;  // finite in K, infinite as a float: out of bounds before any conversion
+  expect_bad(cva::camera_from_K<T>(bad, vga), Status::InvalidInput, "K: fx = ");
+}
+
+TYPED_TEST(OpenCvFrameTyped, IntrinsicsNoCameraHasAreNamed) {
+  using T = TypeParam;
+  const cv::Size vga(640, 480);
+  const struct {
+    double fx, fy, cx, cy;
+    const char* named;
+  } cases[] = {{1e-42, 500, 320, 240, "K: fx = "}, {500, 1e-42, 320, 240, "K: fy = "},
+               {1e8, 500, 320, 240, "K: fx = "},   {500, 500, 1e30, 240, "K: cx = "},
+               {500, 500, 320, -1e4, "K: cy = "},  {500, 500, -700, 240, "K: cx = "}};
+  for (const auto& c : cases) {
+    const cv::Mat K = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
+    const auto cam = cva::camera_from_K<T>(K, vga);
+    EXPECT_EQ(cam.status, Status::InvalidInput) << c.named;
+    EXPECT_NE(cam.reason.find(c.named), std::string::npos) << cam.reason;
   }
+  // Wide-angle, long-focus and off-centre cameras that exist are accepted.
+  for (const cv::Vec4d& k : {cv::Vec4d(150, 150, 320, 240), cv::Vec4d(40000, 40000, 320, 240),
+                            cv::Vec4d(500, 500, -300, 700)}) {
+    const cv::Mat K = (cv::Mat_<double>(3, 3) << k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1);
+    const auto cam = cva::camera_from_K<T>(K, vga);
+    EXPECT_TRUE(cam.ok()) << cam.reason;
+  }
+  // undistort_keypoints checks K without an image size: no bound on where its principal point is.
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << 500, 0, 320, 0, 500, 240, 0, 0, 1);
+  const cv::Mat dist = (cv::Mat_<double>(1, 4) << 0.1, 0, 0, 0);
+  std::vector<cv::Point2f> pts = {cv::Point2f(100.f, 100.f)}, out;
+  std::string why;
+  EXPECT_EQ(cva::undistort_keypoints(pts, K, dist, &out, &why), Status::Ok) << why;
 }
 
 TEST(OpenCvFrame, TumDepthAndItsChecks) {

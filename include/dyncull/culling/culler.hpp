@@ -4,7 +4,9 @@
 /// (keyframe_matcher.hpp; Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-B), the keyframe's 3-D points
 /// back-projected from its depth (pinhole, x = z K^-1 u), stable track ids, frames since the keyframe and
 /// a keyframe policy. The host gives plain views per frame (keypoints, descriptors, depth, boxes, pose)
-/// and gets a keep mask, labels, reasons and a status naming any input the configuration lacked.
+/// and gets a keep mask, labels, reasons and a status naming any input the configuration lacked. The
+/// OpenCV forms (opencv/culler.hpp, opencv/compiled_culler.hpp) run this culler and its frame checks
+/// (culler_checks), so the same frame gets the same answer in every form (docs/design.md, input contract).
 ///
 /// API:
 /// @code
@@ -17,6 +19,7 @@
 
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
@@ -27,10 +30,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -112,6 +117,85 @@ PointsView points_view(const Container& points) {
     v.data = nullptr, v.count = 0;
   return v;
 }
+
+/// The frame checks every culler form shares (Culler, cv_adapter::FrameCuller, cv_adapter::CompiledCuller),
+/// so that the same input gets the same status and reason whichever form the host uses.
+namespace culler_checks {
+
+/// Largest magnitude of a predicted pose's entry (metres for t): 1e8 m holds any Earth-fixed map
+/// (ECEF, UTM) and keeps every entry and its square inside float's range.
+constexpr double kMaxPoseEntry = 1e8;
+/// Largest deviation of a predicted rotation from orthonormal: max |(R^T R - I)_ij| and |det R - 1|. A
+/// float pose composed over a long motion model stays near 1e-6; a scale, shear or sum of rotations is
+/// far above.
+constexpr double kRotationTolerance = 1e-3;
+
+/// A value in a reason: three significant digits, the same text for a float and a double input.
+inline std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+/// Ok, or InvalidInput naming `name`: a given view with a count needs data, and its stride must hold one
+/// (x, y) pair.
+inline Status check_points(const PointsView& v, const char* name, std::string* why) {
+  if (!v.given) return Status::Ok;
+  if (v.count > 0 && v.data == nullptr)
+    return (*why = std::string(name) + ": null data with a count of " + std::to_string(v.count), Status::InvalidInput);
+  const std::size_t pair = v.is_double ? 2 * sizeof(double) : 2 * sizeof(float);
+  if (v.stride_bytes != 0 && v.stride_bytes < pair)
+    return (*why = std::string(name) + ": stride_bytes " + std::to_string(v.stride_bytes) + " is below the " +
+                   std::to_string(pair) + " bytes of an x, y pair",
+            Status::InvalidInput);
+  return Status::Ok;
+}
+
+/// A predicted pose cam_from_world as R (row-major) and t, read in double before any conversion: NonFinite
+/// for a NaN or Inf entry; InvalidInput for an entry beyond kMaxPoseEntry or an R that is not a rotation
+/// (orthonormal with det +1 within kRotationTolerance: a zero, scaled, sheared or reflected R). The
+/// reason names `name`.
+inline Status check_pose(const double R[9], const double t[3], const char* name, std::string* why) {
+  const auto n = [name] { return std::string(name); };  // text only on failure: no allocation per frame
+  for (int k = 0; k < 12; ++k) {
+    const double v = k < 9 ? R[k] : t[k - 9];
+    if (!std::isfinite(v)) return (*why = n() + " has a NaN or Inf entry", Status::NonFinite);
+  }
+  for (int k = 0; k < 12; ++k) {
+    const double v = k < 9 ? R[k] : t[k - 9];
+    if (std::abs(v) > kMaxPoseEntry)
+      return (*why = n() + " has an entry of " + number(v) + ", out of the range [-1e8, 1e8] of a pose",
+              Status::InvalidInput);
+  }
+  double deviation = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      double dot = 0;
+      for (int r = 0; r < 3; ++r) dot += R[3 * r + a] * R[3 * r + b];
+      const double d = std::abs(dot - (a == b ? 1.0 : 0.0));
+      deviation = d > deviation ? d : deviation;
+    }
+  const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
+                     R[2] * (R[3] * R[7] - R[4] * R[6]);
+  if (deviation > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance)
+    return (*why = n() + "'s rotation is not a rotation (R^T R differs from I by " + number(deviation) +
+                   ", det R = " + number(det) + "; a rigid pose has 0 and 1 within 1e-3)",
+            Status::InvalidInput);
+  return Status::Ok;
+}
+
+/// check_pose on a Rigid3.
+template <class T>
+Status check_pose(const Rigid3<T>& pose, const char* name, std::string* why) {
+  double R[9], t[3];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R[3 * r + c] = static_cast<double>(pose.R(r, c));
+    t[r] = static_cast<double>(pose.t(r));
+  }
+  return check_pose(R, t, name, why);
+}
+
+}  // namespace culler_checks
 
 /// Which inputs a configuration reads (Culler::inputs) or a frame lacked (CullerResult::missing).
 struct CullerInputs {
@@ -218,13 +302,19 @@ struct CullerFrame {
 
 /// Outcome of one frame; vectors parallel to the frame's keypoints.
 struct CullerResult {
-  /// Ok; InvalidInput / NonFinite (nothing culled: every keep is 1) when an input cannot be read or the
-  /// arrays disagree in size; MissingInput when an input the configuration reads is missing (`missing`),
-  /// or the pipeline could not run a stage (the first frame has no keyframe to track against): the stages
-  /// that need it did not run and the others culled.
+  /// Ok: every enabled stage did its job. MissingInput: the labels are usable, but part of the input was
+  /// missing or unusable, named in `reason`: an input the configuration reads (`missing`), keypoints with
+  /// a NaN or Inf coordinate (each one culled, reason InvalidInput), a descriptor width other than the
+  /// keyframe's (this frame becomes the keyframe, no tracks), or a stage that could not run (the first
+  /// frame has no keyframe to track against); the stages that could run culled. Another status from the
+  /// pipeline (a stage that could not do its job) is passed on with the labels of the stages that ran.
+  /// refused() (InvalidInput / NonFinite before the pipeline ran): an input cannot be read, the arrays
+  /// disagree in size, or the predicted pose is not rigid; nothing culled, every keep is 1.
   Status status = Status::Ok;
   std::string reason;
   bool ok() const { return status == Status::Ok; }
+  /// The frame was refused before culling: every keep is 1, no keyframe, no track ids (-1).
+  bool refused = false;
 
   std::vector<std::uint8_t> keep;     ///< 1 = static: apply to every parallel array of the host
   std::vector<FeatureLabel> labels;   ///< Static or Dynamic
@@ -242,15 +332,17 @@ template <class T>
 class Culler {
  public:
   static_assert(std::is_floating_point<T>::value, "dyncull::Culler: T is float or double");
+  /// Widest descriptor row the keyframe matcher takes (ORB 32, BRISK 64, BinBoost / LATCH up to 64).
+  static constexpr std::size_t kMaxDescriptorBytes = 256;
 
   /// `camera`: the pinhole model of the (undistorted) keypoints; an invalid camera or options make every
   /// cull() return InvalidInput with the reason (status() says it at once).
   explicit Culler(const PinholeCamera<T>& camera, const CullerOptions<T>& options = CullerOptions<T>())
       : camera_(camera), options_(options) {
-    if (!camera_.valid()) {
+    std::string why;
+    if (camera_.validate(&why) != Status::Ok) {
       status_ = Status::InvalidInput;
-      reason_ = "camera: needs finite, positive focal lengths, a finite principal point and a positive image size "
-                "(no default intrinsics)";
+      reason_ = "camera: " + why + " (no default intrinsics)";
     } else {
       status_ = options_.validate(&reason_);
     }
@@ -282,35 +374,52 @@ class Culler {
   /// Culls one frame and, when the policy says so, makes it the reference keyframe. The result is valid
   /// until the next call.
   const CullerResult& cull(const CullerFrame<T>& f) {
-    CullerResult& r = result_;
-    r.status = Status::Ok;
-    r.reason.clear();
-    r.missing = CullerInputs{};
-    r.matched = 0;
-    r.keyframe = false;
-    const std::size_t n = f.keypoints.given ? f.keypoints.count : 0;
-    r.num_features = n;
-    r.frames_since_keyframe = have_keyframe_ ? frames_since_keyframe_ + 1 : 0;
+    CullerResult& r = begin_result(f.keypoints.given ? f.keypoints.count : 0);
+    const std::size_t n = r.num_features;
     std::string why;
     Status s = check_frame(f, n, &why);
-    if (s != Status::Ok) return refuse(s, why, n);
+    if (s != Status::Ok) return refuse_frame(s, why, n);
 
-    // Positions the geometry reads: undistorted when given.
+    // A descriptor width other than the keyframe's cannot be matched to it: this frame starts anew.
+    std::string dropped;
+    if (have_keyframe_ && f.keyframe_match == nullptr && f.descriptors.data != nullptr && keyframe_desc_rows_ > 0 &&
+        f.descriptors.row_bytes != keyframe_row_bytes_) {
+      dropped = "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) + " bytes where the keyframe's have " +
+                std::to_string(keyframe_row_bytes_) + ": not matched, this frame becomes the keyframe";
+      forget_keyframe();
+      r.frames_since_keyframe = 0;
+    }
+
+    // Positions the geometry reads: undistorted when given. A point non-finite in either is culled.
     const PointsView& geo = f.undistorted_keypoints.given ? f.undistorted_keypoints : f.keypoints;
+    const T nan = std::numeric_limits<T>::quiet_NaN();
     cur_px_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) cur_px_[i] = Vec2<T>(static_cast<T>(geo.x(i)), static_cast<T>(geo.y(i)));
+    non_finite_.assign(n, 0);
+    std::size_t bad[2] = {0, 0}, first_bad[2] = {0, 0};
+    for (std::size_t i = 0; i < n; ++i) {
+      // Read in T: a double beyond float's range is an infinity to Culler<float>.
+      const Vec2<T> raw(static_cast<T>(f.keypoints.x(i)), static_cast<T>(f.keypoints.y(i)));
+      const Vec2<T> p = &geo == &f.keypoints ? raw : Vec2<T>(static_cast<T>(geo.x(i)), static_cast<T>(geo.y(i)));
+      const bool raw_ok = std::isfinite(raw.x()) && std::isfinite(raw.y());
+      const bool geo_ok = std::isfinite(p.x()) && std::isfinite(p.y());
+      cur_px_[i] = raw_ok && geo_ok ? p : Vec2<T>(nan, nan);
+      if (raw_ok && geo_ok) continue;
+      non_finite_[i] = 1;
+      const int which = raw_ok ? 1 : 0;  // named by the argument that holds the NaN or Inf
+      if (bad[which]++ == 0) first_bad[which] = i;
+    }
 
     const CullerInputs need = inputs();
     const bool have_depth = !f.depth_m.empty() || !f.depth_raw.empty();
     const bool have_pose = f.cam_from_world != nullptr;
     r.missing.depth = need.depth && !have_depth;
     r.missing.detections = need.detections && f.detections == nullptr;
-    r.missing.descriptors = need.descriptors && f.descriptors.data == nullptr && f.keyframe_match == nullptr;
+    // A frame without keypoints has no descriptor rows to give: nothing is missing.
+    r.missing.descriptors = need.descriptors && n > 0 && f.descriptors.data == nullptr && f.keyframe_match == nullptr;
     r.missing.pose = need.pose && !have_pose;
     const Rigid3<T> pose = have_pose ? *f.cam_from_world : (have_keyframe_ ? keyframe_pose_ : Rigid3<T>::identity());
 
     // Correspondences to the keyframe, and from them the evidence arrays.
-    const T nan = std::numeric_limits<T>::quiet_NaN();
     prev_px_.assign(n, Vec2<T>(nan, nan));
     valid_.assign(n, 0);
     points_world_.assign(n, Vec3<T>(nan, nan, nan));
@@ -325,14 +434,14 @@ class Culler {
                           f.descriptors, camera_, have_pose ? &cam_from_keyframe : nullptr, options_.matching,
                           match_ws_, &match_);
         if (match_.status == Status::InvalidInput || match_.status == Status::NonFinite)
-          return refuse(match_.status, match_.reason, n);
+          return refuse_frame(match_.status, match_.reason, n);
       } else {
         match_.keyframe_index.assign(n, -1);
       }
     }
     const std::vector<int>& m = f.keyframe_match || !have_keyframe_ ? match_index_ : match_.keyframe_index;
     for (std::size_t i = 0; i < n; ++i) {
-      const int k = have_keyframe_ ? m[i] : -1;
+      const int k = have_keyframe_ && !non_finite_[i] ? m[i] : -1;
       if (k >= 0) {
         const std::size_t ku = static_cast<std::size_t>(k);
         prev_px_[i] = keyframe_px_[ku];
@@ -389,9 +498,21 @@ class Culler {
     r.keep = pr->keep;
     r.labels = pr->labels;
     r.reasons = pr->reasons;
+    if (r.keep.size() == n) {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!non_finite_[i]) continue;  // never trusted, whatever the stages and the survivor guard said
+        r.keep[i] = 0;
+        r.labels[i] = FeatureLabel::Dynamic;
+        r.reasons[i] = CullReason::InvalidInput;
+      }
+    }
     r.num_kept = 0;
     for (std::uint8_t k : r.keep) r.num_kept += k != 0;
-    describe(*pr, have_pose, have_depth, &r);
+    if (bad[0] > 0) append_non_finite("keypoints", bad[0], first_bad[0], &r.reason);
+    if (bad[1] > 0) append_non_finite("undistorted_keypoints", bad[1], first_bad[1], &r.reason);
+    if (!dropped.empty()) append(dropped, &r.reason);
+    if (!r.reason.empty()) r.status = Status::MissingInput;
+    describe(*pr, have_pose, have_depth, dropped.empty(), &r);
 
     if (new_keyframe && pr->keep.size() == n) {
       if (!f.depth_raw.empty())
@@ -405,6 +526,31 @@ class Culler {
     return r;
   }
 
+  /// Forgets the keyframe, the tracks and the pipeline's state, as if newly constructed with the same
+  /// camera and options (a new sequence, or a host that lost track). Buffers are kept.
+  void reset() {
+    forget_keyframe();
+    state_.reset();
+    next_id_ = 0;
+    begin_result(0);
+  }
+
+  /// Reports the frame of `n` keypoints as refused with `status` and `why` (every keep 1, nothing
+  /// culled, no keyframe), as cull() does for an input it cannot read. For the adapters (opencv/culler.hpp)
+  /// that read their own containers first: their refusals then match cull()'s field for field.
+  const CullerResult& refuse_frame(Status status, std::string why, std::size_t n) {
+    CullerResult& r = begin_result(n);
+    r.status = status;
+    r.reason = std::move(why);
+    r.refused = true;
+    r.keep.assign(n, 1);
+    r.labels.assign(n, FeatureLabel::Static);
+    r.reasons.assign(n, CullReason::None);
+    r.track_ids.assign(n, -1);
+    r.num_kept = n;
+    return r;
+  }
+
   /// The last cull()'s result.
   const CullerResult& result() const { return result_; }
   /// The pipeline's full result of the last cull() (per-stage reports, traces).
@@ -414,25 +560,81 @@ class Culler {
   bool has_keyframe() const { return have_keyframe_; }
 
  private:
+  /// Clears the result for a frame of n keypoints; frames_since_keyframe as the frame would see it.
+  CullerResult& begin_result(std::size_t n) {
+    CullerResult& r = result_;
+    r.status = Status::Ok;
+    r.reason.clear();
+    r.refused = false;
+    r.missing = CullerInputs{};
+    r.num_features = n;
+    r.num_kept = 0;
+    r.matched = 0;
+    r.keyframe = false;
+    r.frames_since_keyframe = have_keyframe_ ? frames_since_keyframe_ + 1 : 0;
+    if (n == 0) {
+      r.keep.clear();
+      r.labels.clear();
+      r.reasons.clear();
+      r.track_ids.clear();
+    }
+    return r;
+  }
+
+  void forget_keyframe() {
+    have_keyframe_ = false;
+    keyframe_has_depth_ = false;
+    frames_since_keyframe_ = 0;
+    keyframe_pose_ = Rigid3<T>::identity();
+    keyframe_px_.clear();
+    keyframe_cam_points_.clear();
+    keyframe_world_points_.clear();
+    keyframe_ids_.clear();
+    keyframe_desc_rows_ = 0;
+  }
+
+  static void append(const std::string& part, std::string* s) {
+    if (!s->empty()) *s += "; ";
+    *s += part;
+  }
+
+  static void append_non_finite(const char* name, std::size_t count, std::size_t first, std::string* s) {
+    std::string part = std::string(name) + "[" + std::to_string(first) + "]";
+    if (count > 1) part += " and " + std::to_string(count - 1) + (count == 2 ? " other" : " others");
+    part += count > 1 ? " have" : " has";
+    append(part + " a NaN or Inf coordinate: culled", s);
+  }
+
   /// InvalidInput / NonFinite with the reason naming the input, or Ok.
   Status check_frame(const CullerFrame<T>& f, std::size_t n, std::string* why) {
     if (status_ != Status::Ok) return (*why = reason_, status_);
     if (!f.keypoints.given) return (*why = "missing input: keypoints", Status::InvalidInput);
-    if (n > 0 && f.keypoints.data == nullptr) return (*why = "keypoints: null data with a count", Status::InvalidInput);
+    Status s = culler_checks::check_points(f.keypoints, "keypoints", why);
+    if (s != Status::Ok) return s;
     if (options_.camera_has_distortion && !f.undistorted_keypoints.given)
       return (*why = "missing input: undistorted_keypoints (the camera has distortion; the geometry needs them)",
               Status::InvalidInput);
-    if (f.undistorted_keypoints.given &&
-        (f.undistorted_keypoints.count != n || (n > 0 && f.undistorted_keypoints.data == nullptr)))
+    if (f.undistorted_keypoints.given && f.undistorted_keypoints.count != n)
       return (*why = "undistorted_keypoints has " + std::to_string(f.undistorted_keypoints.count) + " points for " +
                      std::to_string(n) + " keypoints",
               Status::InvalidInput);
+    s = culler_checks::check_points(f.undistorted_keypoints, "undistorted_keypoints", why);
+    if (s != Status::Ok) return s;
     if (f.descriptors.data != nullptr && f.descriptors.rows != n)
       return (*why = "descriptors has " + std::to_string(f.descriptors.rows) + " rows for " + std::to_string(n) +
                      " keypoints",
               Status::InvalidInput);
     if (f.descriptors.data != nullptr && (f.descriptors.row_bytes == 0 || f.descriptors.stride() < f.descriptors.row_bytes))
       return (*why = "descriptors: row_bytes must be positive and at most the stride", Status::InvalidInput);
+    if (f.descriptors.data != nullptr && f.descriptors.row_bytes > kMaxDescriptorBytes)
+      return (*why = "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) +
+                     " bytes; the keyframe matcher takes 1 to 256",
+              Status::InvalidInput);
+    if (f.descriptors.data != nullptr && 8 * f.descriptors.row_bytes < static_cast<std::size_t>(options_.matching.max_hamming))
+      return (*why = "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) + " bytes (" +
+                     std::to_string(8 * f.descriptors.row_bytes) + " bits) are shorter than matching.max_hamming = " +
+                     std::to_string(options_.matching.max_hamming) + " bits",
+              Status::InvalidInput);
     if (!f.depth_m.empty() && !f.depth_raw.empty())
       return (*why = "depth: give depth_m (metres) or depth_raw (uint16), not both", Status::InvalidInput);
     std::string d;
@@ -441,11 +643,11 @@ class Culler {
     const int dw = !f.depth_m.empty() ? f.depth_m.width : f.depth_raw.width;
     const int dh = !f.depth_m.empty() ? f.depth_m.height : f.depth_raw.height;
     if ((!f.depth_m.empty() || !f.depth_raw.empty()) && (dw != camera_.width || dh != camera_.height))
-      return (*why = "depth is " + std::to_string(dw) + "x" + std::to_string(dh) + " for a camera of " +
+      return (*why = "depth: " + std::to_string(dw) + "x" + std::to_string(dh) + " for an image of " +
                      std::to_string(camera_.width) + "x" + std::to_string(camera_.height),
               Status::InvalidInput);
-    if (f.cam_from_world && !f.cam_from_world->all_finite())
-      return (*why = "cam_from_world has a NaN or Inf entry", Status::NonFinite);
+    if (f.cam_from_world && (s = culler_checks::check_pose(*f.cam_from_world, "cam_from_world", why)) != Status::Ok)
+      return s;
     if (f.keyframe_match) {
       const std::size_t nk = have_keyframe_ ? keyframe_px_.size() : 0;
       for (std::size_t i = 0; i < n; ++i) {
@@ -459,20 +661,6 @@ class Culler {
     }
     why->clear();
     return Status::Ok;
-  }
-
-  const CullerResult& refuse(Status s, const std::string& why, std::size_t n) {
-    CullerResult& r = result_;
-    r.status = s;
-    r.reason = why;
-    r.keep.assign(n, 1);
-    r.labels.assign(n, FeatureLabel::Static);
-    r.reasons.assign(n, CullReason::None);
-    r.track_ids.assign(n, -1);
-    r.num_kept = n;
-    r.matched = 0;
-    r.keyframe = false;
-    return r;
   }
 
   template <class A, class B>
@@ -489,28 +677,28 @@ class Culler {
     b->evidence_frames = a.evidence_frames;
   }
 
-  /// Status and reason: the culler's missing inputs first, then the pipeline's own.
-  void describe(const PipelineResult<T>& pr, bool have_pose, bool have_depth, CullerResult* r) const {
+  /// Status and reason after the frame's own (non-finite keypoints, a new descriptor width): the missing
+  /// inputs, then the pipeline's. The status is the first non-Ok one.
+  void describe(const PipelineResult<T>& pr, bool have_pose, bool have_depth, bool say_first_frame,
+                CullerResult* r) const {
     std::string& s = r->reason;
     if (r->missing.any()) {
       r->status = Status::MissingInput;
-      s = "missing input: " + r->missing.names();
+      append("missing input: " + r->missing.names(), &s);
       if (r->missing.depth)
         s += "; monocular (no depth): the depth mask and the reprojection check did not run, epipolar evidence only";
       if (r->missing.descriptors) s += "; no descriptors and no keyframe_match: no tracks, box evidence only";
       if (r->missing.pose) s += "; no predicted pose: the keyframe's pose stands in (no motion prior)";
       if (r->missing.detections) s += "; no detections: the box stages did not run";
     } else if (!have_pose && have_depth && options_.pipeline.reprojection.enabled) {
-      s = "no predicted pose: the reprojection check did not run";
+      append("no predicted pose: the reprojection check did not run", &s);
     }
-    if (!have_keyframe_) {
-      if (!s.empty()) s += "; ";
-      s += "first frame: no keyframe yet, no track evidence";
-    }
+    if (!have_keyframe_ && say_first_frame) append("first frame: no keyframe yet, no track evidence", &s);
     if (!pr.ok()) {
-      if (r->status == Status::Ok) r->status = pr.status;
-      if (!s.empty()) s += "; ";
-      s += "pipeline: " + pr.reason;
+      // The worst wins: a stage that could not do its job outranks a missing input.
+      if (r->status == Status::Ok || (r->status == Status::MissingInput && pr.status != Status::MissingInput))
+        r->status = pr.status;
+      append("pipeline: " + pr.reason, &s);
     }
   }
 
@@ -529,9 +717,8 @@ class Culler {
       const int r = options_.depth_edge_radius_px;
       for (std::size_t i = 0; i < n; ++i) {
         // Depth where the keypoint is in the image (as detected), ray through its undistorted position.
-        const double u = f.keypoints.x(i), v = f.keypoints.y(i);
-        if (!std::isfinite(u) || !std::isfinite(v)) continue;
-        const int x = static_cast<int>(std::lround(u)), y = static_cast<int>(std::lround(v));
+        int x = 0, y = 0;
+        if (!pixel_of(f.keypoints.x(i), f.keypoints.y(i), depth.width, depth.height, &x, &y)) continue;
         if (x < r || y < r || x >= depth.width - r || y >= depth.height - r) continue;
         const float z = depth.depth_m(x, y);
         if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
@@ -578,7 +765,7 @@ class Culler {
   // Per-frame buffers, reused.
   std::vector<Vec2<T>> cur_px_, prev_px_;
   std::vector<Vec3<T>> points_world_;
-  std::vector<std::uint8_t> valid_;
+  std::vector<std::uint8_t> valid_, non_finite_;
   std::vector<int> match_index_;  // the host's keyframe_match, checked
   KeyframeMatchWorkspace<T> match_ws_;
   KeyframeMatchResult<T> match_;

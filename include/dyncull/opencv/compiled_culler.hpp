@@ -39,7 +39,8 @@ struct DetectedBox {
 };
 
 /// One camera stream's culler, compiled into dyncull::culler (float geometry). Not thread-safe; movable,
-/// not copyable. Same per-frame behaviour as cv_adapter::FrameCuller.
+/// not copyable. Same per-frame behaviour as cv_adapter::FrameCuller (it runs one): the same input gives
+/// the same keep mask, labels, status and reason.
 class CompiledCuller {
  public:
   /// Same values and meanings as dyncull::Status.
@@ -97,12 +98,17 @@ class CompiledCuller {
 
   /// Outcome of the last cull(); vectors parallel to its keypoints.
   struct Result {
-    /// Ok; MissingInput when an input the configuration reads was missing (the stages that need it did
-    /// not run, the others culled); InvalidInput / NonFinite when an input could not be read or the arrays
-    /// disagree in size (nothing culled: every keep is 1). `reason` names the input.
+    /// As dyncull::CullerResult::status. Ok: every enabled stage did its job. MissingInput: the labels are
+    /// usable, but an input the configuration reads was missing, keypoints had a NaN or Inf coordinate
+    /// (each culled), the descriptor width changed (this frame became the keyframe), or a stage could not
+    /// run; the others culled. InvalidInput / NonFinite when an input could not be read, the arrays
+    /// disagree in size or the predicted pose is not rigid (nothing culled: every keep is 1). `reason`
+    /// names the argument.
     Status status;
     std::string reason;
     bool ok() const { return status == Status::Ok; }
+    /// The frame was refused before culling: every keep is 1, no keyframe, no track ids (-1).
+    bool refused;
 
     std::vector<std::uint8_t> keep;  ///< 1 = static: apply to every parallel array of the host
     std::vector<Label> labels;
@@ -112,7 +118,7 @@ class CompiledCuller {
     int frames_since_keyframe;  ///< baseline of this frame's evidence (0: no keyframe yet)
     bool keyframe;              ///< this frame became the reference keyframe
 
-    Result() : status(Status::Ok), num_features(0), num_kept(0), matched(0), frames_since_keyframe(0), keyframe(false) {}
+    Result() : status(Status::Ok), refused(false), num_features(0), num_kept(0), matched(0), frames_since_keyframe(0), keyframe(false) {}
   };
 
   /// K: 3x3 CV_32F / CV_64F; distortion: OpenCV's 4, 5, 8, 12 or 14 coefficients, or empty. A bad K,
@@ -126,7 +132,7 @@ class CompiledCuller {
   CompiledCuller& operator=(const CompiledCuller&) = delete;
 
   /// InvalidInput naming the argument when K, the size, the distortion or an option is bad (and after
-  /// a move from this object).
+  /// a move from this object: every cull() then keeps all, parallel to its keys).
   Status status() const;
   const std::string& reason() const;
   bool ok() const { return status() == Status::Ok; }
@@ -154,6 +160,9 @@ class CompiledCuller {
 
   /// The last cull()'s result.
   const Result& result() const;
+  /// Forgets the keyframe, the tracks and the pipeline's state, as if newly constructed (a new sequence,
+  /// or a host that lost track); the camera and options stay.
+  void reset();
 
   static const char* to_string(Status status);
   static const char* to_string(Label label);
@@ -197,6 +206,7 @@ class CompiledCuller {
   }
 
   struct Impl;
+  Impl& impl();  // the moved-from object gets one that refuses every frame
   std::unique_ptr<Impl> impl_;
 };
 

@@ -55,12 +55,13 @@ class FrameCuller {
   /// Keep mask parallel to `keys` (1 = static); result() says why. `descriptors`: one CV_8U row per key
   /// (empty: none); `depth`: the frame's depth at the image size (empty: monocular); `predicted_Tcw`: 4x4
   /// cam_from_world (CV_32F / CV_64F), e.g. the motion model's, or null. `undistorted`: the host's
-  /// undistorted copy of keys, or null to undistort here when the camera has distortion.
+  /// undistorted copy of keys, or null to undistort here when the camera has distortion. The checks and
+  /// statuses are Culler::cull's (a rigid pose, NaN / Inf keypoints culled, descriptor widths): the same
+  /// frame gets the same result as from Culler<float> and CompiledCuller.
   const std::vector<std::uint8_t>& cull(const std::vector<cv::KeyPoint>& keys, const cv::Mat& descriptors,
                                         const cv::Mat& depth, const std::vector<Detection<float>>& detections,
                                         const cv::Mat* predicted_Tcw = nullptr,
                                         const std::vector<cv::KeyPoint>* undistorted = nullptr) {
-    refused_ = false;
     CullerFrame<float> f;
     f.keypoints = points_view(keys);
     std::string why;
@@ -81,9 +82,8 @@ class FrameCuller {
     }
     f.detections = &detections;
     if (predicted_Tcw) {
-      if (!read_pose(*predicted_Tcw, &pose_))
-        return refuse(Status::InvalidInput, "predicted_Tcw must be a 4x4 CV_32F or CV_64F matrix [R t; 0 0 0 1]",
-                      keys.size());
+      const Status s = read_pose(*predicted_Tcw, &pose_, &why);
+      if (s != Status::Ok) return refuse(s, why, keys.size());
       f.cam_from_world = &pose_;
     }
     if (undistorted) {
@@ -97,7 +97,9 @@ class FrameCuller {
   }
 
   /// Labels, reasons, status and what was missing, of the last cull().
-  const CullerResult& result() const { return refused_ ? refused_result_ : culler_.result(); }
+  const CullerResult& result() const { return culler_.result(); }
+  /// Forgets the keyframe, the tracks and the pipeline's state (Culler::reset); the camera and options stay.
+  void reset() { culler_.reset(); }
   /// The camera read from K (with its distortion flag).
   const CameraFromK<float>& camera() const { return camera_; }
   Culler<float>& culler() { return culler_; }
@@ -109,28 +111,33 @@ class FrameCuller {
     return o;
   }
 
+  // Refused here or in Culler::cull: the same result either way.
   const std::vector<std::uint8_t>& refuse(Status s, const std::string& why, std::size_t n) {
-    refused_result_.status = s;
-    refused_result_.reason = why;
-    refused_result_.keep.assign(n, 1);
-    refused_result_.labels.assign(n, FeatureLabel::Static);
-    refused_result_.reasons.assign(n, CullReason::None);
-    refused_result_.track_ids.assign(n, -1);
-    refused_result_.num_features = refused_result_.num_kept = n;
-    refused_ = true;
-    return refused_result_.keep;
+    return culler_.refuse_frame(s, why, n).keep;
   }
 
-  static bool read_pose(const cv::Mat& m, Rigid3<float>* out) {
-    if (m.rows != 4 || m.cols != 4 || m.channels() != 1 || (m.depth() != CV_32F && m.depth() != CV_64F)) return false;
+  /// The 4x4 cam_from_world, checked in double before the conversion to float (culler_checks::check_pose:
+  /// finite, in range, rigid), then its last row.
+  static Status read_pose(const cv::Mat& m, Rigid3<float>* out, std::string* why) {
+    if (m.rows != 4 || m.cols != 4 || m.channels() != 1 || (m.depth() != CV_32F && m.depth() != CV_64F))
+      return (*why = "predicted_Tcw must be a 4x4 CV_32F or CV_64F matrix [R t; 0 0 0 1]", Status::InvalidInput);
     auto at = [&](int r, int c) {
-      return m.depth() == CV_64F ? static_cast<float>(m.at<double>(r, c)) : m.at<float>(r, c);
+      return m.depth() == CV_64F ? m.at<double>(r, c) : static_cast<double>(m.at<float>(r, c));
     };
+    double R[9], t[3];
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) out->R(r, c) = at(r, c);
-      out->t(r) = at(r, 3);
+      for (int c = 0; c < 3; ++c) R[3 * r + c] = at(r, c);
+      t[r] = at(r, 3);
     }
-    return at(3, 0) == 0.f && at(3, 1) == 0.f && at(3, 2) == 0.f && at(3, 3) == 1.f;
+    const Status s = culler_checks::check_pose(R, t, "predicted_Tcw", why);
+    if (s != Status::Ok) return s;
+    if (!(at(3, 0) == 0.0 && at(3, 1) == 0.0 && at(3, 2) == 0.0 && at(3, 3) == 1.0))
+      return (*why = "predicted_Tcw must be a 4x4 CV_32F or CV_64F matrix [R t; 0 0 0 1]", Status::InvalidInput);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) out->R(r, c) = static_cast<float>(R[3 * r + c]);
+      out->t(r) = static_cast<float>(t[r]);
+    }
+    return Status::Ok;
   }
 
   CameraFromK<float> camera_;
@@ -142,8 +149,6 @@ class FrameCuller {
   Rigid3<float> pose_;
   std::vector<cv::KeyPoint> undistorted_;
   UndistortWorkspace undistort_ws_;
-  CullerResult refused_result_;
-  bool refused_ = false;
 };
 
 }  // namespace cv_adapter

@@ -103,47 +103,71 @@ inline bool read_matrix(const cv::Mat& m, std::vector<double>* out) {
 }  // namespace detail
 
 /// PinholeCamera from a 3x3 K (CV_32F or CV_64F: fx 0 cx; 0 fy cy; 0 0 1) and the image size. K must be
-/// finite with positive focal lengths, zero skew and the last row (0, 0, 1), the size positive; the
-/// distortion coefficients (optional) a CV_32F / CV_64F vector of 4, 5, 8, 12 or 14 finite values.
+/// finite with positive focal lengths, zero skew and the last row (0, 0, 1), the size positive, and its
+/// intrinsics those of a camera that exists (PinholeCamera::validate: focal lengths 1e-3 to 1e4 times the
+/// larger image side, the principal point within one image size of the image); the distortion
+/// coefficients (optional) a CV_32F / CV_64F vector of 4, 5, 8, 12 or 14 finite values.
 /// Anything else is InvalidInput (NonFinite for a NaN / Inf entry) with the reason naming K, image_size or
 /// distortion. The camera itself has no distortion: with has_distortion, pass keypoints through
 /// undistort_keypoints before geometry.
+namespace detail {
+/// K's nine entries (row-major) and the distortion coefficients, with the checks of camera_from_K that do
+/// not need the image size. Ok, or the status with the reason (without the "camera_from_K: " prefix).
+inline Status read_calibration(const cv::Mat& K, const cv::Mat& distortion, std::vector<double>* k,
+                               std::vector<double>* coefficients, bool* has_distortion, std::string* why) {
+  auto fail = [&](Status s, const std::string& reason) {
+    *why = reason;
+    return s;
+  };
+  *has_distortion = false;
+  coefficients->clear();
+  if (K.rows != 3 || K.cols != 3 || !read_matrix(K, k))
+    return fail(Status::InvalidInput, "K must be a 3x3 single-channel CV_32F or CV_64F matrix");
+  for (double v : *k)
+    if (!std::isfinite(v)) return fail(Status::NonFinite, "K has a NaN or Inf entry");
+  const std::vector<double>& m = *k;
+  if (!(m[0] > 0.0) || !(m[4] > 0.0)) return fail(Status::InvalidInput, "K's focal lengths fx, fy must be positive");
+  if (m[1] != 0.0) return fail(Status::InvalidInput, "K has a non-zero skew K(0, 1); the pinhole model has none");
+  if (m[3] != 0.0 || m[6] != 0.0 || m[7] != 0.0 || m[8] != 1.0)
+    return fail(Status::InvalidInput, "K's rows must be (fx 0 cx; 0 fy cy; 0 0 1)");
+  if (!distortion.empty()) {
+    if ((distortion.rows != 1 && distortion.cols != 1) || !read_matrix(distortion, coefficients))
+      return fail(Status::InvalidInput, "distortion must be a single-channel CV_32F or CV_64F vector");
+    const std::size_t nd = coefficients->size();
+    if (nd != 4 && nd != 5 && nd != 8 && nd != 12 && nd != 14)
+      return fail(Status::InvalidInput, "distortion has " + std::to_string(nd) +
+                                            " coefficients; OpenCV takes 4, 5, 8, 12 or 14");
+    for (double v : *coefficients) {
+      if (!std::isfinite(v)) return fail(Status::NonFinite, "distortion has a NaN or Inf coefficient");
+      *has_distortion = *has_distortion || v != 0.0;
+    }
+  }
+  why->clear();
+  return Status::Ok;
+}
+}  // namespace detail
+
 template <class T>
 CameraFromK<T> camera_from_K(const cv::Mat& K, cv::Size image_size, const cv::Mat& distortion = cv::Mat()) {
   CameraFromK<T> out;
   auto fail = [&](Status s, const std::string& why) {
     out.status = s;
     out.reason = "camera_from_K: " + why;
+    out.distortion.clear();
+    out.has_distortion = false;
     return out;
   };
   std::vector<double> k;
-  if (K.rows != 3 || K.cols != 3 || !detail::read_matrix(K, &k))
-    return fail(Status::InvalidInput, "K must be a 3x3 single-channel CV_32F or CV_64F matrix");
-  for (double v : k)
-    if (!std::isfinite(v)) return fail(Status::NonFinite, "K has a NaN or Inf entry");
-  if (!(k[0] > 0.0) || !(k[4] > 0.0)) return fail(Status::InvalidInput, "K's focal lengths fx, fy must be positive");
-  if (k[1] != 0.0) return fail(Status::InvalidInput, "K has a non-zero skew K(0, 1); the pinhole model has none");
-  if (k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0)
-    return fail(Status::InvalidInput, "K's rows must be (fx 0 cx; 0 fy cy; 0 0 1)");
+  std::string why;
+  const Status read = detail::read_calibration(K, distortion, &k, &out.distortion, &out.has_distortion, &why);
+  if (read != Status::Ok) return fail(read, why);
   if (image_size.width <= 0 || image_size.height <= 0)
     return fail(Status::InvalidInput, "image_size must be positive, got " + std::to_string(image_size.width) + "x" +
                                           std::to_string(image_size.height));
-  if (!distortion.empty()) {
-    if ((distortion.rows != 1 && distortion.cols != 1) || !detail::read_matrix(distortion, &out.distortion))
-      return fail(Status::InvalidInput, "distortion must be a single-channel CV_32F or CV_64F vector");
-    const std::size_t nd = out.distortion.size();
-    if (nd != 4 && nd != 5 && nd != 8 && nd != 12 && nd != 14)
-      return fail(Status::InvalidInput, "distortion has " + std::to_string(nd) +
-                                            " coefficients; OpenCV takes 4, 5, 8, 12 or 14");
-    for (double v : out.distortion) {
-      if (!std::isfinite(v)) return fail(Status::NonFinite, "distortion has a NaN or Inf coefficient");
-      out.has_distortion = out.has_distortion || v != 0.0;
-    }
-  }
-  out.camera = PinholeCamera<T>{static_cast<T>(k[0]), static_cast<T>(k[4]), static_cast<T>(k[2]),
-                                static_cast<T>(k[5]), image_size.width, image_size.height};
-  if (!out.camera.valid())  // a K entry beyond float's range
-    return fail(Status::InvalidInput, "K does not fit the scalar type");
+  // Checked in double before the conversion: the bounds keep every entry well inside float's range.
+  const PinholeCamera<double> exact{k[0], k[4], k[2], k[5], image_size.width, image_size.height};
+  if (exact.validate(&why) != Status::Ok) return fail(Status::InvalidInput, "K: " + why);
+  out.camera = exact.template cast<T>();
   return out;
 }
 
@@ -216,13 +240,16 @@ Status undistort_keypoints(const std::vector<KP>& keypoints, const cv::Mat& K, c
                     std::is_same<KP, cv::Point2d>::value,
                 "undistort_keypoints: cv::KeyPoint, cv::Point2f or cv::Point2d");
   if (out != &keypoints) *out = keypoints;
-  const CameraFromK<double> cam = camera_from_K<double>(K, cv::Size(1, 1), distortion);
-  if (!cam.ok()) {
-    if (reason) *reason = "undistort_keypoints: " + cam.reason;
-    return cam.status;
+  std::vector<double> k, coefficients;
+  bool has_distortion = false;
+  std::string why;
+  const Status read = detail::read_calibration(K, distortion, &k, &coefficients, &has_distortion, &why);
+  if (read != Status::Ok) {
+    if (reason) *reason = "undistort_keypoints: camera_from_K: " + why;
+    return read;
   }
   if (reason) reason->clear();
-  if (!cam.has_distortion || out->empty()) return Status::Ok;
+  if (!has_distortion || out->empty()) return Status::Ok;
   UndistortWorkspace local;
   UndistortWorkspace& ws = workspace ? *workspace : local;
   ws.src.clear();

@@ -1,0 +1,416 @@
+// One frame contract for the three culler forms: Culler<float> (plain views), cv_adapter::FrameCuller
+// (OpenCV containers, header-only) and cv_adapter::CompiledCuller (dyncull::culler) get the same frames,
+// good and bad (NaN / Inf keypoints, descriptor width changes, bad poses, absurd intrinsics, empty frames,
+// mismatched sizes, bad strides), and give the same keep mask, labels, reasons, status and reason. Also the
+// OpenCV forms' own findings: a CV_64F pose beyond float's range, a moved-from CompiledCuller, a quoted
+// preset name, and a refused frame that keeps frames_since_keyframe.
+#include "dyncull/opencv/compiled_culler.hpp"
+#include "dyncull/opencv/culler.hpp"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dyncull {
+namespace {
+
+using cv_adapter::CompiledCuller;
+using cv_adapter::DetectedBox;
+using cv_adapter::FrameCuller;
+
+const cv::Mat kK = (cv::Mat_<double>(3, 3) << 525, 0, 319.5, 0, 525, 239.5, 0, 0, 1);
+const cv::Size kSize(640, 480);
+
+/// One frame as a host has it; each form gets it in its own containers.
+struct Frame {
+  std::vector<cv::KeyPoint> keys;
+  cv::Mat descriptors;  // CV_8U rows, or empty
+  cv::Mat depth;        // CV_32F metres, or empty
+  std::vector<Detection<float>> boxes;
+  cv::Mat Tcw;  // 4x4 CV_64F, or empty: no pose
+  std::vector<cv::KeyPoint> undistorted;
+  bool has_undistorted = false;
+  std::size_t stride_bytes = 0;  // for the plain view and the compiled float-pair overload (0: as the keys)
+};
+
+/// A static scene seen from the same pose: 60 keypoints, each with its own descriptor, depth 2 m, a person
+/// box over a quarter of them.
+Frame good_frame(std::size_t width = 32) {
+  Frame f;
+  cv::RNG rng(7);
+  for (int i = 0; i < 60; ++i) f.keys.emplace_back(cv::Point2f(20.f + 10.f * float(i), 60.f + 6.f * float(i % 11)), 31.f);
+  f.descriptors.create(60, static_cast<int>(width), CV_8UC1);
+  rng.fill(f.descriptors, cv::RNG::UNIFORM, 0, 256);
+  f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.f));
+  Detection<float> person;
+  person.box = Box<float>{15.f, 50.f, 170.f, 130.f};
+  person.class_id = 0;
+  person.confidence = 0.9f;
+  f.boxes.push_back(person);
+  f.Tcw = cv::Mat::eye(4, 4, CV_64F);
+  return f;
+}
+
+/// What the test compares, from any form.
+struct Outcome {
+  int status = 0;
+  std::string reason;
+  std::vector<std::uint8_t> keep;
+  std::vector<int> labels, reasons;
+  std::vector<std::int64_t> track_ids;
+  int frames_since_keyframe = 0;
+  bool keyframe = false;
+  std::size_t matched = 0;
+};
+
+template <class R>
+Outcome outcome_of(const R& r) {
+  Outcome o;
+  o.status = static_cast<int>(r.status);
+  o.reason = r.reason;
+  o.keep = r.keep;
+  for (auto l : r.labels) o.labels.push_back(static_cast<int>(l));
+  for (auto c : r.reasons) o.reasons.push_back(static_cast<int>(c));
+  o.track_ids = r.track_ids;
+  o.frames_since_keyframe = r.frames_since_keyframe;
+  o.keyframe = r.keyframe;
+  o.matched = r.matched;
+  return o;
+}
+
+/// The plain culler on the frame's data, read in place. Its pose argument is cam_from_world; the OpenCV
+/// forms name it predicted_Tcw: the reason is compared with that name.
+class PlainForm {
+ public:
+  explicit PlainForm(const cv::Mat& K, const CullerOptions<float>& o = CullerOptions<float>())
+      : culler_(camera_of(K), o) {}
+  Outcome cull(const Frame& in) {
+    CullerFrame<float> f;
+    f.keypoints = points_view(in.keys);
+    if (in.stride_bytes != 0) f.keypoints.stride_bytes = in.stride_bytes;
+    if (in.has_undistorted) f.undistorted_keypoints = points_view(in.undistorted);
+    if (!in.descriptors.empty())
+      f.descriptors = DescriptorRows(in.descriptors.ptr<std::uint8_t>(0), static_cast<std::size_t>(in.descriptors.rows),
+                                     in.descriptors.step[0], in.descriptors.cols * in.descriptors.elemSize());
+    if (!in.depth.empty()) f.depth_m = cv_adapter::depth_view_f32(in.depth);
+    f.detections = &in.boxes;
+    if (!in.Tcw.empty()) {
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) pose_.R(r, c) = static_cast<float>(in.Tcw.at<double>(r, c));
+        pose_.t(r) = static_cast<float>(in.Tcw.at<double>(r, 3));
+      }
+      f.cam_from_world = &pose_;
+    }
+    Outcome o = outcome_of(culler_.cull(f));
+    for (std::size_t at = o.reason.find("cam_from_world"); at != std::string::npos; at = o.reason.find("cam_from_world"))
+      o.reason.replace(at, 14, "predicted_Tcw");
+    return o;
+  }
+
+ private:
+  static PinholeCamera<float> camera_of(const cv::Mat& K) {
+    return PinholeCamera<float>{static_cast<float>(K.at<double>(0, 0)), static_cast<float>(K.at<double>(1, 1)),
+                                static_cast<float>(K.at<double>(0, 2)), static_cast<float>(K.at<double>(1, 2)),
+                                kSize.width, kSize.height};
+  }
+  Culler<float> culler_;
+  Rigid3<float> pose_;
+};
+
+class FrameForm {
+ public:
+  explicit FrameForm(const cv::Mat& K) : culler_(K, kSize) {}
+  Outcome cull(const Frame& in) {
+    culler_.cull(in.keys, in.descriptors, in.depth, in.boxes, in.Tcw.empty() ? nullptr : &in.Tcw,
+                 in.has_undistorted ? &in.undistorted : nullptr);
+    return outcome_of(culler_.result());
+  }
+  FrameCuller culler_;
+};
+
+std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
+  std::vector<DetectedBox> out;
+  for (const Detection<float>& d : detections)
+    out.emplace_back(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence);
+  return out;
+}
+
+class CompiledForm {
+ public:
+  explicit CompiledForm(const cv::Mat& K) : culler_(K, kSize) {}
+  Outcome cull(const Frame& in) {
+    const std::vector<DetectedBox> boxes = boxes_of(in.boxes);
+    const cv::Mat* pose = in.Tcw.empty() ? nullptr : &in.Tcw;
+    if (in.stride_bytes != 0) {
+      culler_.cull(in.keys.empty() ? nullptr : &in.keys[0].pt.x, in.keys.size(), in.stride_bytes, in.descriptors,
+                   in.depth, boxes, pose);
+    } else {
+      culler_.cull(in.keys, in.descriptors, in.depth, boxes, pose, in.has_undistorted ? &in.undistorted : nullptr);
+    }
+    return outcome_of(culler_.result());
+  }
+  CompiledCuller culler_;
+};
+
+void expect_same(const Outcome& a, const Outcome& b, const char* what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(a.status, b.status);
+  EXPECT_EQ(a.reason, b.reason);
+  EXPECT_EQ(a.keep, b.keep);
+  EXPECT_EQ(a.labels, b.labels);
+  EXPECT_EQ(a.reasons, b.reasons);
+  EXPECT_EQ(a.track_ids, b.track_ids);
+  EXPECT_EQ(a.frames_since_keyframe, b.frames_since_keyframe);
+  EXPECT_EQ(a.keyframe, b.keyframe);
+  EXPECT_EQ(a.matched, b.matched);
+}
+
+/// Feeds the frames to all three forms (the plain one only when `plain`), each after a good first frame,
+/// compares every frame's outcome and returns the last one.
+Outcome same_in_every_form(const std::vector<Frame>& frames, bool plain = true, bool frame_form = true) {
+  PlainForm p(kK);
+  FrameForm f(kK);
+  CompiledForm c(kK);
+  const Frame first = good_frame();
+  Outcome last = c.cull(first);
+  if (plain) expect_same(p.cull(first), last, "first frame, plain vs compiled");
+  if (frame_form) expect_same(f.cull(first), last, "first frame, FrameCuller vs compiled");
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const std::string step = "frame " + std::to_string(k + 1);
+    last = c.cull(frames[k]);
+    if (plain) expect_same(p.cull(frames[k]), last, (step + ", plain vs compiled").c_str());
+    if (frame_form) expect_same(f.cull(frames[k]), last, (step + ", FrameCuller vs compiled").c_str());
+  }
+  return last;
+}
+
+bool culled_as_invalid(const Outcome& o, std::size_t i) {
+  return o.keep[i] == 0 && o.labels[i] == static_cast<int>(FeatureLabel::Dynamic) &&
+         o.reasons[i] == static_cast<int>(CullReason::InvalidInput);
+}
+
+TEST(CullerContract, NonFiniteKeypointsAreCulledAndNamedAlikeInEveryForm) {
+  Frame bad = good_frame();
+  bad.keys[3].pt.x = std::numeric_limits<float>::quiet_NaN();
+  bad.keys[40].pt.y = -std::numeric_limits<float>::infinity();
+  const Outcome o = same_in_every_form({bad, good_frame()});
+  EXPECT_EQ(o.status, static_cast<int>(Status::Ok)) << o.reason;  // the frame after is usable as ever
+
+  const Outcome during = same_in_every_form({bad});
+  EXPECT_EQ(during.status, static_cast<int>(Status::MissingInput));
+  EXPECT_NE(during.reason.find("keypoints[3] and 1 other have a NaN or Inf coordinate: culled"), std::string::npos)
+      << during.reason;
+  EXPECT_TRUE(culled_as_invalid(during, 3));
+  EXPECT_TRUE(culled_as_invalid(during, 40));
+  EXPECT_GT(during.matched, 50u);  // the other keypoints were judged as usual
+
+  Frame und = good_frame();
+  und.undistorted = und.keys;
+  und.has_undistorted = true;
+  und.undistorted[8].pt.y = std::numeric_limits<float>::quiet_NaN();
+  const Outcome u = same_in_every_form({und});
+  EXPECT_EQ(u.status, static_cast<int>(Status::MissingInput));
+  EXPECT_NE(u.reason.find("undistorted_keypoints[8] has a NaN or Inf coordinate: culled"), std::string::npos)
+      << u.reason;
+  EXPECT_TRUE(culled_as_invalid(u, 8));
+}
+
+TEST(CullerContract, DescriptorWidthChangeStartsANewKeyframeAlikeInEveryForm) {
+  for (const std::size_t width : {std::size_t(64), std::size_t(33)}) {
+    SCOPED_TRACE("rows of " + std::to_string(width) + " bytes");
+    const Frame wide = good_frame(width);
+    const Outcome o = same_in_every_form({wide});
+    EXPECT_EQ(o.status, static_cast<int>(Status::MissingInput));
+    EXPECT_NE(o.reason.find("descriptors: rows of " + std::to_string(width) + " bytes where the keyframe's have 32"),
+              std::string::npos)
+        << o.reason;
+    EXPECT_TRUE(o.keyframe);
+    const Outcome after = same_in_every_form({wide, wide});
+    EXPECT_EQ(after.status, static_cast<int>(Status::Ok)) << after.reason;
+    EXPECT_EQ(after.matched, 60u);
+  }
+  const Outcome too_wide = same_in_every_form({good_frame(300), good_frame()});
+  EXPECT_EQ(too_wide.status, static_cast<int>(Status::Ok)) << too_wide.reason;
+  const Outcome refused = same_in_every_form({good_frame(300)});
+  EXPECT_EQ(refused.status, static_cast<int>(Status::InvalidInput));
+  EXPECT_NE(refused.reason.find("descriptors: rows of 300 bytes"), std::string::npos) << refused.reason;
+  EXPECT_EQ(refused.keep, std::vector<std::uint8_t>(60, 1));
+}
+
+TEST(CullerContract, PoseThatIsNotRigidOrOutOfRangeIsRefusedAlikeInEveryForm) {
+  const std::pair<const char*, cv::Mat> rotations[] = {
+      {"zero", cv::Mat::zeros(3, 3, CV_64F)},
+      {"doubled", 2 * cv::Mat::eye(3, 3, CV_64F)},
+      {"reflection", (cv::Mat_<double>(3, 3) << 1, 0, 0, 0, 1, 0, 0, 0, -1)},
+      {"shear", (cv::Mat_<double>(3, 3) << 1, 0.5, 0, 0, 1, 0, 0, 0, 1)}};
+  for (const auto& r : rotations) {
+    SCOPED_TRACE(r.first);
+    Frame bad = good_frame();
+    r.second.copyTo(bad.Tcw(cv::Rect(0, 0, 3, 3)));
+    const Outcome o = same_in_every_form({bad});
+    EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
+    EXPECT_NE(o.reason.find("predicted_Tcw's rotation is not a rotation"), std::string::npos) << o.reason;
+    EXPECT_EQ(o.keep, std::vector<std::uint8_t>(60, 1));
+  }
+  Frame far = good_frame();
+  far.Tcw.at<double>(1, 3) = 1e30;  // in float's range: all three forms read it
+  const Outcome o = same_in_every_form({far});
+  EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
+  EXPECT_NE(o.reason.find("out of the range"), std::string::npos) << o.reason;
+  Frame nan = good_frame();
+  nan.Tcw.at<double>(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(same_in_every_form({nan}).status, static_cast<int>(Status::NonFinite));
+}
+
+TEST(CullerContract, DoublePoseBeyondFloatRangeIsOutOfRangeNotNonFinite) {
+  for (const cv::Point at : {cv::Point(3, 0), cv::Point(1, 1)}) {
+    Frame huge = good_frame();
+    huge.Tcw.at<double>(at) = 1e300;
+    const Outcome o = same_in_every_form({huge}, /*plain=*/false);  // a float pose cannot hold 1e300
+    EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput)) << o.reason;
+    EXPECT_NE(o.reason.find("predicted_Tcw has an entry of"), std::string::npos) << o.reason;
+    EXPECT_NE(o.reason.find("out of the range"), std::string::npos) << o.reason;
+    EXPECT_EQ(o.reason.find("NaN"), std::string::npos) << o.reason;
+  }
+}
+
+TEST(CullerContract, AbsurdIntrinsicsAreRefusedInEveryForm) {
+  const cv::Mat tiny_focal = (cv::Mat_<double>(3, 3) << 1e-42, 0, 319.5, 0, 525, 239.5, 0, 0, 1);
+  const cv::Mat far_centre = (cv::Mat_<double>(3, 3) << 525, 0, 1e30, 0, 525, 239.5, 0, 0, 1);
+  for (const auto& k : {std::make_pair("fx", tiny_focal), std::make_pair("cx", far_centre)}) {
+    SCOPED_TRACE(k.first);
+    PlainForm p(k.second);
+    FrameForm f(k.second);
+    CompiledForm c(k.second);
+    EXPECT_FALSE(f.culler_.ok());
+    EXPECT_FALSE(c.culler_.ok());
+    EXPECT_NE(c.culler_.reason().find(std::string("camera_from_K: K: ") + k.first + " = "), std::string::npos)
+        << c.culler_.reason();
+    const Frame in = good_frame();
+    const Outcome a = p.cull(in), b = f.cull(in), d = c.cull(in);
+    for (const Outcome* o : {&a, &b, &d}) {
+      EXPECT_EQ(o->status, static_cast<int>(Status::InvalidInput));
+      EXPECT_NE(o->reason.find(std::string(k.first) + " = "), std::string::npos) << o->reason;
+      EXPECT_EQ(o->keep, std::vector<std::uint8_t>(60, 1));
+    }
+    expect_same(b, d, "FrameCuller vs compiled");
+  }
+}
+
+TEST(CullerContract, EmptyFrameIsAlikeInEveryFormAndLacksNoDescriptors) {
+  Frame empty = good_frame();
+  empty.keys.clear();
+  empty.descriptors = cv::Mat();
+  const Outcome o = same_in_every_form({empty});
+  EXPECT_TRUE(o.keep.empty());
+  EXPECT_EQ(o.reason.find("descriptors"), std::string::npos) << o.reason;
+  const Outcome after = same_in_every_form({empty, good_frame()});
+  EXPECT_EQ(after.keep.size(), 60u);
+}
+
+TEST(CullerContract, MismatchedSizesAndBadStridesAreRefusedAlikeInEveryForm) {
+  Frame rows = good_frame();
+  rows.descriptors = rows.descriptors.rowRange(0, 59).clone();
+  Outcome o = same_in_every_form({rows});
+  EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
+  EXPECT_NE(o.reason.find("descriptors has 59 rows for 60 keypoints"), std::string::npos) << o.reason;
+
+  Frame und = good_frame();
+  und.undistorted.assign(und.keys.begin(), und.keys.begin() + 5);
+  und.has_undistorted = true;
+  o = same_in_every_form({und});
+  EXPECT_NE(o.reason.find("undistorted_keypoints has 5 points for 60 keypoints"), std::string::npos) << o.reason;
+
+  Frame depth = good_frame();
+  depth.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.f));
+  o = same_in_every_form({depth});
+  EXPECT_NE(o.reason.find("depth: 320x240 for an image of 640x480"), std::string::npos) << o.reason;
+
+  Frame stride = good_frame();
+  stride.stride_bytes = 4;  // FrameCuller takes cv::KeyPoint vectors only: no stride to get wrong
+  o = same_in_every_form({stride}, /*plain=*/true, /*frame_form=*/false);
+  EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
+  EXPECT_NE(o.reason.find("keypoints: stride_bytes 4 is below the 8 bytes of an x, y pair"), std::string::npos)
+      << o.reason;
+  EXPECT_EQ(o.keep, std::vector<std::uint8_t>(60, 1));
+}
+
+TEST(CullerContract, RefusedFrameKeepsFramesSinceKeyframeInEveryForm) {
+  // Refused by the plain culler's checks, by the compiled culler's own reading of float pairs, and by
+  // FrameCuller's reading of a cv::Mat: the count goes on in each.
+  Frame rows = good_frame();
+  rows.descriptors = rows.descriptors.rowRange(0, 59).clone();
+  Frame stride = good_frame();
+  stride.stride_bytes = 4;
+  Frame bytes = good_frame();
+  bytes.depth = cv::Mat(480, 640, CV_8UC1, cv::Scalar(2));
+  const struct {
+    const char* what;
+    Frame frame;
+    bool plain, frame_form;
+  } cases[] = {{"descriptor rows", rows, true, true}, {"stride", stride, true, false}, {"8-bit depth", bytes, false, true}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const Outcome o = same_in_every_form({good_frame(), good_frame(), c.frame}, c.plain, c.frame_form);
+    EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput)) << o.reason;
+    EXPECT_EQ(o.frames_since_keyframe, 3);
+  }
+}
+
+TEST(CullerContract, ResetStartsAgainInEveryForm) {
+  FrameForm f(kK);
+  CompiledForm c(kK);
+  for (int k = 0; k < 2; ++k) {
+    f.cull(good_frame());
+    c.cull(good_frame());
+  }
+  f.culler_.reset();
+  c.culler_.reset();
+  const Outcome a = f.cull(good_frame()), b = c.cull(good_frame());
+  expect_same(a, b, "after reset");
+  EXPECT_TRUE(b.keyframe);
+  EXPECT_EQ(b.matched, 0u);
+  EXPECT_EQ(b.track_ids.front(), 0);
+}
+
+TEST(CompiledCullerContract, MovedFromCullerKeepsAllParallelToTheKeys) {
+  CompiledCuller a(kK, kSize);
+  CompiledCuller b(std::move(a));
+  EXPECT_TRUE(b.ok());
+  const Frame in = good_frame();
+  const std::vector<DetectedBox> boxes = boxes_of(in.boxes);
+  // NOLINTNEXTLINE(bugprone-use-after-move): the moved-from state is what is tested
+  const std::vector<std::uint8_t>& keep = a.cull(in.keys, in.descriptors, in.depth, boxes, &in.Tcw);
+  EXPECT_EQ(keep, std::vector<std::uint8_t>(60, 1));
+  EXPECT_EQ(a.result().status, CompiledCuller::Status::InvalidInput);
+  EXPECT_NE(a.result().reason.find("moved from"), std::string::npos) << a.result().reason;
+  EXPECT_EQ(a.result().labels.size(), 60u);
+  std::vector<cv::Point2f> points;
+  cv::KeyPoint::convert(in.keys, points);
+  EXPECT_EQ(a.cull(points, in.descriptors, in.depth, boxes), std::vector<std::uint8_t>(60, 1));
+  EXPECT_EQ(a.cull(&points[0].x, 7, 0, cv::Mat(), in.depth, boxes), std::vector<std::uint8_t>(7, 1));
+  EXPECT_FALSE(a.ok());
+}
+
+TEST(CompiledCullerContract, PresetNameIsQuotedInTheReason) {
+  CompiledCuller::Options options;
+  options.preset = "\x1b[31mred" + std::string(5000, 'k') + std::string(1, '\0') + "after";
+  CompiledCuller culler(kK, kSize, cv::Mat(), options);
+  EXPECT_EQ(culler.status(), CompiledCuller::Status::InvalidInput);
+  const std::string& why = culler.reason();
+  EXPECT_EQ(why.find('\x1b'), std::string::npos) << why;
+  EXPECT_EQ(why.find('\0'), std::string::npos);
+  EXPECT_LT(why.size(), 200u) << why;
+  EXPECT_NE(why.find("'\\x1b[31mred"), std::string::npos) << why;
+  EXPECT_NE(why.find("is not one of"), std::string::npos) << why;  // the text after the name is not cut
+}
+
+}  // namespace
+}  // namespace dyncull
