@@ -182,6 +182,10 @@ TEST(CompiledCuller, EmptyOrBadCalibrationIsNamedAndEveryCullKeepsAll) {
   bad_scale.depth_units_per_metre = 0.f;
   CompiledCuller zero_scale(in.K, cv::Size(640, 480), cv::Mat(), bad_scale);
   EXPECT_NE(zero_scale.reason().find("depth_units_per_metre"), std::string::npos) << zero_scale.reason();
+  // A scale the depth view refuses is refused at construction, not on every frame.
+  bad_scale.depth_units_per_metre = 2e6f;
+  CompiledCuller huge_scale(in.K, cv::Size(640, 480), cv::Mat(), bad_scale);
+  EXPECT_NE(huge_scale.reason().find("depth_units_per_metre"), std::string::npos) << huge_scale.reason();
 }
 
 TEST(CompiledCuller, NonFiniteKeypointIsCulledNamingItsIndexOnEveryOverload) {

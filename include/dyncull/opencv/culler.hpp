@@ -39,9 +39,10 @@ class FrameCuller {
     if (!camera_.ok()) {
       status_ = camera_.status;
       reason_ = camera_.reason;
-    } else if (!(depth_units_per_metre > 0.f && depth_units_per_metre <= 1e9f)) {
+    } else if (!(depth_units_per_metre >= DepthView<std::uint16_t>::kMinUnitsPerMetre &&
+                 depth_units_per_metre <= DepthView<std::uint16_t>::kMaxUnitsPerMetre)) {
       status_ = Status::InvalidInput;
-      reason_ = "depth_units_per_metre must be in (0, 1e9]";
+      reason_ = "depth_units_per_metre must be in [1e-3, 1e6] (metres: 1, millimetres: 1000, TUM: 5000)";
     } else {
       status_ = culler_.status();
       reason_ = culler_.reason();
