@@ -78,6 +78,8 @@ void usage(const char* argv0) {
       "  --tum-trajectories DIR  directory of the fr3_* recordings (default $DYNCULL_DATA_DIR/tum)\n"
       "  --seeds LIST        scene seeds, comma separated (default 1,2,3). Every sequence runs once per seed\n"
       "                      and, with several, a summary gives the median ATE and pooled labels per strategy\n"
+      "                      (with --dataset: the front end's PnP-RANSAC seeds, default one run; with several,\n"
+      "                      ATE and RPE are the median over the runs and the ATE's range is given)\n"
       "  --dataset DIR       run on a real RGB-D sequence in TUM format (rgb.txt, depth.txt, optional\n"
       "                      groundtruth.txt, camera.txt, detections/) instead of the synthetic sequences:\n"
       "                      every frame unless --frames; writes dataset_summary.csv (ATE, RPE over 1 s, lost\n"
@@ -330,6 +332,7 @@ int run_dataset_command(const Args& args, const std::vector<vo::StrategySpec>& c
   o.detections = args.detections;
   o.camera = args.camera;
   o.strategies = chosen;
+  if (args.seeds_set) o.pnp_seeds = args.seeds;
   if (!args.frames_set && !args.quick) ro.max_frames = std::numeric_limits<int>::max();  // the whole sequence
   o.runner = ro;
   vo::DatasetRun run;

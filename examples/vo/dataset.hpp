@@ -44,6 +44,9 @@ struct DatasetOptions {
   eval::SequenceOptions sequence;
   int strip_frames = 4;  ///< annotated frames in the strip (evenly spaced, drawn with the recommended preset)
   LiveDetector* live_detector = nullptr;  ///< when set (and open), boxes come from it instead of files
+  /// PnP-RANSAC seeds of the front end, one run of every strategy each (empty: runner.front_end.seed).
+  /// A single run's ATE moves by centimetres with the seed alone, so rows report the median and range.
+  std::vector<std::uint64_t> pnp_seeds;
 };
 
 /// A TUM-format folder as a frame source of the runner: images loaded with OpenCV, depth scaled by the
@@ -233,6 +236,9 @@ struct DatasetRow {
   double culled_in_person_boxes = std::numeric_limits<double>::quiet_NaN();
   double culled_outside_boxes = std::numeric_limits<double>::quiet_NaN();
   double cull_ms = 0, front_end_ms = 0;  ///< per frame
+  // Over the PnP seeds (DatasetOptions::pnp_seeds): ATE and RPE above are medians, lost_frames the most.
+  std::size_t runs = 1;
+  double ate_min_m = std::numeric_limits<double>::quiet_NaN(), ate_max_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct DatasetRun {
@@ -249,7 +255,8 @@ struct DatasetRun {
 inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
   std::ostringstream o;
   o << "strategy,frames,lost_frames,keyframes,ate_rmse_m,ate_pairs,rpe_trans_m,rpe_rot_deg,rpe_pairs,"
-       "culled_in_person_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end\n";
+       "culled_in_person_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end,runs,ate_min_m,"
+       "ate_max_m\n";
   auto num = [](double v, const char* f) { return std::isfinite(v) ? fmt(v, f) : std::string(); };
   for (const DatasetRow& r : rows) {
     o << r.strategy << "," << r.frames << "," << r.lost_frames << "," << r.keyframes << "," << num(r.ate_rmse_m, "%.6f")
@@ -257,7 +264,8 @@ inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
       << r.rpe_pairs << "," << (r.culls ? num(r.culled_in_person_boxes, "%.4f") : "0") << ","
       << (r.culls ? num(r.culled_outside_boxes, "%.4f") : "0") << "," << num(r.cull_ms, "%.4f") << ","
       << num(r.front_end_ms, "%.3f") << ","
-      << (r.culls && r.front_end_ms > 0 ? num(r.cull_ms / r.front_end_ms, "%.4f") : "") << "\n";
+      << (r.culls && r.front_end_ms > 0 ? num(r.cull_ms / r.front_end_ms, "%.4f") : "") << "," << r.runs << ","
+      << num(r.ate_min_m, "%.6f") << "," << num(r.ate_max_m, "%.6f") << "\n";
   }
   return o.str();
 }
@@ -269,7 +277,8 @@ inline std::string dataset_summary_md(const DatasetRun& run, const std::string& 
        "| culled outside boxes | cull ms/frame | front end ms/frame | cull / front end |\n"
        "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const DatasetRow& r : run.rows) {
-    o << "| " << r.strategy << (r.recommended ? " (default)" : "") << " | " << fmt(100 * r.ate_rmse_m, "%.2f") << " | "
+    const std::string range = r.runs > 1 ? " (" + fmt(100 * r.ate_min_m, "%.2f") + "-" + fmt(100 * r.ate_max_m, "%.2f") + ")" : "";
+    o << "| " << r.strategy << (r.recommended ? " (default)" : "") << " | " << fmt(100 * r.ate_rmse_m, "%.2f") << range << " | "
       << fmt(100 * r.rpe_trans_m, "%.2f") << " | " << fmt(r.rpe_rot_deg, "%.2f") << " | " << r.lost_frames << " of "
       << r.frames << " | " << r.keyframes << " | "
       << (r.culls ? fmt(100 * r.culled_in_person_boxes, "%.1f %%") : "-") << " | "
@@ -280,6 +289,9 @@ inline std::string dataset_summary_md(const DatasetRun& run, const std::string& 
        "--fixed_delta --delta 1 --delta_unit s, RMSE over every pair. Lost frames: PnP failed and the pose came from "
        "the constant-velocity prior. Culled in person boxes / outside boxes: share of the tracked features inside a "
        "person box / outside every box that the strategy culled. Times: wall clock per frame on this machine.\n";
+  if (!run.rows.empty() && run.rows.front().runs > 1)
+    o << "Over " << run.rows.front().runs << " runs with different PnP-RANSAC seeds: ATE and RPE are medians, the ATE's "
+      << "range in brackets; lost frames the most of any run; the other columns from the first run.\n";
   if (run.frames_without_depth > 0) o << "Frames without depth: " << run.frames_without_depth << ".\n";
   for (const std::string& s : run.skipped) o << "Not run: " << s << ".\n";
   o << "\nCommand: `" << command << "` (" << fmt(seconds, "%.0f") << " s)\n";
@@ -298,6 +310,51 @@ inline std::vector<StripFrame> dataset_strip(const SequenceReport& report, const
   }
   return out;
 }
+}  // namespace detail
+
+namespace detail {
+
+/// Runs the strategies again with the other PnP seeds (no files written) and turns the first run's rows
+/// into medians and ranges over all seeds.
+inline bool rerun_with_seeds(const DatasetOptions& options, DatasetSource& source, const std::vector<StrategySpec>& run,
+                             const RunnerOptions& first, const std::string& name, DatasetRun* out, std::string* error) {
+  std::vector<std::vector<double>> ate(out->rows.size()), rpe(out->rows.size());
+  for (std::size_t k = 0; k < out->rows.size(); ++k) {
+    ate[k].push_back(out->rows[k].ate_rmse_m);
+    rpe[k].push_back(out->rows[k].rpe_trans_m);
+  }
+  for (std::size_t i = 1; i < options.pnp_seeds.size(); ++i) {
+    RunnerOptions ro = first;
+    ro.front_end.seed = options.pnp_seeds[i];
+    ro.write_outputs = false;
+    ro.frames_to_draw = 0;
+    SequenceReport report;
+    if (!run_sequence(name, source, run, ro, &report, error)) return false;
+    const bool evaluated = !source.index().groundtruth_path.empty() &&
+                           evaluate_against_file(source.index().groundtruth_path, &report, ro);
+    for (std::size_t k = 0; k < report.runs.size() && k < out->rows.size(); ++k) {
+      const StrategyRun& r = report.runs[k];
+      ate[k].push_back(evaluated && r.has_ate ? r.ate_rmse_m : std::numeric_limits<double>::quiet_NaN());
+      const eval::RpeResult<double> e = evaluated ? eval::evaluate_rpe(report.truth, r.estimate) : eval::RpeResult<double>{};
+      rpe[k].push_back(e.ok() ? e.translation_m.rmse : std::numeric_limits<double>::quiet_NaN());
+      out->rows[k].lost_frames = std::max(out->rows[k].lost_frames, r.fallbacks);
+    }
+  }
+  for (std::size_t k = 0; k < out->rows.size(); ++k) {
+    DatasetRow& row = out->rows[k];
+    row.runs = options.pnp_seeds.size();
+    row.ate_rmse_m = median_of(ate[k]);
+    row.rpe_trans_m = median_of(rpe[k]);
+    std::vector<double> a = ate[k];
+    a.erase(std::remove_if(a.begin(), a.end(), [](double x) { return !std::isfinite(x); }), a.end());
+    if (!a.empty()) {
+      row.ate_min_m = *std::min_element(a.begin(), a.end());
+      row.ate_max_m = *std::max_element(a.begin(), a.end());
+    }
+  }
+  return true;
+}
+
 }  // namespace detail
 
 /// Runs every strategy over the folder (RunnerOptions::max_frames frames at most), evaluates it against
@@ -321,6 +378,7 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
   }
   RunnerOptions ro = options.runner;
   ro.frames_to_draw = options.strip_frames;
+  if (!options.pnp_seeds.empty()) ro.front_end.seed = options.pnp_seeds.front();
   std::string name = std::filesystem::path(options.dir).filename().string();
   if (name.empty()) name = std::filesystem::path(options.dir).parent_path().filename().string();
   if (!run_sequence(name, source, run, ro, &out->report, error)) return false;
@@ -358,6 +416,7 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
     row.front_end_ms = r.front_end_ms_per_frame();
     out->rows.push_back(row);
   }
+  if (options.pnp_seeds.size() > 1 && !detail::rerun_with_seeds(options, source, run, ro, name, out, error)) return false;
   if (!ro.write_outputs) return true;
   const std::string csv = ro.out_dir + "/dataset_summary.csv";
   std::ofstream(csv) << dataset_summary_csv(out->rows);
