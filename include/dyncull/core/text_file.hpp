@@ -60,7 +60,7 @@ struct LineReaderOptions {
 
 /// What LineReader::next() found.
 enum class LineStatus : std::uint8_t {
-  Line = 0,      ///< a line, without its '\n' (a '\r' before it is kept)
+  Line = 0,      ///< a line, without its newline (a carriage return before it is kept)
   TooLong,       ///< a line over max_line_chars: its first max_line_chars bytes; line_chars() has the length
   End,           ///< no more lines
   TooManyLines,  ///< the line after max_lines; error() says so, reading stops
@@ -68,7 +68,7 @@ enum class LineStatus : std::uint8_t {
 };
 
 /// Reads a regular file line by line in memory bounded by max_line_chars plus a 64 KiB buffer,
-/// whatever the file holds. The last line needs no '\n'. Not copyable (it owns the stream).
+/// whatever the file holds. The last line needs no newline. Not copyable (it owns the stream).
 class LineReader {
  public:
   LineReader() = default;

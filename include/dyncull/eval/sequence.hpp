@@ -584,7 +584,7 @@ inline void read_yolo_text(const std::string& path, const SequenceIndex& s, int 
 
 /// Detector boxes per frame of `sequence` from `path`: a folder holding *.json (yolo_json.hpp; matched by
 /// their timestamp within detection_max_difference_s; names starting with '_' are skipped), a folder of
-/// YOLO <image stem>.txt files, or one YOLO text file keyed by rgb stamp or image stem. Boxes pass
+/// YOLO `<image stem>.txt` files, or one YOLO text file keyed by rgb stamp or image stem. Boxes pass
 /// SequenceOptions::detection_filter for a width x height image. A frame without a file has no boxes and
 /// has_file 0 (noted once with the count). Any unreadable or malformed file fails the whole read: culling
 /// with part of a detector's boxes would measure the wrong thing.
