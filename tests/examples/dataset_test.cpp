@@ -34,6 +34,21 @@ fs::path fresh_dir(const std::string& name) {
 
 // A three-frame folder: frame 0 with depth, frame 1 whose depth file is not a PNG, frame 2 without a
 // depth partner within 0.02 s.
+/// The real sequence under DYNCULL_DATA_DIR; false with why the real-data test cannot run.
+bool bonn_crowd_dir(std::string* dir, std::string* why_not) {
+  const char* root = std::getenv("DYNCULL_DATA_DIR");
+  if (root == nullptr || *root == '\0') {
+    *why_not = "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
+    return false;
+  }
+  *dir = std::string(root) + "/bonn/crowd_part1";
+  if (!fs::is_directory(*dir)) {
+    *why_not = *dir + " does not exist: the real-sequence run did not happen";
+    return false;
+  }
+  return true;
+}
+
 fs::path write_small_folder(const std::string& name) {
   const fs::path dir = fresh_dir(name);
   fs::create_directories(dir / "rgb");
@@ -178,11 +193,8 @@ std::map<std::string, std::string> csv_row(const std::string& header, const std:
 // and the box-only zhu_2024 preset: the CSV has the columns and finite, plausible values. Bounds are loose
 // (the camera moves about 0.3 m over these frames): they catch a broken evaluation, not a tuned figure.
 TEST(DatasetRun, BonnCrowdFirstFramesWriteTheSummary) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0')
-    GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
-  const std::string dir = std::string(root) + "/bonn/crowd_part1";
-  if (!fs::is_directory(dir)) GTEST_SKIP() << dir << " does not exist: the real-sequence run did not happen";
+  std::string dir, why_not;
+  if (!bonn_crowd_dir(&dir, &why_not)) GTEST_SKIP() << why_not;
   const fs::path out = fresh_dir("bonn_run");
   vo::DatasetOptions o;
   o.dir = dir;
@@ -238,11 +250,8 @@ TEST(DatasetRun, SeveralPnpSeedsGiveTheMedianAndTheRange) {
   EXPECT_DOUBLE_EQ(vo::detail::median_of({3.0, 1.0, std::numeric_limits<double>::quiet_NaN(), 2.0}), 2.0);
   EXPECT_DOUBLE_EQ(vo::detail::median_of({4.0, 1.0}), 2.5);
   EXPECT_TRUE(std::isnan(vo::detail::median_of({})));
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0')
-    GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
-  const std::string dir = std::string(root) + "/bonn/crowd_part1";
-  if (!fs::is_directory(dir)) GTEST_SKIP() << dir << " does not exist: the real-sequence run did not happen";
+  std::string dir, why_not;
+  if (!bonn_crowd_dir(&dir, &why_not)) GTEST_SKIP() << why_not;
   const fs::path out = fresh_dir("bonn_seeds");
   vo::DatasetOptions o;
   o.dir = dir;
