@@ -145,6 +145,15 @@ class DatasetSource {
     out->bgr.release();
     return true;
   }
+  /// The first frame whose stored boxes hold a person (COCO-80 class 0, any confidence), or -1: none, or
+  /// the boxes come from the live detector and are not known before the run.
+  int first_person_frame() const {
+    if (live_ != nullptr || !has_detections_) return -1;
+    for (std::size_t i = 0; i < detections_.per_frame.size(); ++i)
+      for (const Detection<float>& d : detections_.per_frame[i])
+        if (d.class_id == BoxCullCounts::kPersonClass) return static_cast<int>(i);
+    return -1;
+  }
   void load_colour(SequenceFrame* out) const {
     if (!bgr_.empty()) out->bgr = bgr_;
     else cv::cvtColor(gray_, out->bgr, cv::COLOR_GRAY2BGR);
@@ -236,6 +245,9 @@ struct DatasetRow {
   double culled_in_person_boxes = std::numeric_limits<double>::quiet_NaN();
   double culled_outside_boxes = std::numeric_limits<double>::quiet_NaN();
   double cull_ms = 0, front_end_ms = 0;  ///< per frame
+  /// ATE RMSE over the frames before the first person box: the front end's own error, which culling
+  /// cannot lower (NaN when the sequence opens with a person or has no stored boxes).
+  double ate_before_people_m = std::numeric_limits<double>::quiet_NaN();
   // Over the PnP seeds (DatasetOptions::pnp_seeds): ATE and RPE above are medians, lost_frames the most.
   std::size_t runs = 1;
   double ate_min_m = std::numeric_limits<double>::quiet_NaN(), ate_max_m = std::numeric_limits<double>::quiet_NaN();
@@ -247,6 +259,7 @@ struct DatasetRun {
   std::vector<std::string> notes;    ///< from the reader and the run
   std::vector<std::string> skipped;  ///< strategies that could not run here, with why
   std::size_t frames_without_depth = 0;
+  int first_person_frame = -1;       ///< see DatasetSource::first_person_frame()
   std::string camera_source, detections_path;
   std::vector<std::string> files;    ///< everything written
 };
@@ -256,7 +269,7 @@ inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
   std::ostringstream o;
   o << "strategy,frames,lost_frames,keyframes,ate_rmse_m,ate_pairs,rpe_trans_m,rpe_rot_deg,rpe_pairs,"
        "culled_in_person_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end,runs,ate_min_m,"
-       "ate_max_m\n";
+       "ate_max_m,ate_before_people_m\n";
   auto num = [](double v, const char* f) { return std::isfinite(v) ? fmt(v, f) : std::string(); };
   for (const DatasetRow& r : rows) {
     o << r.strategy << "," << r.frames << "," << r.lost_frames << "," << r.keyframes << "," << num(r.ate_rmse_m, "%.6f")
@@ -265,8 +278,33 @@ inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
       << (r.culls ? num(r.culled_outside_boxes, "%.4f") : "0") << "," << num(r.cull_ms, "%.4f") << ","
       << num(r.front_end_ms, "%.3f") << ","
       << (r.culls && r.front_end_ms > 0 ? num(r.cull_ms / r.front_end_ms, "%.4f") : "") << "," << r.runs << ","
-      << num(r.ate_min_m, "%.6f") << "," << num(r.ate_max_m, "%.6f") << "\n";
+      << num(r.ate_min_m, "%.6f") << "," << num(r.ate_max_m, "%.6f") << "," << num(r.ate_before_people_m, "%.6f")
+      << "\n";
   }
+  return o.str();
+}
+
+/// The front end's noise floor in words: the ATE before the first person (no mover to cull, so every
+/// strategy's error there is the front end's) and the lowest RPE of any strategy.
+inline std::string noise_floor_line(const DatasetRun& run) {
+  double before = std::numeric_limits<double>::infinity(), rpe = before;
+  std::string best;
+  for (const DatasetRow& r : run.rows) {
+    if (std::isfinite(r.ate_before_people_m)) before = std::min(before, r.ate_before_people_m);
+    if (std::isfinite(r.rpe_trans_m) && r.rpe_trans_m < rpe) {
+      rpe = r.rpe_trans_m;
+      best = r.strategy;
+    }
+  }
+  std::ostringstream o;
+  if (run.first_person_frame > 0 && std::isfinite(before))
+    o << "Noise floor of the front end: over frames 0-" << run.first_person_frame - 1
+      << ", before the first person box, the ATE is " << fmt(100 * before, "%.2f")
+      << " cm at best (ATE before people); ";
+  else
+    o << "Noise floor of the front end: no frames before the first person box to measure the ATE on; ";
+  if (!best.empty()) o << "the lowest RPE over 1 s is " << fmt(100 * rpe, "%.2f") << " cm (" << best << ").\n";
+  else o << "no RPE.\n";
   return o.str();
 }
 
@@ -274,8 +312,8 @@ inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
 inline std::string dataset_summary_md(const DatasetRun& run, const std::string& command, double seconds) {
   std::ostringstream o;
   o << "| strategy | ATE RMSE (cm) | RPE 1 s (cm) | RPE 1 s (deg) | lost frames | keyframes | culled in person boxes "
-       "| culled outside boxes | cull ms/frame | front end ms/frame | cull / front end |\n"
-       "|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "| culled outside boxes | cull ms/frame | front end ms/frame | cull / front end | ATE before people (cm) |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const DatasetRow& r : run.rows) {
     const std::string range = r.runs > 1 ? " (" + fmt(100 * r.ate_min_m, "%.2f") + "-" + fmt(100 * r.ate_max_m, "%.2f") + ")" : "";
     o << "| " << r.strategy << (r.recommended ? " (default)" : "") << " | " << fmt(100 * r.ate_rmse_m, "%.2f") << range << " | "
@@ -283,7 +321,8 @@ inline std::string dataset_summary_md(const DatasetRun& run, const std::string& 
       << r.frames << " | " << r.keyframes << " | "
       << (r.culls ? fmt(100 * r.culled_in_person_boxes, "%.1f %%") : "-") << " | "
       << (r.culls ? fmt(100 * r.culled_outside_boxes, "%.1f %%") : "-") << " | " << fmt(r.cull_ms, "%.2f") << " | "
-      << fmt(r.front_end_ms, "%.1f") << " | " << (r.culls ? fmt(r.cull_ms / r.front_end_ms, "%.3f") : "-") << " |\n";
+      << fmt(r.front_end_ms, "%.1f") << " | " << (r.culls ? fmt(r.cull_ms / r.front_end_ms, "%.3f") : "-") << " | "
+      << (std::isfinite(r.ate_before_people_m) ? fmt(100 * r.ate_before_people_m, "%.2f") : "-") << " |\n";
   }
   o << "\nATE: TUM evaluate_ate.py (0.02 s association, rigid SE(3) alignment, RMSE). RPE: evaluate_rpe.py "
        "--fixed_delta --delta 1 --delta_unit s, RMSE over every pair. Lost frames: PnP failed and the pose came from "
@@ -292,6 +331,7 @@ inline std::string dataset_summary_md(const DatasetRun& run, const std::string& 
   if (!run.rows.empty() && run.rows.front().runs > 1)
     o << "Over " << run.rows.front().runs << " runs with different PnP-RANSAC seeds: ATE and RPE are medians, the ATE's "
       << "range in brackets; lost frames the most of any run; the other columns from the first run.\n";
+  o << noise_floor_line(run);
   if (run.frames_without_depth > 0) o << "Frames without depth: " << run.frames_without_depth << ".\n";
   for (const std::string& s : run.skipped) o << "Not run: " << s << ".\n";
   o << "\nCommand: `" << command << "` (" << fmt(seconds, "%.0f") << " s)\n";
@@ -314,15 +354,34 @@ inline std::vector<StripFrame> dataset_strip(const SequenceReport& report, const
 
 namespace detail {
 
+/// ATE RMSE of the estimate's poses stamped before `end_stamp`; NaN when there are none or the
+/// evaluation fails (too few pairs, no motion to align on).
+inline double ate_before(const eval::Trajectory<double>& truth, const eval::Trajectory<double>& estimate,
+                         double end_stamp) {
+  eval::Trajectory<double> head;
+  for (std::size_t i = 0; i < estimate.size() && estimate.stamps[i] < end_stamp; ++i)
+    head.push_back(estimate.stamps[i], estimate.poses[i]);
+  const eval::AteResult<double> ate = eval::evaluate_ate(truth, head);
+  return ate.ok() ? ate.error_m.rmse : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// The timestamp of the first person frame, or NaN without one.
+inline double first_person_stamp(const DatasetSource& source) {
+  const int k = source.first_person_frame();
+  return k > 0 ? source.index().frames[static_cast<std::size_t>(k)].timestamp : std::numeric_limits<double>::quiet_NaN();
+}
+
 /// Runs the strategies again with the other PnP seeds (no files written) and turns the first run's rows
 /// into medians and ranges over all seeds.
 inline bool rerun_with_seeds(const DatasetOptions& options, DatasetSource& source, const std::vector<StrategySpec>& run,
                              const RunnerOptions& first, const std::string& name, DatasetRun* out, std::string* error) {
-  std::vector<std::vector<double>> ate(out->rows.size()), rpe(out->rows.size());
+  std::vector<std::vector<double>> ate(out->rows.size()), rpe(out->rows.size()), before(out->rows.size());
   for (std::size_t k = 0; k < out->rows.size(); ++k) {
     ate[k].push_back(out->rows[k].ate_rmse_m);
     rpe[k].push_back(out->rows[k].rpe_trans_m);
+    before[k].push_back(out->rows[k].ate_before_people_m);
   }
+  const double people_stamp = first_person_stamp(source);
   for (std::size_t i = 1; i < options.pnp_seeds.size(); ++i) {
     RunnerOptions ro = first;
     ro.front_end.seed = options.pnp_seeds[i];
@@ -337,6 +396,8 @@ inline bool rerun_with_seeds(const DatasetOptions& options, DatasetSource& sourc
       ate[k].push_back(evaluated && r.has_ate ? r.ate_rmse_m : std::numeric_limits<double>::quiet_NaN());
       const eval::RpeResult<double> e = evaluated ? eval::evaluate_rpe(report.truth, r.estimate) : eval::RpeResult<double>{};
       rpe[k].push_back(e.ok() ? e.translation_m.rmse : std::numeric_limits<double>::quiet_NaN());
+      before[k].push_back(evaluated && std::isfinite(people_stamp) ? ate_before(report.truth, r.estimate, people_stamp)
+                                                                   : std::numeric_limits<double>::quiet_NaN());
       out->rows[k].lost_frames = std::max(out->rows[k].lost_frames, r.fallbacks);
     }
   }
@@ -345,6 +406,7 @@ inline bool rerun_with_seeds(const DatasetOptions& options, DatasetSource& sourc
     row.runs = options.pnp_seeds.size();
     row.ate_rmse_m = median_of(ate[k]);
     row.rpe_trans_m = median_of(rpe[k]);
+    row.ate_before_people_m = median_of(before[k]);
     std::vector<double> a = ate[k];
     a.erase(std::remove_if(a.begin(), a.end(), [](double x) { return !std::isfinite(x); }), a.end());
     if (!a.empty()) {
@@ -365,6 +427,8 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
   DatasetSource source;
   if (!source.open(options, error)) return false;
   out->camera_source = source.sequence_camera().source;
+  out->first_person_frame = source.first_person_frame();
+  const double people_stamp = detail::first_person_stamp(source);
   out->detections_path = source.has_detections() ? source.detections_path() : std::string();
   std::vector<StrategySpec> run;
   for (const StrategySpec& s : options.strategies) {
@@ -406,6 +470,7 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
         row.rpe_trans_m = rpe.translation_m.rmse;
         row.rpe_rot_deg = rpe.rotation_deg.rmse;
         row.rpe_pairs = rpe.num_pairs;
+        if (std::isfinite(people_stamp)) row.ate_before_people_m = detail::ate_before(out->report.truth, r.estimate, people_stamp);
       } else {
         out->notes.push_back(r.spec.name + ": RPE not computed (" + rpe.reason + ")");
       }

@@ -189,6 +189,43 @@ std::map<std::string, std::string> csv_row(const std::string& header, const std:
   return out;
 }
 
+// The ATE before the first person takes only the poses stamped before it: an estimate exact up to then and
+// off afterwards has a zero ATE there and a non-zero one over the whole run.
+TEST(DatasetSummary, AteBeforePeopleUsesOnlyThePosesBeforeTheFirstPerson) {
+  eval::Trajectory<double> truth, estimate;
+  for (int i = 0; i < 40; ++i) {
+    Rigid3<double> pose = Rigid3<double>::identity();
+    pose.t = Vec3<double>(0.01 * i, 0.002 * i * i / 10.0, 0.0);
+    truth.push_back(i * 0.1, pose);
+    if (i >= 20) pose.t.z() += 0.05 * (i - 19);
+    estimate.push_back(i * 0.1, pose);
+  }
+  EXPECT_NEAR(vo::detail::ate_before(truth, estimate, 2.0), 0.0, 1e-9);
+  const eval::AteResult<double> whole = eval::evaluate_ate(truth, estimate);
+  ASSERT_TRUE(whole.ok()) << whole.reason;
+  EXPECT_GT(whole.error_m.rmse, 0.05);
+  EXPECT_TRUE(std::isnan(vo::detail::ate_before(truth, estimate, -1.0))) << "no poses before the first person";
+
+  vo::DatasetRun run;
+  run.first_person_frame = 20;
+  vo::DatasetRow a, b;
+  a.strategy = "none";
+  a.ate_before_people_m = 0.012;
+  a.rpe_trans_m = 0.05;
+  b.strategy = "culler";
+  b.ate_before_people_m = 0.011;
+  b.rpe_trans_m = 0.03;
+  run.rows = {a, b};
+  EXPECT_EQ(vo::noise_floor_line(run),
+            "Noise floor of the front end: over frames 0-19, before the first person box, the ATE is 1.10 cm at best "
+            "(ATE before people); the lowest RPE over 1 s is 3.00 cm (culler).\n");
+  std::istringstream csv(vo::dataset_summary_csv(run.rows));
+  std::string header, line;
+  std::getline(csv, header);
+  std::getline(csv, line);
+  EXPECT_EQ(csv_row(header, line)["ate_before_people_m"], "0.012000");
+}
+
 // The first 80 frames of Bonn crowd (Palazzolo et al. 2019; a person enters at frame 57) with no culling
 // and the box-only zhu_2024 preset: the CSV has the columns and finite, plausible values. Bounds are loose
 // (the camera moves about 0.3 m over these frames): they catch a broken evaluation, not a tuned figure.
@@ -209,6 +246,11 @@ TEST(DatasetRun, BonnCrowdFirstFramesWriteTheSummary) {
   ASSERT_TRUE(vo::run_dataset(o, &run, &error)) << error;
   EXPECT_EQ(run.camera_source, dir + "/camera.txt");
   EXPECT_EQ(run.detections_path, dir + "/detections");
+  EXPECT_EQ(run.first_person_frame, 57) << "the stored boxes show the first person on frame 57";
+  for (const vo::DatasetRow& r : run.rows) {
+    EXPECT_GT(r.ate_before_people_m, 0.0) << r.strategy;
+    EXPECT_LT(r.ate_before_people_m, 0.05) << r.strategy;
+  }
 
   std::ifstream csv(out / "dataset_summary.csv");
   ASSERT_TRUE(csv.good());
