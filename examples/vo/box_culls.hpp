@@ -1,8 +1,9 @@
 /// @file box_culls.hpp
 /// Where a strategy's culls fall relative to the detector's boxes, for sequences without per-pixel
-/// truth: the share of tracked features culled inside person boxes (what box-based culling is for) and
-/// outside every box (static background lost, unless a geometric check caught a mover the detector
-/// missed). No paper equation.
+/// truth: the share of tracked features culled inside person boxes (what box-based culling is for), inside
+/// the boxes of other classes only (chairs, screens: in an office mostly static, so mostly lost) and outside
+/// every box (static background lost, unless a geometric check caught a mover the detector missed). No
+/// paper equation.
 #pragma once
 
 #include "dyncull/core/box.hpp"
@@ -20,6 +21,7 @@ namespace vo {
 struct BoxCullCounts {
   static constexpr int kPersonClass = 0;  ///< COCO-80 person
   std::size_t in_person = 0, in_person_culled = 0;
+  std::size_t in_other = 0, in_other_culled = 0;  ///< in some box, in no person box
   std::size_t outside = 0, outside_culled = 0;
 
   /// Adds one frame: px the tracked features, keep[i] == 0 culled, boxes the frame's detections.
@@ -36,7 +38,10 @@ struct BoxCullCounts {
       if (person) {
         ++in_person;
         in_person_culled += culled ? 1 : 0;
-      } else if (!any) {
+      } else if (any) {
+        ++in_other;
+        in_other_culled += culled ? 1 : 0;
+      } else {
         ++outside;
         outside_culled += culled ? 1 : 0;
       }
@@ -46,6 +51,7 @@ struct BoxCullCounts {
     return whole ? static_cast<double>(part) / static_cast<double>(whole) : std::numeric_limits<double>::quiet_NaN();
   }
   double culled_in_person_boxes() const { return share(in_person_culled, in_person); }
+  double culled_in_other_boxes() const { return share(in_other_culled, in_other); }
   double culled_outside_boxes() const { return share(outside_culled, outside); }
 };
 

@@ -243,6 +243,7 @@ struct DatasetRow {
   double rpe_rot_deg = std::numeric_limits<double>::quiet_NaN();
   std::size_t rpe_pairs = 0;
   double culled_in_person_boxes = std::numeric_limits<double>::quiet_NaN();
+  double culled_in_other_boxes = std::numeric_limits<double>::quiet_NaN();  ///< boxes of other classes only
   double culled_outside_boxes = std::numeric_limits<double>::quiet_NaN();
   double cull_ms = 0, front_end_ms = 0;  ///< per frame
   /// ATE RMSE over the frames before the first person box: the front end's own error, which culling
@@ -268,13 +269,14 @@ struct DatasetRun {
 inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
   std::ostringstream o;
   o << "strategy,frames,lost_frames,keyframes,ate_rmse_m,ate_pairs,rpe_trans_m,rpe_rot_deg,rpe_pairs,"
-       "culled_in_person_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end,runs,ate_min_m,"
+       "culled_in_person_boxes,culled_in_other_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end,runs,ate_min_m,"
        "ate_max_m,ate_before_people_m\n";
   auto num = [](double v, const char* f) { return std::isfinite(v) ? fmt(v, f) : std::string(); };
   for (const DatasetRow& r : rows) {
     o << r.strategy << "," << r.frames << "," << r.lost_frames << "," << r.keyframes << "," << num(r.ate_rmse_m, "%.6f")
       << "," << r.ate_pairs << "," << num(r.rpe_trans_m, "%.6f") << "," << num(r.rpe_rot_deg, "%.4f") << ","
       << r.rpe_pairs << "," << (r.culls ? num(r.culled_in_person_boxes, "%.4f") : "0") << ","
+      << (r.culls ? num(r.culled_in_other_boxes, "%.4f") : "0") << ","
       << (r.culls ? num(r.culled_outside_boxes, "%.4f") : "0") << "," << num(r.cull_ms, "%.4f") << ","
       << num(r.front_end_ms, "%.3f") << ","
       << (r.culls && r.front_end_ms > 0 ? num(r.cull_ms / r.front_end_ms, "%.4f") : "") << "," << r.runs << ","
@@ -312,22 +314,23 @@ inline std::string noise_floor_line(const DatasetRun& run) {
 inline std::string dataset_summary_md(const DatasetRun& run, const std::string& command, double seconds) {
   std::ostringstream o;
   o << "| strategy | ATE RMSE (cm) | RPE 1 s (cm) | RPE 1 s (deg) | lost frames | keyframes | culled in person boxes "
-       "| culled outside boxes | cull ms/frame | front end ms/frame | cull / front end | ATE before people (cm) |\n"
-       "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "| culled in other boxes | culled outside boxes | cull ms/frame | front end ms/frame | cull / front end | ATE before people (cm) |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const DatasetRow& r : run.rows) {
     const std::string range = r.runs > 1 ? " (" + fmt(100 * r.ate_min_m, "%.2f") + "-" + fmt(100 * r.ate_max_m, "%.2f") + ")" : "";
     o << "| " << r.strategy << (r.recommended ? " (default)" : "") << " | " << fmt(100 * r.ate_rmse_m, "%.2f") << range << " | "
       << fmt(100 * r.rpe_trans_m, "%.2f") << " | " << fmt(r.rpe_rot_deg, "%.2f") << " | " << r.lost_frames << " of "
       << r.frames << " | " << r.keyframes << " | "
       << (r.culls ? fmt(100 * r.culled_in_person_boxes, "%.1f %%") : "-") << " | "
+      << (r.culls ? fmt(100 * r.culled_in_other_boxes, "%.1f %%") : "-") << " | "
       << (r.culls ? fmt(100 * r.culled_outside_boxes, "%.1f %%") : "-") << " | " << fmt(r.cull_ms, "%.2f") << " | "
       << fmt(r.front_end_ms, "%.1f") << " | " << (r.culls ? fmt(r.cull_ms / r.front_end_ms, "%.3f") : "-") << " | "
       << (std::isfinite(r.ate_before_people_m) ? fmt(100 * r.ate_before_people_m, "%.2f") : "-") << " |\n";
   }
   o << "\nATE: TUM evaluate_ate.py (0.02 s association, rigid SE(3) alignment, RMSE). RPE: evaluate_rpe.py "
        "--fixed_delta --delta 1 --delta_unit s, RMSE over every pair. Lost frames: PnP failed and the pose came from "
-       "the constant-velocity prior. Culled in person boxes / outside boxes: share of the tracked features inside a "
-       "person box / outside every box that the strategy culled. Times: wall clock per frame on this machine.\n";
+       "the constant-velocity prior. Culled in person boxes / in other boxes / outside boxes: share of the tracked "
+       "features inside a person box / inside boxes of other classes only / outside every box that the strategy culled. Times: wall clock per frame on this machine.\n";
   if (!run.rows.empty() && run.rows.front().runs > 1)
     o << "Over " << run.rows.front().runs << " runs with different PnP-RANSAC seeds: ATE and RPE are medians, the ATE's "
       << "range in brackets; lost frames the most of any run; the other columns from the first run.\n";
@@ -476,6 +479,7 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
       }
     }
     row.culled_in_person_boxes = r.box_culls.culled_in_person_boxes();
+    row.culled_in_other_boxes = r.box_culls.culled_in_other_boxes();
     row.culled_outside_boxes = r.box_culls.culled_outside_boxes();
     row.cull_ms = r.cull_ms_per_frame();
     row.front_end_ms = r.front_end_ms_per_frame();

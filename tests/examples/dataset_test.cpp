@@ -150,6 +150,7 @@ TEST(DatasetSummary, CsvHasOneRowPerStrategyAndTheNamedColumns) {
   rec.lost_frames = 1;
   rec.ate_rmse_m = 0.01;
   rec.culled_in_person_boxes = 0.5;
+  rec.culled_in_other_boxes = 0.2;
   rec.culled_outside_boxes = 0.01;
   rec.cull_ms = 1.5;
   rec.front_end_ms = 30;
@@ -161,7 +162,27 @@ TEST(DatasetSummary, CsvHasOneRowPerStrategyAndTheNamedColumns) {
   EXPECT_FALSE(std::getline(csv, extra));
   EXPECT_EQ(header.rfind("strategy,frames,lost_frames,", 0), 0u) << header;
   EXPECT_EQ(a.rfind("none,10,0,", 0), 0u) << a;
-  EXPECT_NE(b.find(",0.5000,0.0100,1.5000,30.000,0.0500"), std::string::npos) << b;
+  EXPECT_NE(b.find(",0.5000,0.2000,0.0100,1.5000,30.000,0.0500"), std::string::npos) << b;
+}
+
+// A feature counts in the person box when it is in one, else in the other classes' boxes when it is in
+// one of them, else outside every box.
+TEST(DatasetSummary, CullsAreCountedInPersonBoxesOtherBoxesAndOutside) {
+  Detection<float> person, chair;
+  person.box = {0.f, 0.f, 10.f, 10.f};
+  person.class_id = 0;
+  chair.box = {5.f, 5.f, 20.f, 20.f};
+  chair.class_id = 56;
+  const std::vector<cv::Point2f> px = {{2, 2}, {7, 7}, {15, 15}, {16, 16}, {30, 30}, {31, 31}};
+  const std::vector<std::uint8_t> keep = {0, 1, 0, 1, 1, 0};
+  vo::BoxCullCounts counts;
+  counts.add(px, keep, {person, chair});
+  EXPECT_EQ(counts.in_person, 2u);  // (7,7) is in both: the person's
+  EXPECT_DOUBLE_EQ(counts.culled_in_person_boxes(), 0.5);
+  EXPECT_EQ(counts.in_other, 2u);
+  EXPECT_DOUBLE_EQ(counts.culled_in_other_boxes(), 0.5);
+  EXPECT_EQ(counts.outside, 2u);
+  EXPECT_DOUBLE_EQ(counts.culled_outside_boxes(), 0.5);
 }
 
 // The family summary and the trajectory plot colour strategies by their index: every default strategy
