@@ -1,11 +1,14 @@
 // Writes a synthetic dynamic RGB-D sequence (dyncull::sim::Scene) in TUM RGB-D format, so any SLAM
 // system can run on it: rgb/*.png, depth/*.png (16-bit, 5000 per metre), rgb.txt, depth.txt,
-// associations.txt, groundtruth.txt (timestamp tx ty tz qx qy qz qw of world_from_cam), camera.txt,
-// detections/*.txt (YOLO style "class cx cy w h conf", normalised) indexed by detections.txt, and
-// the truth masks instance/*.png (16-bit ids) and moving/*.png (255 = moving surface).
+// associations.txt, groundtruth.txt (timestamp tx ty tz qx qy qz qw of world_from_cam), camera.txt
+// ("key value" lines: fx fy cx cy width height depth_units_per_metre, as dynamic_vo --dataset reads it),
+// detections/*.txt (YOLO style "class cx cy w h conf", normalised; one per rgb image, same stem) indexed
+// by detections.txt, and the truth masks instance/*.png (16-bit ids) and moving/*.png (255 = moving
+// surface).
 //
-// Usage: write_tum_sequence OUTDIR [--motion static|xyz|rpy|halfsphere] [--frames N] [--seed S]
-//                                  [--clean-depth]
+// Usage: write_tum_sequence OUTDIR [--family NAME] [--motion static|xyz|rpy|halfsphere] [--frames N]
+//                                  [--seed S] [--clean-depth]
+#include "dyncull/sim/families.hpp"
 #include "dyncull/sim/scene.hpp"
 
 #include <opencv2/core.hpp>
@@ -27,8 +30,10 @@ namespace {
 
 int usage(const char* why) {
   std::cerr << "write_tum_sequence: " << why << "\n"
-            << "usage: write_tum_sequence OUTDIR [--motion static|xyz|rpy|halfsphere] [--frames N] [--seed S] "
-               "[--clean-depth]\n";
+            << "usage: write_tum_sequence OUTDIR [--family NAME] [--motion static|xyz|rpy|halfsphere] [--frames N] "
+               "[--seed S] [--clean-depth]\n"
+            << "families (default walking):\n"
+            << dyncull::sim::format_scene_families();
   return 2;
 }
 
@@ -65,11 +70,21 @@ int main(int argc, char** argv) {
   if (argc < 2) return usage("missing OUTDIR");
   const fs::path out = argv[1];
   SceneOptions options;
+  std::string family = "walking";
+  // The family sets the scene; motion, frames and seed given in any order apply on top of it.
+  for (int k = 2; k + 1 < argc; ++k)
+    if (std::string(argv[k]) == "--family") family = argv[k + 1];
+  SceneFamily chosen;
+  std::string why;
+  if (!find_scene_family(family, &chosen, &why)) return usage(why.c_str());
+  options = chosen.options;
   for (int k = 2; k < argc; ++k) {
     const std::string arg = argv[k];
     const bool has_value = k + 1 < argc;
     long long value = 0;
-    if (arg == "--motion" && has_value) {
+    if (arg == "--family" && has_value) {
+      ++k;  // read above
+    } else if (arg == "--motion" && has_value) {
       if (!parse_motion(argv[++k], &options.motion)) return usage("unknown motion");
     } else if (arg == "--frames" && has_value) {
       if (!parse_int(argv[++k], 1, 1000000, &value)) return usage("--frames needs a positive integer");
@@ -100,16 +115,16 @@ int main(int argc, char** argv) {
     std::cerr << "write_tum_sequence: cannot write the index files in " << out << "\n";
     return 1;
   }
-  const std::string name = std::string("dyncull synthetic ") + to_string(options.motion) + " seed " +
+  const std::string name = "dyncull synthetic " + family + " " + to_string(options.motion) + " seed " +
                            std::to_string(options.seed);
   rgb_txt << "# color images\n# file: '" << name << "'\n# timestamp filename\n";
   depth_txt << "# depth maps\n# file: '" << name << "'\n# timestamp filename\n";
   gt_txt << "# ground truth trajectory\n# file: '" << name << "'\n# timestamp tx ty tz qx qy qz qw\n";
   det_txt << "# detections (YOLO style: class cx cy w h conf, normalised to the image size)\n# timestamp filename\n";
   const auto cam = scene.camera();
-  cam_txt << "# pinhole camera, no distortion; depth PNG scale 5000 per metre\n# fx fy cx cy width height\n"
-          << std::setprecision(10) << cam.fx << ' ' << cam.fy << ' ' << cam.cx << ' ' << cam.cy << ' ' << cam.width
-          << ' ' << cam.height << '\n';
+  cam_txt << "# pinhole camera, no distortion (" << name << ")\n" << std::setprecision(10) << "fx " << cam.fx
+          << "\nfy " << cam.fy << "\ncx " << cam.cx << "\ncy " << cam.cy << "\nwidth " << cam.width << "\nheight "
+          << cam.height << "\ndepth_units_per_metre 5000\n";
 
   FrameData f;
   cv::Mat bgr, depth16(options.height, options.width, CV_16UC1), moving8(options.height, options.width, CV_8UC1);
