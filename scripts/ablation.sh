@@ -35,9 +35,9 @@ mkdir -p "$out"
 if [[ -z "$table_only" ]]; then
   build="${DYNCULL_DEMO_BUILD:-$root/build/demo}"
   cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_BUILD_TESTS=OFF \
-    -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=ON >/dev/null
+    -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=ON >/dev/null
   cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dynamic_vo
-  vo="$build/examples/dynamic_vo"
+  vo="$build/apps/dynamic_vo"
   ablations=$("$vo" --list | awk '$1 ~ /^recommended-no_/ { print $1 }' | paste -sd, -)
   if [[ -n "$dataset" ]]; then
     "$vo" --dataset "$dataset" --strategies "none,recommended,$ablations" --out "$out" ${pass[@]+"${pass[@]}"}

@@ -43,7 +43,7 @@ commit="$(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet HE
 cores=$(getconf _NPROCESSORS_ONLN)
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_WERROR=ON -DDYNCULL_BUILD_BENCHMARKS=ON \
-  -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_BUILD_DOCS=OFF >/dev/null
+  -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_BUILD_DOCS=OFF >/dev/null
 mapfile -t targets < <(cmake --build "$build" --target help | awk '$2 ~ /^bench_/ { print $2 }' | grep -E -- "$only" | sort)
 ((${#targets[@]})) || { echo "benchmarks.sh: no bench target matches '$only'" >&2; exit 1; }
 # One core per compile: an -O3 instantiation of the pipeline takes about 1.5 GB.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the examples (Release) and runs the main demo: dynamic_vo on the synthetic dynamic RGB-D
+# Builds dynamic_vo (apps/, Release) and runs the main demo: dynamic_vo on the synthetic dynamic RGB-D
 # sequences, every culling preset against no culling. Without arguments it runs the scene-family suite
 # (dynamic_vo --suite: every family x static,xyz,rpy,halfsphere x seeds 1,2,3, 150 frames each, on
 # DYNCULL_JOBS threads, default all cores) and prints one summary table, a row per family; it also writes
@@ -10,9 +10,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="${DYNCULL_DEMO_BUILD:-$root/build/demo}"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_BUILD_TESTS=OFF \
-  -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=ON >/dev/null
+  -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=ON >/dev/null
 cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dynamic_vo
 if (($# == 0)); then
   set -- --suite --jobs "${DYNCULL_JOBS:-$(nproc)}"
 fi
-exec "$build/examples/dynamic_vo" "$@"
+exec "$build/apps/dynamic_vo" "$@"

@@ -20,7 +20,7 @@ if [[ -z "$cxx" ]]; then
 fi
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="" -DCMAKE_CXX_COMPILER="$cxx" \
   -DDYNCULL_WERROR=ON -DDYNCULL_BUILD_FUZZERS=ON -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_BENCHMARKS=OFF \
-  -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=ON -DDYNCULL_WITH_CERES=OFF >/dev/null
+  -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=ON -DDYNCULL_WITH_CERES=OFF >/dev/null
 
 # Every target this configuration builds (the culler target needs OpenCV: fuzz.sh says when it is left out).
 targets=${DYNCULL_FUZZ_TARGETS:-$(cat "$build/tests/fuzz/targets.txt")}

@@ -48,7 +48,7 @@ run_recorded() {
   {
     echo "machine: $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores"
     echo "compiler: $("${compiler:-c++}" --version | head -1), CMAKE_BUILD_TYPE=Release"
-    echo "commit: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet HEAD -- include examples || echo ' (with local changes)')"
+    echo "commit: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet HEAD -- include apps || echo ' (with local changes)')"
     echo "command: $shown"
     echo "wall time: $((end - start)) s"
   } >"$dir/run_info.txt"
@@ -91,7 +91,7 @@ else
 fi
 
 # What the families and the ablation rows are, as the binary that ran them describes them.
-vo="${DYNCULL_DEMO_BUILD:-$root/build/demo}/examples/dynamic_vo"
+vo="${DYNCULL_DEMO_BUILD:-$root/build/demo}/apps/dynamic_vo"
 if [[ -x "$vo" && -z "$real_only" ]]; then
   "$vo" --help | awk '/^scene families/ { on = 1; next } on && /^$/ { on = 0 } on' >"$suite/families.txt"
   "$vo" --list | awk '$1 ~ /^recommended-no_/' | sed 's/ *(ablation).*//' >"$ablation/strategies.txt"

@@ -336,7 +336,7 @@ def suite_sections(suite, ablation):
         "`dynamic_vo --help` lists them with their `--scene` text.\n"
     return f"""## What runs
 
-`examples/dynamic_vo` renders each sequence in memory (`dyncull::sim::Scene`: 640x480 at 30 fps,
+`apps/dynamic_vo` renders each sequence in memory (`dyncull::sim::Scene`: 640x480 at 30 fps,
 Kinect-like depth noise and holes, detections from a simulated detector) and tracks it with an RGB-D front
 end: ORB corners tracked by pyramidal Lucas-Kanade, PnP-RANSAC against the keyframe's depth, Huber
 Levenberg-Marquardt refinement and a constant-velocity fallback. Every strategy culls the same frames

@@ -27,7 +27,7 @@ case "$mode" in
     # for symbolised sanitizer reports and costs a third less than -g; -O0 made the sim tests 5x slower.
     cxx=$(command -v clang++ || command -v g++)
     cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug -DDYNCULL_WERROR=ON -DCMAKE_CXX_COMPILER="$cxx" \
-      -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_CHECK_HEADERS=OFF \
+      -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_CHECK_HEADERS=OFF \
       -DCMAKE_CXX_FLAGS_DEBUG="" \
       -DCMAKE_CXX_FLAGS="-O1 -g1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
       -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \

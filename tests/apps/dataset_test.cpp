@@ -1,11 +1,11 @@
-// dynamic_vo --dataset (examples/vo/dataset.hpp): the frame source over a TUM-format folder (frames without
+// dynamic_vo --dataset (apps/vo/dataset.hpp): the frame source over a TUM-format folder (frames without
 // depth run with an empty depth map, never a crash), the summary CSV, and a run on the first 80 frames of
 // the real Bonn crowd sequence (through DYNCULL_DATA_DIR; skipped loudly without it).
 #include <gtest/gtest.h>
 
 #ifdef DYNCULL_HAS_OPENCV
 
-#include "../../examples/vo/dataset.hpp"
+#include "../../apps/vo/dataset.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 

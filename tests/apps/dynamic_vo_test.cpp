@@ -1,11 +1,11 @@
-// Smoke and unit tests of the dynamic_vo demo's pieces (examples/vo/*.hpp): the VO with and without
+// Smoke and unit tests of the dynamic_vo demo's pieces (apps/vo/*.hpp): the VO with and without
 // culling on a short synthetic walking sequence, the label counting, and the TUM directory reader.
 #include <gtest/gtest.h>
 
 #ifdef DYNCULL_HAS_OPENCV
 
-#include "../../examples/vo/ablation.hpp"
-#include "../../examples/vo/runner.hpp"
+#include "../../apps/vo/ablation.hpp"
+#include "../../apps/vo/runner.hpp"
 #include "dyncull/sim/families.hpp"
 
 #include <opencv2/imgcodecs.hpp>
