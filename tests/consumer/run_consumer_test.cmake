@@ -81,3 +81,26 @@ execute_process(COMMAND "${SCRATCH_DIR}/build_subdir/consumer" RESULT_VARIABLE r
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the add_subdirectory consumer ran but returned ${rc}")
 endif()
+
+# examples/ on its own against the install, as a user copies it: the README's front end and the monocular
+# one configure, build and run with find_package(dyncull) alone.
+if(EXPECT_CULLER)
+  execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}/../../examples" -B "${SCRATCH_DIR}/build_examples"
+                          -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+                          -DCMAKE_BUILD_TYPE=Release
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "configuring examples/ against the installed package failed (${rc})")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_examples" --target front_end monocular
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "building examples/ against the installed package failed (${rc})")
+  endif()
+  foreach(example front_end monocular)
+    execute_process(COMMAND "${SCRATCH_DIR}/build_examples/${example}" RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "examples/${example}, built against the install, returned ${rc}")
+    endif()
+  endforeach()
+endif()
