@@ -259,7 +259,8 @@ PnP failed and the pose came from the constant-velocity prior. Culled in person 
 outside boxes: the share of the tracked features inside a person box / inside boxes of other classes only /
 outside every box that the strategy culled (no per-pixel truth here: a cull outside every box is static
 background lost, unless a geometric check caught a mover the detector missed). ATE before people: over the
-frames before the first person box. Times: wall clock per frame on the machine above.
+frames before the first person box. Times: wall clock per frame on the machine above; the ORB descriptors
+the culler needs at the front end's tracks count as front-end time, since an ORB-based host has them.
 
 Each strategy runs three times with different PnP-RANSAC seeds of the front end; the ATE and RPE columns
 are the medians, with the ATE's range over the three runs in brackets. One run ranks strategies only where

@@ -21,6 +21,7 @@
 #include <opencv2/features2d.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -178,6 +179,9 @@ class Culler {
   const std::vector<KeptWhy>& kept_why() const { return kept_why_; }
   /// The stateful culler's result of the last cull() (null unless StrategySpec::through_culler).
   const CullerResult* culler_result() const { return frame_culler_ ? &frame_culler_->result() : nullptr; }
+  /// Milliseconds the last cull() spent computing ORB descriptors at the tracks (through_culler only): a
+  /// host with ORB features has them already, so they are front-end time, not culling time.
+  double descriptor_ms() const { return descriptor_ms_; }
   /// Tracks of the last cull() that ORB gave no descriptor (kept without asking the culler).
   std::size_t without_descriptor() const { return without_descriptor_; }
 
@@ -199,7 +203,9 @@ class Culler {
     for (std::size_t i = 0; i < n; ++i)
       keys_[i] = cv::KeyPoint(tracks.cur_px[i], 31.f, -1.f, 0.f, 0, static_cast<int>(i));
     descriptors_.release();
+    const auto t0 = std::chrono::steady_clock::now();
     if (n > 0) orb_->compute(frame.gray, keys_, descriptors_);
+    descriptor_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     // ORB drops keypoints and keeps the rest in order; class_id says which track each one is.
     without_descriptor_ = n - keys_.size();
     const cv::Matx44d Tcw = to_matx(predicted_world_from_cam.inverse());
@@ -280,6 +286,7 @@ class Culler {
   // StrategySpec::through_culler.
   std::unique_ptr<cv_adapter::FrameCuller> frame_culler_;
   cv::Ptr<cv::ORB> orb_;
+  double descriptor_ms_ = 0;
   std::vector<cv::KeyPoint> keys_;
   cv::Mat descriptors_;
   std::size_t without_descriptor_ = 0;
