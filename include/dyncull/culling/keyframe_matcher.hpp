@@ -20,6 +20,7 @@
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
+#include "dyncull/geometry/point_grid.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -133,8 +134,7 @@ struct KeyframeMatchWorkspace {
   std::vector<T> cur_x, cur_y;                 // current keypoints (NaN marks a non-finite one)
   std::vector<T> pred_x, pred_y;               // keyframe points' predictions (NaN: not searched)
   std::vector<std::uint8_t> pred_depth;        // 1: predicted through depth (radius_px)
-  std::vector<std::uint32_t> cell_start;       // grid: cell c holds sorted positions [cell_start[c], cell_start[c+1])
-  std::vector<std::uint32_t> cell_of;          // grid cell of each current keypoint (kNone: not in the grid)
+  PointGrid<T> grid;                           // the current keypoints' grid (geometry/point_grid.hpp)
   std::vector<T> sorted_x, sorted_y;           // finite current keypoints in cell order
   std::vector<std::uint32_t> sorted_index;     // sorted position -> current keypoint index
   std::vector<std::uint8_t> sorted_desc;       // their descriptor rows, row_bytes apart
@@ -361,6 +361,205 @@ void kfm_fill(std::vector<V>& v, std::size_t n, const V& value) {
   for (auto& x : v) x = value;
 }
 
+/// Every current keypoint unmatched and every count zero: the result before any work (and of a refusal).
+template <class T>
+void kfm_reset(std::size_t n, KeyframeMatchResult<T>* out) {
+  KeyframeMatchResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.matched = r.predicted_by_depth = r.predicted_without_depth = r.behind_camera = 0;
+  r.keyframe_nonfinite = r.current_nonfinite = 0;
+  r.examined = r.searches_capped = 0;
+  r.used_pose = false;
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  kfm_fill(r.keyframe_index, n, -1);
+  kfm_fill(r.keyframe_pixel, n, Vec2<T>(nan, nan));
+  kfm_fill(r.distance, n, -1);
+}
+
+/// The input contract of match_to_keyframe(); false with the status set and the reason naming the input.
+template <class T>
+bool kfm_inputs_ok(std::size_t n_kf, std::size_t n_kf_points, DescriptorRows kf_desc, std::size_t n,
+                   DescriptorRows cur_desc, const PinholeCamera<T>& camera, const Rigid3<T>* cam_from_keyframe,
+                   const KeyframeMatchOptions& options, KeyframeMatchResult<T>* r) {
+  auto fail = [&](Status s, const std::string& why) {
+    r->status = s;
+    r->reason = "match_to_keyframe: " + why;
+    return false;
+  };
+  std::string why;
+  if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, why);
+  if (!camera.valid()) return fail(Status::InvalidInput, "camera needs finite, positive focal lengths, a finite "
+                                                         "principal point and a positive image size");
+  if (n_kf_points != 0 && n_kf_points != n_kf)
+    return fail(Status::InvalidInput, "kf_points has " + std::to_string(n_kf_points) + " points for " +
+                                          std::to_string(n_kf) + " keyframe keypoints (give one per keypoint, or none)");
+  if (!kfm_rows_ok(kf_desc, n_kf, "kf_desc", &why)) return fail(Status::InvalidInput, why);
+  if (!kfm_rows_ok(cur_desc, n, "cur_desc", &why)) return fail(Status::InvalidInput, why);
+  if (kf_desc.row_bytes != cur_desc.row_bytes)
+    return fail(Status::InvalidInput, "kf_desc rows have " + std::to_string(kf_desc.row_bytes) +
+                                          " bytes, cur_desc rows " + std::to_string(cur_desc.row_bytes));
+  if (static_cast<std::size_t>(options.max_hamming) > 8 * kf_desc.row_bytes)
+    return fail(Status::InvalidInput, "KeyframeMatchOptions: max_hamming " + std::to_string(options.max_hamming) +
+                                          " exceeds the descriptor's " + std::to_string(8 * kf_desc.row_bytes) +
+                                          " bits");
+  if (n > std::numeric_limits<std::uint32_t>::max() - 1 ||
+      n_kf > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    return fail(Status::InvalidInput, "more keypoints than the matcher indexes (2^31)");
+  if (cam_from_keyframe != nullptr && !cam_from_keyframe->all_finite())
+    return fail(Status::NonFinite, "cam_from_keyframe has a NaN or Inf entry");
+  if (n_kf == 0) return fail(Status::TooFewPoints, "the keyframe has no keypoints");
+  if (n == 0) return fail(Status::TooFewPoints, "the current frame has no keypoints");
+  return true;
+}
+
+/// Reads the current keypoints once (NaN marks a non-finite one) and sorts them by grid cell, so that
+/// positions, indices and descriptor rows are contiguous per cell and a search reads one run of memory
+/// per grid row. The grid spans the keypoints' own extent, not the camera's image size (which may be
+/// bogus): keypoints off the image are still found.
+template <class T, class CurKeypoints>
+void kfm_sort_current(const CurKeypoints& cur_keypoints, DescriptorRows cur_desc, const KeyframeMatchOptions& options,
+                      KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* r) {
+  const std::size_t n = cur_keypoints.size();
+  ws.cur_x.resize(n);
+  ws.cur_y.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const T x = point_x<T>(cur_keypoints[i]), y = point_y<T>(cur_keypoints[i]);
+    const bool finite = std::isfinite(x) && std::isfinite(y);
+    ws.cur_x[i] = finite ? x : std::numeric_limits<T>::quiet_NaN();
+    ws.cur_y[i] = finite ? y : std::numeric_limits<T>::quiet_NaN();
+    r->current_nonfinite += finite ? 0 : 1;
+  }
+  constexpr int kMaxCellsPerSide = 256;
+  size_point_grid(ws.cur_x.data(), ws.cur_y.data(), n, options.grid_cell_px, kMaxCellsPerSide, &ws.grid);
+  const std::size_t n_sorted = n - r->current_nonfinite;
+  const std::size_t row_bytes = cur_desc.row_bytes;
+  ws.sorted_x.resize(n_sorted);
+  ws.sorted_y.resize(n_sorted);
+  ws.sorted_index.resize(n_sorted);
+  ws.sorted_desc.resize(n_sorted * row_bytes);
+  sort_by_cell(&ws.grid, [&](std::size_t i, std::uint32_t pos) {
+    ws.sorted_x[pos] = ws.cur_x[i];
+    ws.sorted_y[pos] = ws.cur_y[i];
+    ws.sorted_index[pos] = static_cast<std::uint32_t>(i);
+    std::memcpy(ws.sorted_desc.data() + std::size_t(pos) * row_bytes, cur_desc.row(i), row_bytes);
+  });
+}
+
+/// Where keyframe point k is searched: through its depth and the pose (1 in pred_depth), along its ray
+/// rotated by the pose's infinite homography K R K^-1 without depth, or at its own pixel without a pose;
+/// NaN when it is not searched (non-finite, or the pose puts it behind the camera).
+template <class T, class KfKeypoints, class KfPoints>
+void kfm_predict(const KfKeypoints& kf_keypoints, const KfPoints& kf_points, const PinholeCamera<T>& camera,
+                 const Rigid3<T>* cam_from_keyframe, KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* out) {
+  KeyframeMatchResult<T>& r = *out;
+  const std::size_t n_kf = kf_keypoints.size();
+  const T nan = std::numeric_limits<T>::quiet_NaN();
+  ws.pred_x.resize(n_kf);
+  ws.pred_y.resize(n_kf);
+  ws.pred_depth.resize(n_kf);
+  const bool have_depth = kf_points.size() == n_kf;
+  const bool have_pose = cam_from_keyframe != nullptr;
+  r.used_pose = have_pose;
+  Mat3<T> H = Mat3<T>::Identity();
+  if (have_pose) H = camera.K() * cam_from_keyframe->R * camera.K().inverse();
+  for (std::size_t k = 0; k < n_kf; ++k) {
+    const T u = point_x<T>(kf_keypoints[k]), v = point_y<T>(kf_keypoints[k]);
+    ws.pred_x[k] = ws.pred_y[k] = nan;
+    ws.pred_depth[k] = 0;
+    if (!std::isfinite(u) || !std::isfinite(v)) {
+      ++r.keyframe_nonfinite;
+      continue;
+    }
+    Vec3<T> X(nan, nan, nan);
+    if (have_pose && have_depth) X = Vec3<T>(point_x<T>(kf_points[k]), point_y<T>(kf_points[k]), point_z<T>(kf_points[k]));
+    Vec2<T> p(u, v);  // without a pose: the same pixel
+    if (have_pose && X.allFinite() && X.z() > T(0)) {
+      const Vec3<T> Xc = cam_from_keyframe->apply(X);
+      if (Xc.z() > T(0)) p = camera.project(Xc);  // a point at z ~ 0 projects to Inf: not searched below
+      else p = Vec2<T>(nan, nan);
+      ws.pred_depth[k] = 1;
+    } else if (have_pose) {
+      const Vec3<T> h = H * Vec3<T>(u, v, T(1));
+      p = h.z() > T(0) ? Vec2<T>(h.x() / h.z(), h.y() / h.z()) : Vec2<T>(nan, nan);  // turned over 90 degrees
+    }
+    if (!p.allFinite()) {
+      ws.pred_depth[k] = 0;
+      ++r.behind_camera;
+      continue;
+    }
+    ws.pred_x[k] = p.x();
+    ws.pred_y[k] = p.y();
+    ++(ws.pred_depth[k] ? r.predicted_by_depth : r.predicted_without_depth);
+  }
+}
+
+/// The radius search of every predicted keyframe point over the sorted current keypoints (kfm_scan):
+/// the nearest and second-nearest distance per keyframe point, the nearest keyframe point per keypoint.
+template <class T>
+void kfm_search(DescriptorRows kf_desc, std::size_t row_bytes, const KeyframeMatchOptions& options,
+                KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* r) {
+  const std::size_t n_kf = ws.pred_x.size(), n_sorted = ws.sorted_index.size();
+  kfm_fill(ws.kf_best_cur, n_kf, -1);
+  kfm_fill(ws.kf_second_dist, n_kf, std::numeric_limits<int>::max());
+  kfm_fill(ws.kf_best_dist, n_kf, -1);
+  kfm_fill(ws.cur_best_kf, n_sorted, -1);
+  kfm_fill(ws.cur_best_dist, n_sorted, std::numeric_limits<int>::max());
+  KfmScan<T> s;
+  s.pred_x = ws.pred_x.data();
+  s.pred_y = ws.pred_y.data();
+  s.pred_depth = ws.pred_depth.data();
+  s.n_kf = n_kf;
+  s.cur_x = ws.sorted_x.data();
+  s.cur_y = ws.sorted_y.data();
+  s.cur_index = ws.sorted_index.data();
+  s.kf_desc = kf_desc;
+  s.cur_desc = ws.sorted_desc.data();
+  s.row_bytes = row_bytes;
+  s.r_depth = static_cast<T>(options.radius_px);
+  s.r_free = static_cast<T>(options.radius_unpredicted_px);
+  s.r2_depth = s.r_depth * s.r_depth;
+  s.r2_free = s.r_free * s.r_free;
+  s.grid_x0 = ws.grid.x0;
+  s.grid_y0 = ws.grid.y0;
+  s.cell = ws.grid.cell;
+  s.cols = ws.grid.cols;
+  s.rows = ws.grid.rows;
+  s.cell_start = ws.grid.cell_start.data();
+  s.kf_best_cur = ws.kf_best_cur.data();
+  s.kf_best_dist = ws.kf_best_dist.data();
+  s.kf_second_dist = ws.kf_second_dist.data();
+  s.cur_best_kf = ws.cur_best_kf.data();
+  s.cur_best_dist = ws.cur_best_dist.data();
+  s.max_candidates = static_cast<std::uint32_t>(options.max_candidates);  // at most 2^20 (validate)
+  const KfmWork work = kfm_scan(s);
+  r->examined = work.examined;
+  r->searches_capped = work.capped;
+}
+
+/// Accepts a keyframe point's nearest keypoint on distance and ratio (Lowe's test against its second
+/// nearest) and, with mutual_check, only when the keypoint's nearest is that point; a keypoint claimed by
+/// several keyframe points keeps the closest (the earliest on a tie).
+template <class T, class KfKeypoints>
+void kfm_accept(const KfKeypoints& kf_keypoints, const KeyframeMatchOptions& options,
+                const KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* out) {
+  KeyframeMatchResult<T>& r = *out;
+  for (std::size_t k = 0; k < ws.kf_best_cur.size(); ++k) {
+    const int c = ws.kf_best_cur[k];
+    if (c < 0) continue;
+    const int d = ws.kf_best_dist[k], second = ws.kf_second_dist[k];
+    if (d > options.max_hamming) continue;
+    if (second != std::numeric_limits<int>::max() && !(double(d) <= options.ratio * double(second))) continue;
+    if (options.mutual_check && ws.cur_best_kf[static_cast<std::size_t>(c)] != static_cast<int>(k)) continue;
+    const std::size_t ci = ws.sorted_index[static_cast<std::size_t>(c)];
+    if (r.keyframe_index[ci] >= 0 && r.distance[ci] <= d) continue;
+    if (r.keyframe_index[ci] < 0) ++r.matched;
+    r.keyframe_index[ci] = static_cast<int>(k);
+    r.distance[ci] = d;
+    r.keyframe_pixel[ci] = Vec2<T>(point_x<T>(kf_keypoints[k]), point_y<T>(kf_keypoints[k]));
+  }
+}
+
 }  // namespace detail
 
 /// Matches the current keypoints to the keyframe's (see the file comment). Inputs:
@@ -390,238 +589,14 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
   static_assert(is_point_container_v<KfPoints> && PointTraits<container_point_t<KfPoints>>::dim == 3,
                 "dyncull::match_to_keyframe: kf_points must be a container of 3-D points");
   KeyframeMatchResult<T>& r = *out;
-  const std::size_t n = cur_keypoints.size();
-  const std::size_t n_kf = kf_keypoints.size();
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.matched = r.predicted_by_depth = r.predicted_without_depth = r.behind_camera = 0;
-  r.keyframe_nonfinite = r.current_nonfinite = 0;
-  r.examined = r.searches_capped = 0;
-  r.used_pose = false;
-  const T nan = std::numeric_limits<T>::quiet_NaN();
-  detail::kfm_fill(r.keyframe_index, n, -1);
-  detail::kfm_fill(r.keyframe_pixel, n, Vec2<T>(nan, nan));
-  detail::kfm_fill(r.distance, n, -1);
-
-  auto fail = [&](Status s, std::string why) {
-    r.status = s;
-    r.reason = "match_to_keyframe: " + why;
-  };
-  std::string why;
-  if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, why);
-  if (!camera.valid()) return fail(Status::InvalidInput, "camera needs finite, positive focal lengths, a finite "
-                                                         "principal point and a positive image size");
-  if (kf_points.size() != 0 && kf_points.size() != n_kf)
-    return fail(Status::InvalidInput, "kf_points has " + std::to_string(kf_points.size()) + " points for " +
-                                          std::to_string(n_kf) +
-                                          " keyframe keypoints (give one per keypoint, or none)");
-  if (!detail::kfm_rows_ok(kf_desc, n_kf, "kf_desc", &why)) return fail(Status::InvalidInput, why);
-  if (!detail::kfm_rows_ok(cur_desc, n, "cur_desc", &why)) return fail(Status::InvalidInput, why);
-  if (kf_desc.row_bytes != cur_desc.row_bytes)
-    return fail(Status::InvalidInput, "kf_desc rows have " + std::to_string(kf_desc.row_bytes) +
-                                          " bytes, cur_desc rows " + std::to_string(cur_desc.row_bytes));
-  if (static_cast<std::size_t>(options.max_hamming) > 8 * kf_desc.row_bytes)
-    return fail(Status::InvalidInput, "KeyframeMatchOptions: max_hamming " + std::to_string(options.max_hamming) +
-                                          " exceeds the descriptor's " + std::to_string(8 * kf_desc.row_bytes) +
-                                          " bits");
-  if (n > std::numeric_limits<std::uint32_t>::max() - 1 ||
-      n_kf > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-    return fail(Status::InvalidInput, "more keypoints than the matcher indexes (2^31)");
-  if (cam_from_keyframe != nullptr && !cam_from_keyframe->all_finite())
-    return fail(Status::NonFinite, "cam_from_keyframe has a NaN or Inf entry");
-  if (n_kf == 0) return fail(Status::TooFewPoints, "the keyframe has no keypoints");
-  if (n == 0) return fail(Status::TooFewPoints, "the current frame has no keypoints");
-
-  // Current keypoints: read once, bucketed in a grid over their own extent (not the camera's image size,
-  // which may be bogus; keypoints off the image are still found).
-  ws.cur_x.resize(n);
-  ws.cur_y.resize(n);
-  T x0 = std::numeric_limits<T>::max(), y0 = x0, x1 = std::numeric_limits<T>::lowest(), y1 = x1;
-  for (std::size_t i = 0; i < n; ++i) {
-    const T x = point_x<T>(cur_keypoints[i]), y = point_y<T>(cur_keypoints[i]);
-    if (!std::isfinite(x) || !std::isfinite(y)) {
-      ws.cur_x[i] = ws.cur_y[i] = nan;
-      ++r.current_nonfinite;
-      continue;
-    }
-    ws.cur_x[i] = x;
-    ws.cur_y[i] = y;
-    x0 = x < x0 ? x : x0;
-    x1 = x > x1 ? x : x1;
-    y0 = y < y0 ? y : y0;
-    y1 = y > y1 ? y : y1;
-  }
-  constexpr int kMaxCellsPerSide = 256;
-  int cols = 1, rows = 1;
-  T cell = T(1);
-  if (r.current_nonfinite < n) {
-    // Extents in double: (x1 - x0) of two huge finite floats stays finite.
-    const double ex = static_cast<double>(x1) - static_cast<double>(x0);
-    const double ey = static_cast<double>(y1) - static_cast<double>(y0);
-    double c = options.grid_cell_px;
-    const double spread = (ex > ey ? ex : ey) / double(kMaxCellsPerSide - 1);
-    if (spread > c) c = spread;
-    if (std::isfinite(c) && c <= static_cast<double>(std::numeric_limits<T>::max())) {
-      cell = static_cast<T>(c);
-      cols = clamped_int(ex / c, 0, kMaxCellsPerSide - 1) + 1;
-      rows = clamped_int(ey / c, 0, kMaxCellsPerSide - 1) + 1;
-    } else {
-      x0 = y0 = T(0);
-      cell = std::numeric_limits<T>::max();
-    }
-  } else {
-    x0 = y0 = T(0);
-  }
-  const std::size_t cells = static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
-  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-  detail::kfm_fill(ws.cell_start, cells + 1, std::uint32_t(0));
-  ws.cell_of.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!(ws.cur_x[i] == ws.cur_x[i])) {
-      ws.cell_of[i] = kNone;
-      continue;
-    }
-    const int c = detail::kfm_cell(ws.cur_x[i], x0, cell, cols), q = detail::kfm_cell(ws.cur_y[i], y0, cell, rows);
-    const std::uint32_t id =
-        static_cast<std::uint32_t>(q) * static_cast<std::uint32_t>(cols) + static_cast<std::uint32_t>(c);
-    ws.cell_of[i] = id;
-    ++ws.cell_start[id + 1];
-  }
-  for (std::size_t c = 0; c < cells; ++c) ws.cell_start[c + 1] += ws.cell_start[c];
-  // Counting sort by cell, stable (ascending index within a cell): positions, indices and descriptor
-  // rows become contiguous, so a search reads one run of memory per grid row.
-  const std::size_t n_sorted = n - r.current_nonfinite;
-  const std::size_t row_bytes = cur_desc.row_bytes;
-  ws.sorted_x.resize(n_sorted);
-  ws.sorted_y.resize(n_sorted);
-  ws.sorted_index.resize(n_sorted);
-  ws.sorted_desc.resize(n_sorted * row_bytes);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (ws.cell_of[i] == kNone) continue;
-    const std::uint32_t pos = ws.cell_start[ws.cell_of[i]]++;  // cell_start[c] is c's write cursor here
-    ws.sorted_x[pos] = ws.cur_x[i];
-    ws.sorted_y[pos] = ws.cur_y[i];
-    ws.sorted_index[pos] = static_cast<std::uint32_t>(i);
-    std::memcpy(ws.sorted_desc.data() + std::size_t(pos) * row_bytes, cur_desc.row(i), row_bytes);
-  }
-  for (std::size_t c = cells; c > 0; --c) ws.cell_start[c] = ws.cell_start[c - 1];
-  ws.cell_start[0] = 0;
-
-  // Keyframe predictions.
-  ws.pred_x.resize(n_kf);
-  ws.pred_y.resize(n_kf);
-  ws.pred_depth.resize(n_kf);
-  T* pred_x = ws.pred_x.data();
-  T* pred_y = ws.pred_y.data();
-  const bool have_depth = kf_points.size() == n_kf;
-  const bool have_pose = cam_from_keyframe != nullptr;
-  r.used_pose = have_pose;
-  Mat3<T> H = Mat3<T>::Identity();  // infinite homography K R K^-1: a ray's prediction without depth
-  if (have_pose) H = camera.K() * cam_from_keyframe->R * camera.K().inverse();
-  for (std::size_t k = 0; k < n_kf; ++k) {
-    const T u = point_x<T>(kf_keypoints[k]), v = point_y<T>(kf_keypoints[k]);
-    pred_x[k] = pred_y[k] = nan;
-    ws.pred_depth[k] = 0;
-    if (!std::isfinite(u) || !std::isfinite(v)) {
-      ++r.keyframe_nonfinite;
-      continue;
-    }
-    if (!have_pose) {
-      pred_x[k] = u;
-      pred_y[k] = v;
-      ++r.predicted_without_depth;
-      continue;
-    }
-    Vec3<T> X(nan, nan, nan);
-    if (have_depth) {
-      const auto& P = kf_points[k];
-      X = Vec3<T>(point_x<T>(P), point_y<T>(P), point_z<T>(P));
-    }
-    if (X.allFinite() && X.z() > T(0)) {
-      const Vec3<T> Xc = cam_from_keyframe->apply(X);
-      if (!(Xc.z() > T(0))) {
-        ++r.behind_camera;
-        continue;
-      }
-      const Vec2<T> p = camera.project(Xc);
-      if (!p.allFinite()) {  // a point at z ~ 0 projects to Inf: nowhere to search
-        ++r.behind_camera;
-        continue;
-      }
-      pred_x[k] = p.x();
-      pred_y[k] = p.y();
-      ws.pred_depth[k] = 1;
-      ++r.predicted_by_depth;
-    } else {
-      const Vec3<T> h = H * Vec3<T>(u, v, T(1));
-      if (!(h.z() > T(0))) {  // the ray turned more than 90 degrees away
-        ++r.behind_camera;
-        continue;
-      }
-      const T px = h.x() / h.z(), py = h.y() / h.z();
-      if (!std::isfinite(px) || !std::isfinite(py)) {
-        ++r.behind_camera;
-        continue;
-      }
-      pred_x[k] = px;
-      pred_y[k] = py;
-      ++r.predicted_without_depth;
-    }
-  }
-
-  detail::kfm_fill(ws.kf_best_cur, n_kf, -1);
-  detail::kfm_fill(ws.kf_second_dist, n_kf, std::numeric_limits<int>::max());
-  detail::kfm_fill(ws.kf_best_dist, n_kf, -1);
-  detail::kfm_fill(ws.cur_best_kf, n_sorted, -1);
-  detail::kfm_fill(ws.cur_best_dist, n_sorted, std::numeric_limits<int>::max());
-
-  detail::KfmScan<T> s;
-  s.pred_x = pred_x;
-  s.pred_y = pred_y;
-  s.pred_depth = ws.pred_depth.data();
-  s.n_kf = n_kf;
-  s.cur_x = ws.sorted_x.data();
-  s.cur_y = ws.sorted_y.data();
-  s.cur_index = ws.sorted_index.data();
-  s.kf_desc = kf_desc;
-  s.cur_desc = ws.sorted_desc.data();
-  s.row_bytes = row_bytes;
-  s.r_depth = static_cast<T>(options.radius_px);
-  s.r_free = static_cast<T>(options.radius_unpredicted_px);
-  s.r2_depth = s.r_depth * s.r_depth;
-  s.r2_free = s.r_free * s.r_free;
-  s.grid_x0 = x0;
-  s.grid_y0 = y0;
-  s.cell = cell;
-  s.cols = cols;
-  s.rows = rows;
-  s.cell_start = ws.cell_start.data();
-  s.kf_best_cur = ws.kf_best_cur.data();
-  s.kf_best_dist = ws.kf_best_dist.data();
-  s.kf_second_dist = ws.kf_second_dist.data();
-  s.cur_best_kf = ws.cur_best_kf.data();
-  s.cur_best_dist = ws.cur_best_dist.data();
-  s.max_candidates = static_cast<std::uint32_t>(options.max_candidates);  // at most 2^20 (validate)
-  const detail::KfmWork work = detail::kfm_scan(s);
-  r.examined = work.examined;
-  r.searches_capped = work.capped;
-
-  // Accept: distance and ratio per keyframe point, then one keyframe point per current keypoint.
-  const int* second = ws.kf_second_dist.data();
-  for (std::size_t k = 0; k < n_kf; ++k) {
-    const int c = ws.kf_best_cur[k];
-    if (c < 0) continue;
-    const int d = ws.kf_best_dist[k];
-    if (d > options.max_hamming) continue;
-    if (second[k] != std::numeric_limits<int>::max() && !(double(d) <= options.ratio * double(second[k]))) continue;
-    if (options.mutual_check && ws.cur_best_kf[static_cast<std::size_t>(c)] != static_cast<int>(k)) continue;
-    const std::size_t ci = ws.sorted_index[static_cast<std::size_t>(c)];
-    if (r.keyframe_index[ci] >= 0 && r.distance[ci] <= d) continue;  // a closer (or earlier) keyframe point won
-    if (r.keyframe_index[ci] < 0) ++r.matched;
-    r.keyframe_index[ci] = static_cast<int>(k);
-    r.distance[ci] = d;
-    r.keyframe_pixel[ci] = Vec2<T>(point_x<T>(kf_keypoints[k]), point_y<T>(kf_keypoints[k]));
-  }
+  detail::kfm_reset(cur_keypoints.size(), &r);
+  if (!detail::kfm_inputs_ok(kf_keypoints.size(), kf_points.size(), kf_desc, cur_keypoints.size(), cur_desc, camera,
+                             cam_from_keyframe, options, &r))
+    return;
+  detail::kfm_sort_current(cur_keypoints, cur_desc, options, ws, &r);
+  detail::kfm_predict(kf_keypoints, kf_points, camera, cam_from_keyframe, ws, &r);
+  detail::kfm_search(kf_desc, cur_desc.row_bytes, options, ws, &r);
+  detail::kfm_accept(kf_keypoints, options, ws, &r);
 }
 
 /// Convenience form that allocates its workspace and result (tests, one-off calls).
