@@ -180,18 +180,13 @@ T median_in_place(std::vector<T>& v) {
 }
 }  // namespace detail
 
-/// Dynamic probability of every feature. prev_points[i] -> curr_points[i] is feature i's LK flow
-/// (non-finite = lost track: M = 0). `levels` has one entry per feature. `track_ids` (optional, one
-/// per feature, negative = untracked) with `store` gives K and is updated with this frame's M and
-/// decisions (call store->begin_frame() before each frame). Writes into `*out`, reusing its and
-/// `*scratch`'s buffers (no allocation once warm).
-template <class T, class Prev, class Curr>
-void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const std::vector<MotionLevel>& levels,
-                         const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego, TrackStateStore* store,
-                         const std::vector<std::int64_t>* track_ids, DynamicProbabilityResult<T>* out,
-                         DynamicProbabilityScratch<T>* scratch) {
-  static_assert(is_point_container_v<Prev> && is_point_container_v<Curr>,
-                "dynamic_probability: points must be containers of points");
+namespace detail {
+
+/// Every feature static with no flow measured yet; false (status and reason set) when the inputs break
+/// the contract.
+template <class T>
+bool dp_start(std::size_t n, std::size_t n_prev, std::size_t n_levels, const std::vector<std::int64_t>* track_ids,
+              const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego, DynamicProbabilityResult<T>* out) {
   DynamicProbabilityResult<T>& r = *out;
   r.status = Status::Ok;
   r.reason.clear();
@@ -199,38 +194,41 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
   r.motion_threshold_px = T(0);
   r.num_reference = r.num_masked = r.num_dynamic = r.num_no_flow = 0;
   r.used_fallback = false;
-  const std::size_t n = curr_points.size();
   r.labels.assign(n, FeatureLabel::Static);
   r.reasons.assign(n, CullReason::None);
   r.probability.assign(n, T(0));
   r.residual_px.assign(n, Constants<T>::nan());
   r.moving.assign(n, 0);
   r.temporal.assign(n, 0);
-  if (prev_points.size() != n || levels.size() != n || (track_ids && track_ids->size() != n)) {
+  if (n_prev != n || n_levels != n || (track_ids && track_ids->size() != n)) {
     r.status = Status::InvalidInput;
     r.reason.assign("prev_points, curr_points, levels (and track_ids) must have the same size");
-    return;
+    return false;
   }
   if (o.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
     r.reason.insert(0, "invalid options: ");
-    return;
+    return false;
   }
   if (static_cast<int>(ego.model) > 2) {
     r.status = Status::InvalidInput;
     r.reason.assign("ego.model must be MeanFlow, Fundamental or Homography");
-    return;
+    return false;
   }
   if (!ego.matrix.allFinite()) {
     r.status = Status::NonFinite;
     r.reason.assign("ego-motion matrix is not finite");
-    return;
+    return false;
   }
-  auto is_reference = [&](MotionLevel l) {
-    return l == MotionLevel::Ignore || (o.low_level_in_reference && l == MotionLevel::Low);
-  };
+  return true;
+}
 
-  // Residual of each feature against the camera-motion model (MeanFlow: the raw flow for now).
+/// Each feature's flow, and its residual against the camera-motion model where the model is F or H
+/// (the MeanFlow residual needs the reference flow: dp_reference_flow).
+template <class T, class Prev, class Curr>
+void dp_flow(const Prev& prev_points, const Curr& curr_points, const EgoMotion<T>& ego,
+             DynamicProbabilityScratch<T>* scratch, DynamicProbabilityResult<T>* r) {
+  const std::size_t n = curr_points.size();
   std::vector<Vec2<T>>& flow = scratch->flow;
   std::vector<std::uint8_t>& has_flow = scratch->has_flow;
   flow.assign(n, Vec2<T>::Zero());
@@ -243,28 +241,46 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
     if (ego.model == FlowModel::Fundamental) {
       const Vec3<T> l = ego.matrix * Vec3<T>(p1.x(), p1.y(), T(1));
       const T norm = std::sqrt(l.x() * l.x() + l.y() * l.y());
-      r.residual_px[i] = norm > T(0) ? std::abs(l.x() * p2.x() + l.y() * p2.y() + l.z()) / norm : T(0);
+      r->residual_px[i] = norm > T(0) ? std::abs(l.x() * p2.x() + l.y() * p2.y() + l.z()) / norm : T(0);
     } else if (ego.model == FlowModel::Homography) {
       const Vec3<T> q = ego.matrix * Vec3<T>(p1.x(), p1.y(), T(1));
-      r.residual_px[i] = std::abs(q.z()) > Constants<T>::small()
-                             ? (Vec2<T>(q.x() / q.z(), q.y() / q.z()) - p2).norm()
-                             : std::numeric_limits<T>::infinity();
+      r->residual_px[i] = std::abs(q.z()) > Constants<T>::small()
+                              ? (Vec2<T>(q.x() / q.z(), q.y() / q.z()) - p2).norm()
+                              : std::numeric_limits<T>::infinity();
     }
   }
+}
+
+/// The reference set of eq. 4: features with flow in no mask (and in low-level ones when
+/// low_level_in_reference); every feature with flow when fewer than min_reference_features are left.
+template <class T>
+void dp_reference_set(const std::vector<MotionLevel>& levels, const DynamicProbabilityOptions<T>& o,
+                      DynamicProbabilityScratch<T>* scratch, DynamicProbabilityResult<T>* r) {
+  const std::size_t n = levels.size();
+  auto is_reference = [&](MotionLevel l) {
+    return l == MotionLevel::Ignore || (o.low_level_in_reference && l == MotionLevel::Low);
+  };
   std::vector<std::size_t>& ref = scratch->ref;
   ref.clear();
   ref.reserve(n);
   for (std::size_t i = 0; i < n; ++i)
-    if (has_flow[i] && is_reference(levels[i])) ref.push_back(i);
+    if (scratch->has_flow[i] && is_reference(levels[i])) ref.push_back(i);
   if (ref.size() < o.min_reference_features) {
-    r.used_fallback = true;
+    r->used_fallback = true;
     ref.clear();
     for (std::size_t i = 0; i < n; ++i)
-      if (has_flow[i]) ref.push_back(i);
+      if (scratch->has_flow[i]) ref.push_back(i);
   }
-  r.num_reference = ref.size();
+  r->num_reference = ref.size();
+}
 
-  if (ego.model == FlowModel::MeanFlow && !ref.empty()) {
+/// MeanFlow (eq. 4): (U, V) = the reference features' flow, median or mean; residual = |flow - (U, V)|.
+template <class T>
+void dp_reference_flow(const DynamicProbabilityOptions<T>& o, DynamicProbabilityScratch<T>* scratch,
+                       DynamicProbabilityResult<T>* r) {
+  const std::vector<std::size_t>& ref = scratch->ref;
+  const std::vector<Vec2<T>>& flow = scratch->flow;
+  if (!ref.empty()) {
     std::vector<T>& u = scratch->u;
     std::vector<T>& v = scratch->v;
     u.clear();
@@ -276,42 +292,54 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
       v.push_back(flow[i].y());
     }
     if (o.median_reference) {
-      r.reference_flow = Vec2<T>(detail::median_in_place(u), detail::median_in_place(v));
+      r->reference_flow = Vec2<T>(median_in_place(u), median_in_place(v));
     } else {
       Vec2<T> s = Vec2<T>::Zero();
       for (std::size_t i : ref) s += flow[i];
-      r.reference_flow = s / T(ref.size());
+      r->reference_flow = s / T(ref.size());
     }
   }
-  if (ego.model == FlowModel::MeanFlow) {
-    const Vec2<T> ref_flow = r.reference_flow;  // a local: stores into r must not force reloads
-    T* res = r.residual_px.data();
-    for (std::size_t i = 0; i < n; ++i)
-      if (has_flow[i]) res[i] = (flow[i] - ref_flow).norm();
-  }
+  const Vec2<T> ref_flow = r->reference_flow;  // a local: stores into r must not force reloads
+  T* res = r->residual_px.data();
+  for (std::size_t i = 0; i < flow.size(); ++i)
+    if (scratch->has_flow[i]) res[i] = (flow[i] - ref_flow).norm();
+}
 
-  // Adaptive t: robust spread of the reference features' own residuals, with a floor.
-  if (r.used_fallback || ref.empty()) {
-    r.motion_threshold_px = o.fallback_motion_threshold_px;
+/// t of eq. 5, adaptive: median + mad_scale x 1.4826 MAD of the reference features' own residuals, at
+/// least min_motion_threshold_px; the fixed fallback threshold without a reference of its own.
+template <class T>
+void dp_motion_threshold(const DynamicProbabilityOptions<T>& o, DynamicProbabilityScratch<T>* scratch,
+                         DynamicProbabilityResult<T>* r) {
+  const std::vector<std::size_t>& ref = scratch->ref;
+  if (r->used_fallback || ref.empty()) {
+    r->motion_threshold_px = o.fallback_motion_threshold_px;
   } else {
     std::vector<T>& res = scratch->res;
     res.clear();
     res.reserve(ref.size());
-    for (std::size_t i : ref) res.push_back(r.residual_px[i]);
-    const T med = detail::median_in_place(res);
+    for (std::size_t i : ref) res.push_back(r->residual_px[i]);
+    const T med = median_in_place(res);
     for (T& x : res) x = std::abs(x - med);
-    const T mad = detail::median_in_place(res);
+    const T mad = median_in_place(res);
     const T t = med + o.mad_scale * T(1.4826) * mad;
-    r.motion_threshold_px = std::isfinite(t) ? std::max(o.min_motion_threshold_px, t) : o.min_motion_threshold_px;
+    r->motion_threshold_px = std::isfinite(t) ? std::max(o.min_motion_threshold_px, t) : o.min_motion_threshold_px;
   }
-  if (r.used_fallback) {
-    r.reason.assign("only ");  // built in place: a reused result keeps the string's capacity
-    r.reason += std::to_string(r.num_reference);
-    r.reason += " features with flow as reference (fewer than ";
-    r.reason += std::to_string(o.min_reference_features);
-    r.reason += " outside masks): fallback threshold used";
+  if (r->used_fallback) {
+    r->reason.assign("only ");  // built in place: a reused result keeps the string's capacity
+    r->reason += std::to_string(r->num_reference);
+    r->reason += " features with flow as reference (fewer than ";
+    r->reason += std::to_string(o.min_reference_features);
+    r->reason += " outside masks): fallback threshold used";
   }
+}
 
+/// Eq. 3 per feature in a mask: P = a1 S + a2 M + a3 K, dynamic iff P >= threshold; M = residual > t
+/// (eq. 5), K from the track's state in `store`, which is updated with this frame's M and decision.
+template <class T>
+void dp_combine(const std::vector<MotionLevel>& levels, const DynamicProbabilityOptions<T>& o, TrackStateStore* store,
+                const std::vector<std::int64_t>* track_ids, const std::vector<std::uint8_t>& has_flow,
+                DynamicProbabilityResult<T>* out) {
+  DynamicProbabilityResult<T>& r = *out;
   // Locals and raw pointers: stores through `r` would otherwise alias every read of `r`.
   const T t = r.motion_threshold_px;
   const T a1 = o.weight_semantic, a2 = o.weight_motion, a3 = o.weight_temporal, threshold = o.threshold;
@@ -323,7 +351,7 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
   CullReason* reasons = r.reasons.data();
   std::size_t num_no_flow = 0, num_masked = 0, num_dynamic = 0;
   const bool use_store = store && track_ids;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < levels.size(); ++i) {
     num_no_flow += !has_flow[i];
     const bool m = has_flow[i] && res[i] > t;
     moving[i] = static_cast<std::uint8_t>(m);
@@ -351,6 +379,28 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
   r.num_no_flow = num_no_flow;
   r.num_masked = num_masked;
   r.num_dynamic = num_dynamic;
+}
+
+}  // namespace detail
+
+/// Dynamic probability of every feature. prev_points[i] -> curr_points[i] is feature i's LK flow
+/// (non-finite = lost track: M = 0). `levels` has one entry per feature. `track_ids` (optional, one
+/// per feature, negative = untracked) with `store` gives K and is updated with this frame's M and
+/// decisions (call store->begin_frame() before each frame). Writes into `*out`, reusing its and
+/// `*scratch`'s buffers (no allocation once warm).
+template <class T, class Prev, class Curr>
+void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const std::vector<MotionLevel>& levels,
+                         const DynamicProbabilityOptions<T>& o, const EgoMotion<T>& ego, TrackStateStore* store,
+                         const std::vector<std::int64_t>* track_ids, DynamicProbabilityResult<T>* out,
+                         DynamicProbabilityScratch<T>* scratch) {
+  static_assert(is_point_container_v<Prev> && is_point_container_v<Curr>,
+                "dynamic_probability: points must be containers of points");
+  if (!detail::dp_start(curr_points.size(), prev_points.size(), levels.size(), track_ids, o, ego, out)) return;
+  detail::dp_flow(prev_points, curr_points, ego, scratch, out);           // flow, F / H residuals
+  detail::dp_reference_set(levels, o, scratch, out);                      // eq. 4's static reference
+  if (ego.model == FlowModel::MeanFlow) detail::dp_reference_flow(o, scratch, out);  // eq. 4
+  detail::dp_motion_threshold(o, scratch, out);                           // t of eq. 5
+  detail::dp_combine(levels, o, store, track_ids, scratch->has_flow, out);  // eq. 3 and 5
 }
 
 /// The same probability in a fresh result (allocates; the out-parameter form reuses buffers).
