@@ -136,6 +136,129 @@ struct BoxRuleScratch {
   std::vector<std::uint8_t> flags;    ///< membership and non-finite bits per point
 };
 
+namespace detail {
+
+/// The boxes the rule tests, with their level bit and detection index: high-level boxes padded by
+/// high_padding_px, low-level ones shrunk by low_shrink_px, medium ones as detected; Ignore-level classes
+/// left out. Returns the boxes skipped as invalid (or padded to nothing).
+template <class Dets, class T>
+std::size_t effective_boxes(const Dets& detections, const MotionLevelTable& levels, const BoxRuleOptions<T>& options,
+                            BoxRuleScratch<T>* scratch, BoxRuleResult<T>* r) {
+  std::vector<Box<T>>& boxes = scratch->boxes;
+  boxes.clear();
+  scratch->bits.clear();
+  scratch->source.clear();
+  boxes.reserve(detections.size());
+  std::size_t skipped = 0;
+  for (std::size_t b = 0; b < detections.size(); ++b) {
+    const Detection<T>& d = detections[b];
+    const MotionLevel level = levels.level(d.class_id);
+    if (level == MotionLevel::Ignore) continue;
+    if (!d.box.valid()) {
+      ++skipped;
+      continue;
+    }
+    Box<T> e = d.box;
+    std::uint8_t bit = kInMedium;
+    if (level == MotionLevel::High) {
+      e = d.box.padded(options.high_padding_px);
+      bit = kInHigh;
+      if (!e.valid()) {  // shrunk to nothing by a negative padding
+        ++skipped;
+        continue;
+      }
+      ++r->num_high_boxes;
+    } else if (level == MotionLevel::Low) {
+      e = d.box.padded(-options.low_shrink_px);
+      bit = kInLow;
+      if (!e.valid()) continue;
+      ++r->num_low_boxes;
+    } else {
+      ++r->num_medium_boxes;
+    }
+    boxes.push_back(e);
+    scratch->bits.push_back(bit);
+    scratch->source.push_back(static_cast<std::int32_t>(b));
+  }
+  return skipped;
+}
+
+/// Zhang et al. 2023, Algorithm 1 as a table over the membership bits (high, medium, low) and the
+/// non-finite bit: high -> dynamic (candidate with high_as_candidate) unless also low; medium ->
+/// candidate with medium_as_candidate unless low overrides it; a non-finite point is never static.
+template <class T>
+void box_rule_table(const BoxRuleOptions<T>& options, FeatureLabel label_of[16], CullReason reason_of[16]) {
+  for (unsigned f = 0; f < 16; ++f) {
+    const bool high = f & kInHigh, medium = f & kInMedium, low = f & kInLow;
+    label_of[f] = FeatureLabel::Static;
+    reason_of[f] = CullReason::None;
+    if (f & kNonFinite) {  // never trusted as static
+      label_of[f] = FeatureLabel::Dynamic;
+      reason_of[f] = CullReason::InvalidInput;
+    } else if (high) {
+      if (low) {
+        reason_of[f] = CullReason::LowLevelOverride;
+      } else {
+        label_of[f] = options.high_as_candidate ? FeatureLabel::Candidate : FeatureLabel::Dynamic;
+        reason_of[f] = CullReason::HighLevelBox;
+      }
+    } else if (medium) {
+      if (low && options.low_overrides_medium) {
+        reason_of[f] = CullReason::LowLevelOverride;
+      } else if (options.medium_as_candidate) {
+        label_of[f] = FeatureLabel::Candidate;
+        reason_of[f] = CullReason::MediumLevelBox;
+      }
+    }
+  }
+}
+
+/// Labels every point by its bits through the table, and names the deciding box (the first high one,
+/// else the first medium one) of a boxed point.
+template <class T>
+void label_by_table(std::size_t n, const FeatureLabel label_of[16], const CullReason reason_of[16],
+                    const BoxRuleScratch<T>& scratch, BoxRuleResult<T>* out) {
+  BoxRuleResult<T>& r = *out;
+  // Counters in locals: stores through `r` would alias the label stores and serialise the loop.
+  std::size_t num_dynamic = 0, num_candidate = 0, num_override = 0, num_bad = 0;
+  FeatureLabel* labels = r.labels.data();
+  CullReason* reasons = r.reasons.data();
+  const std::uint8_t* flags = scratch.flags.data();
+  const T* xs = scratch.xs.data();
+  const T* ys = scratch.ys.data();
+  const Box<T>* boxes = scratch.boxes.data();
+  const std::uint8_t* bits = scratch.bits.data();
+  const std::size_t num_boxes = scratch.boxes.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t f = flags[i];
+    const FeatureLabel label = label_of[f];
+    const CullReason reason = reason_of[f];
+    labels[i] = label;
+    reasons[i] = reason;
+    num_bad += (f & kNonFinite) != 0;
+    num_override += reason == CullReason::LowLevelOverride;
+    num_dynamic += label == FeatureLabel::Dynamic;
+    num_candidate += label == FeatureLabel::Candidate;
+    if (f & (kInHigh | kInMedium)) {
+      // Few points are boxed: find the deciding box directly.
+      const std::uint8_t want = (f & kInHigh) ? kInHigh : kInMedium;
+      for (std::size_t b = 0; b < num_boxes; ++b) {
+        if (bits[b] == want && boxes[b].contains(xs[i], ys[i])) {
+          r.box_index[i] = scratch.source[b];
+          break;
+        }
+      }
+    }
+  }
+  r.num_dynamic = num_dynamic;
+  r.num_candidate = num_candidate;
+  r.num_low_override = num_override;
+  r.num_non_finite = num_bad;
+  r.num_static = n - r.num_dynamic - r.num_candidate;
+}
+
+}  // namespace detail
+
 /// Applies the box rule to every point, writing into `*out` and reusing its and `*scratch`'s
 /// buffers. Boxes of Ignore-level classes take no part; invalid (non-finite or inverted) boxes, and
 /// high-level boxes a negative high_padding_px empties, are skipped and counted in `reason`. Options
@@ -157,58 +280,18 @@ void apply_box_rule(const Points& points, const Dets& detections, const MotionLe
     r.num_static = n;
     return;
   }
-
-  // Effective boxes (padded / shrunk) with their level bit; detection index kept for box_index.
-  std::vector<Box<T>>& boxes = scratch->boxes;
-  std::vector<std::uint8_t>& bits = scratch->bits;
-  std::vector<std::int32_t>& source = scratch->source;
-  boxes.clear();
-  bits.clear();
-  source.clear();
-  boxes.reserve(detections.size());
-  std::size_t skipped = 0;
-  for (std::size_t b = 0; b < detections.size(); ++b) {
-    const Detection<T>& d = detections[b];
-    const MotionLevel level = levels.level(d.class_id);
-    if (level == MotionLevel::Ignore) continue;
-    if (!d.box.valid()) {
-      ++skipped;
-      continue;
-    }
-    Box<T> e = d.box;
-    std::uint8_t bit = detail::kInMedium;
-    if (level == MotionLevel::High) {
-      e = d.box.padded(options.high_padding_px);
-      bit = detail::kInHigh;
-      if (!e.valid()) {  // shrunk to nothing by a negative padding
-        ++skipped;
-        continue;
-      }
-      ++r.num_high_boxes;
-    } else if (level == MotionLevel::Low) {
-      e = d.box.padded(-options.low_shrink_px);
-      bit = detail::kInLow;
-      if (!e.valid()) continue;
-      ++r.num_low_boxes;
-    } else {
-      ++r.num_medium_boxes;
-    }
-    boxes.push_back(e);
-    bits.push_back(bit);
-    source.push_back(static_cast<std::int32_t>(b));
-  }
+  const std::size_t skipped = detail::effective_boxes(detections, levels, options, scratch, &r);
   if (skipped) {
     r.reason.assign(std::to_string(skipped));
     r.reason += " invalid box(es) skipped";
   }
-
   // NaN / Inf coordinates compare false against every finite bound: never inside a box; they are
   // flagged here (x * 0 is NaN only for non-finite x) and labelled by the decision table.
   // Scratch arrays are left uninitialised: every element is written before it is read.
   scratch->xs.resize(n);
   scratch->ys.resize(n);
   scratch->flags.resize(n);
-  T* const xs = scratch->xs.data();
+  T* const xs = scratch->xs.data();  // raw pointers: byte stores through the vectors would alias them
   T* const ys = scratch->ys.data();
   std::uint8_t* const flags = scratch->flags.data();
   for (std::size_t i = 0; i < n; ++i) {
@@ -217,64 +300,11 @@ void apply_box_rule(const Points& points, const Dets& detections, const MotionLe
     ys[i] = y;
     flags[i] = (x * T(0) + y * T(0) == T(0)) ? std::uint8_t(0) : detail::kNonFinite;
   }
-  detail::mark_points(xs, ys, n, boxes, bits, flags);
-
-  // Decision table over the three membership bits and the non-finite bit.
+  detail::mark_points(xs, ys, n, scratch->boxes, scratch->bits, flags);
   FeatureLabel label_of[16];
   CullReason reason_of[16];
-  for (unsigned f = 0; f < 16; ++f) {
-    const bool high = f & detail::kInHigh, medium = f & detail::kInMedium, low = f & detail::kInLow;
-    label_of[f] = FeatureLabel::Static;
-    reason_of[f] = CullReason::None;
-    if (f & detail::kNonFinite) {  // never trusted as static
-      label_of[f] = FeatureLabel::Dynamic;
-      reason_of[f] = CullReason::InvalidInput;
-    } else if (high) {
-      if (low) {
-        reason_of[f] = CullReason::LowLevelOverride;
-      } else {
-        label_of[f] = options.high_as_candidate ? FeatureLabel::Candidate : FeatureLabel::Dynamic;
-        reason_of[f] = CullReason::HighLevelBox;
-      }
-    } else if (medium) {
-      if (low && options.low_overrides_medium) {
-        reason_of[f] = CullReason::LowLevelOverride;
-      } else if (options.medium_as_candidate) {
-        label_of[f] = FeatureLabel::Candidate;
-        reason_of[f] = CullReason::MediumLevelBox;
-      }
-    }
-  }
-  // Counters in locals: stores through `r` would alias the label stores and serialise the loop.
-  std::size_t num_dynamic = 0, num_candidate = 0, num_override = 0, num_bad = 0;
-  FeatureLabel* labels = r.labels.data();
-  CullReason* reasons = r.reasons.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t f = flags[i];
-    const FeatureLabel label = label_of[f];
-    const CullReason reason = reason_of[f];
-    labels[i] = label;
-    reasons[i] = reason;
-    num_bad += (f & detail::kNonFinite) != 0;
-    num_override += reason == CullReason::LowLevelOverride;
-    num_dynamic += label == FeatureLabel::Dynamic;
-    num_candidate += label == FeatureLabel::Candidate;
-    if (f & (detail::kInHigh | detail::kInMedium)) {
-      // Few points are boxed: find the deciding box (first high, else first medium) directly.
-      const std::uint8_t want = (f & detail::kInHigh) ? detail::kInHigh : detail::kInMedium;
-      for (std::size_t b = 0; b < boxes.size(); ++b) {
-        if (bits[b] == want && boxes[b].contains(xs[i], ys[i])) {
-          r.box_index[i] = source[b];
-          break;
-        }
-      }
-    }
-  }
-  r.num_dynamic = num_dynamic;
-  r.num_candidate = num_candidate;
-  r.num_low_override = num_override;
-  r.num_non_finite = num_bad;
-  r.num_static = n - r.num_dynamic - r.num_candidate;
+  detail::box_rule_table(options, label_of, reason_of);
+  detail::label_by_table(n, label_of, reason_of, *scratch, &r);
 }
 
 /// The same rule returning a fresh result (allocates; apply_box_rule with an out-parameter reuses buffers).
