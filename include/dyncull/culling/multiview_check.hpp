@@ -147,6 +147,70 @@ struct RawDepthRange<Raw, true> {
 
 }  // namespace detail
 
+namespace detail {
+
+/// Every point a candidate with no outcome yet; false (status and reason set) when the check cannot run
+/// (Skipped: no keyframe points, pose or depth image) or its inputs break the contract (InvalidInput).
+template <class T, class Raw>
+bool multiview_start(std::size_t n, std::size_t n_depths, const Rigid3<T>& cam_from_world_ref,
+                     const Rigid3<T>& cam_from_world_cur, const DepthView<Raw>& depth, const PinholeCamera<T>& camera,
+                     const MultiViewOptions<T>& options, MultiViewResult<T>* out) {
+  MultiViewResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_points = n;
+  r.num_checked = r.num_dynamic = r.num_large_parallax = r.num_no_depth = r.num_outside = 0;
+  r.labels.assign(n, FeatureLabel::Candidate);
+  r.outcome.assign(n, MultiViewOutcome::NonFinite);
+  r.projected.resize(n);
+  r.projected_depth_m.assign(n, T(0));
+  r.measured_depth_m.assign(n, T(0));
+  auto stop = [&](Status s, std::string why) {
+    r.status = s;
+    r.reason = std::move(why);
+    return false;
+  };
+  if (n_depths != n)
+    return stop(Status::InvalidInput, "ref_depths_m has " + std::to_string(n_depths) + " depths for " +
+                                          std::to_string(n) + " ref_points");
+  if (n == 0) return stop(Status::Skipped, "no keyframe points yet: the multi-view check needs a keyframe with depth");
+  if (!cam_from_world_ref.all_finite() || !cam_from_world_cur.all_finite())
+    return stop(Status::Skipped, "no valid pose for the keyframe or the current frame (tracking not initialised?)");
+  if (depth.empty()) return stop(Status::Skipped, "no current depth image");
+  std::string why;
+  if (options.validate(&why) != Status::Ok) return stop(Status::InvalidInput, "invalid options: " + why);
+  if (depth.validate(&why) != Status::Ok) return stop(Status::InvalidInput, why);
+  if (!camera.valid()) return stop(Status::InvalidInput, "invalid camera");
+  return true;
+}
+
+/// What the current frame can say about one keyframe point (pixel u, v at depth d): projected into the
+/// current view (x, z), seen there at a small enough parallax, and its depth measured near x. Checked
+/// when a measurement exists; the other outcomes say why not.
+template <class T, class Raw>
+MultiViewOutcome multiview_observe(T u, T v, T d, const Rigid3<T>& cur_from_ref, const Vec3<T>& c_cur_in_ref,
+                                   T cos_max, const DepthView<Raw>& depth, const PinholeCamera<T>& camera,
+                                   const MultiViewOptions<T>& options, Vec2<T>* x, T* z, T* measured) {
+  if (!std::isfinite(u) || !std::isfinite(v) || !std::isfinite(d)) return MultiViewOutcome::NonFinite;
+  if (!(d > T(0)) || d > options.max_reference_depth_m) return MultiViewOutcome::NoReferenceDepth;
+  const Vec3<T> X_ref = camera.backproject(Vec2<T>(u, v), d);
+  const Vec3<T> X_cur = cur_from_ref.apply(X_ref);
+  if (!(X_cur.z() > T(0)) || X_cur.z() > options.max_projected_depth_m) return MultiViewOutcome::BehindCamera;
+  *x = camera.project(X_cur);
+  *z = X_cur.z();
+  if (!camera.in_image(x->x(), x->y(), options.border_px)) return MultiViewOutcome::OutsideImage;
+  const Vec3<T> ray_cur = X_ref - c_cur_in_ref;
+  const T cosang = X_ref.dot(ray_cur) / (X_ref.norm() * ray_cur.norm());
+  if (!(cosang >= cos_max)) return MultiViewOutcome::LargeParallax;
+  int pu = 0, pv = 0;
+  *measured = pixel_of(x->x(), x->y(), depth.width, depth.height, &pu, &pv)
+                  ? closest_depth_in_window<Raw, T>(depth, pu, pv, options.search_radius_px, X_cur.z())
+                  : T(0);
+  return *measured > T(0) ? MultiViewOutcome::Checked : MultiViewOutcome::NoMeasuredDepth;
+}
+
+}  // namespace detail
+
 /// Checks keyframe points against the current depth image, writing into `out` (its buffers are reused).
 /// ref_points: any point container (keyframe pixels); ref_depths_m: container of depths (metres) with
 /// operator[] and size(), one per point (else InvalidInput); poses are cam_from_world. Status Skipped
@@ -159,109 +223,31 @@ void check_multiview(const C& ref_points, const D& ref_depths_m, const Rigid3<T>
   static_assert(is_point_container_v<C>, "dyncull::check_multiview: ref_points must hold points (see PointTraits)");
   MultiViewResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(ref_points.size());
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_points = n;
-  r.num_checked = r.num_dynamic = r.num_large_parallax = r.num_no_depth = r.num_outside = 0;
-  r.labels.assign(n, FeatureLabel::Candidate);
-  r.outcome.assign(n, MultiViewOutcome::NonFinite);
-  r.projected.resize(n);
-  r.projected_depth_m.assign(n, T(0));
-  r.measured_depth_m.assign(n, T(0));
-  if (static_cast<std::size_t>(ref_depths_m.size()) != n) {
-    r.status = Status::InvalidInput;
-    r.reason = "ref_depths_m has " + std::to_string(ref_depths_m.size()) + " depths for " + std::to_string(n) +
-               " ref_points";
+  if (!detail::multiview_start(n, static_cast<std::size_t>(ref_depths_m.size()), cam_from_world_ref,
+                               cam_from_world_cur, depth, camera, options, out))
     return;
-  }
-  if (n == 0) {
-    r.status = Status::Skipped;
-    r.reason = "no keyframe points yet: the multi-view check needs a keyframe with depth";
-    return;
-  }
-  if (!cam_from_world_ref.all_finite() || !cam_from_world_cur.all_finite()) {
-    r.status = Status::Skipped;
-    r.reason = "no valid pose for the keyframe or the current frame (tracking not initialised?)";
-    return;
-  }
-  if (depth.empty()) {
-    r.status = Status::Skipped;
-    r.reason = "no current depth image";
-    return;
-  }
-  std::string why;
-  if (options.validate(&why) != Status::Ok) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid options: " + why;
-    return;
-  }
-  if (depth.validate(&why) != Status::Ok) {
-    r.status = Status::InvalidInput;
-    r.reason = why;
-    return;
-  }
-  if (!camera.valid()) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid camera";
-    return;
-  }
   const Rigid3<T> cur_from_ref = cam_from_world_cur * cam_from_world_ref.inverse();
   // Parallax from camera centres (DynaSLAM used the translation column of Tcw, right only without rotation).
   // In the reference frame: the ray from the reference centre is X, the current centre is c_cur.
   const Vec3<T> c_cur_in_ref = cur_from_ref.inverse().t;
   const T cos_max = std::cos(options.max_parallax_deg * Constants<T>::deg_to_rad());
-  const T max_ref = options.max_reference_depth_m, max_proj = options.max_projected_depth_m;
-  const T border = options.border_px;
   for (std::size_t i = 0; i < n; ++i) {
-    const T u = point_x<T>(ref_points[i]), v = point_y<T>(ref_points[i]);
-    const T d = static_cast<T>(ref_depths_m[i]);
-    if (!std::isfinite(u) || !std::isfinite(v) || !std::isfinite(d)) continue;  // outcome NonFinite
-    if (!(d > T(0)) || d > max_ref) {
-      r.outcome[i] = MultiViewOutcome::NoReferenceDepth;
-      ++r.num_no_depth;
-      continue;
-    }
-    const Vec3<T> X_ref = camera.backproject(Vec2<T>(u, v), d);
-    const Vec3<T> X_cur = cur_from_ref.apply(X_ref);
-    if (!(X_cur.z() > T(0)) || X_cur.z() > max_proj) {
-      r.outcome[i] = MultiViewOutcome::BehindCamera;
-      ++r.num_outside;
-      continue;
-    }
-    const Vec2<T> x = camera.project(X_cur);
-    r.projected[i] = x;
-    r.projected_depth_m[i] = X_cur.z();
-    if (!camera.in_image(x.x(), x.y(), border)) {
-      r.outcome[i] = MultiViewOutcome::OutsideImage;
-      ++r.num_outside;
-      continue;
-    }
-    const Vec3<T> ray_cur = X_ref - c_cur_in_ref;
-    const T cosang = X_ref.dot(ray_cur) / (X_ref.norm() * ray_cur.norm());
-    if (!(cosang >= cos_max)) {
-      r.outcome[i] = MultiViewOutcome::LargeParallax;
-      ++r.num_large_parallax;
-      continue;
-    }
-    int pu = 0, pv = 0;
-    const T measured = pixel_of(x.x(), x.y(), depth.width, depth.height, &pu, &pv)
-                           ? detail::closest_depth_in_window<Raw, T>(depth, pu, pv, options.search_radius_px, X_cur.z())
-                           : T(0);
+    T z = T(0), measured = T(0);
+    const MultiViewOutcome o = detail::multiview_observe(
+        point_x<T>(ref_points[i]), point_y<T>(ref_points[i]), static_cast<T>(ref_depths_m[i]), cur_from_ref,
+        c_cur_in_ref, cos_max, depth, camera, options, &r.projected[i], &z, &measured);
+    r.outcome[i] = o;
+    r.projected_depth_m[i] = z;
     r.measured_depth_m[i] = measured;
-    if (!(measured > T(0))) {
-      r.outcome[i] = MultiViewOutcome::NoMeasuredDepth;
-      ++r.num_no_depth;
-      continue;
-    }
-    r.outcome[i] = MultiViewOutcome::Checked;
+    r.num_no_depth += o == MultiViewOutcome::NoReferenceDepth || o == MultiViewOutcome::NoMeasuredDepth;
+    r.num_outside += o == MultiViewOutcome::BehindCamera || o == MultiViewOutcome::OutsideImage;
+    r.num_large_parallax += o == MultiViewOutcome::LargeParallax;
+    if (o != MultiViewOutcome::Checked) continue;
     ++r.num_checked;
     // Something now in front of the remembered surface: the thing at x' moved there (RTD-SLAM).
-    if (X_cur.z() - measured > options.depth_threshold_m) {
-      r.labels[i] = FeatureLabel::Dynamic;
-      ++r.num_dynamic;
-    } else {
-      r.labels[i] = FeatureLabel::Static;
-    }
+    const bool moved = z - measured > options.depth_threshold_m;
+    r.labels[i] = moved ? FeatureLabel::Dynamic : FeatureLabel::Static;
+    r.num_dynamic += moved;
   }
   if (r.num_checked == 0) {
     r.status = Status::TooFewPoints;
