@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -81,6 +82,85 @@ template <class X>
 using NonDeduced = typename NonDeducedHolder<X>::type;
 }  // namespace detail
 
+namespace detail {
+
+/// Nothing flagged yet; false (status and reason set) when the inputs break the contract or there is
+/// nothing to test (Skipped: no features or no boxes).
+template <class T>
+bool coherent_start(std::size_t n, std::size_t nb, ArrayView<Vec2<T>> residuals, const CoherentMotionOptions<T>& options,
+                    const FeatureLabel* labels, FlagView in_object_mask, BoxBitsView object_box_bits,
+                    FlagView eligible, CoherentMotionResult<T>* out) {
+  CoherentMotionResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_cells_tested = r.num_cells_flagged = r.num_flagged = 0;
+  r.cells.clear();
+  auto stop = [&](Status s, std::string why) {
+    r.status = s;
+    r.reason = std::move(why);
+    return false;
+  };
+  std::string why;
+  if (options.validate(&why) != Status::Ok) return stop(Status::InvalidInput, "invalid options: " + why);
+  if (!residuals.given) return stop(Status::InvalidInput, "residuals is required (" + std::to_string(n) + " points)");
+  if (!flags_fit(residuals, n, "residuals", "points", &why) ||
+      !flags_fit(in_object_mask, n, "in_object_mask", "points", &why) ||
+      !flags_fit(object_box_bits, n, "object_box_bits", "points", &why) ||
+      !flags_fit(eligible, n, "eligible", "points", &why))
+    return stop(Status::InvalidInput, why);
+  r.cells.assign(nb * static_cast<std::size_t>(options.grid * options.grid), 0);
+  if (n == 0 || nb == 0) return stop(Status::Skipped, n == 0 ? "no features" : "no boxes");
+  if (!labels) return stop(Status::InvalidInput, "labels is required");
+  return true;
+}
+
+/// Counting sort of box b's object features that have a residual by grid cell (allocation-free):
+/// afterwards cell c's features are scratch_order[start[c - 1] .. start[c]) (from 0 for the first).
+template <class T, class Points>
+void sort_box_features_by_cell(const Points& points, ArrayView<Vec2<T>> residuals, const Box<T>& box, std::size_t b,
+                               int g, FlagView in_object_mask, BoxBitsView object_box_bits, FlagView eligible,
+                               CoherentMotionResult<T>* r) {
+  const std::size_t n = static_cast<std::size_t>(points.size()), cells = static_cast<std::size_t>(g * g);
+  std::uint32_t* start = r->scratch_start.data();
+  std::fill(start, start + cells + 1, 0u);
+  for (std::size_t i = 0; i < n; ++i) {
+    int c = -1;
+    if ((!eligible.given || eligible[i]) && subbox_in_object(in_object_mask, object_box_bits, i, b) &&
+        residuals[i].allFinite())
+      c = subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
+    r->scratch_cell[i] = static_cast<std::int8_t>(c);  // grid <= 8: cells 0-63
+    if (c >= 0) ++start[c + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  for (std::size_t i = 0; i < n; ++i) {
+    const int c = r->scratch_cell[i];
+    if (c >= 0) r->scratch_order[start[c]++] = static_cast<std::uint32_t>(i);
+  }
+}
+
+/// The cell's features move together: the median of their residual vectors is above min_median_px and
+/// `sigmas` standard errors of a median of static residuals (1.2533 noise / sqrt(count)).
+template <class T>
+bool cell_moves_coherently(ArrayView<Vec2<T>> residuals, std::uint32_t begin, std::uint32_t end,
+                           const CoherentMotionOptions<T>& options, CoherentMotionResult<T>* r) {
+  const std::size_t count = end - begin;
+  for (std::uint32_t k = begin; k < end; ++k) {
+    r->scratch_u[k - begin] = residuals[r->scratch_order[k]].x();
+    r->scratch_v[k - begin] = residuals[r->scratch_order[k]].y();
+  }
+  const auto median = [count](std::vector<T>& v) {
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(count / 2);
+    std::nth_element(v.begin(), mid, v.begin() + static_cast<std::ptrdiff_t>(count));
+    return *mid;
+  };
+  const T mu = median(r->scratch_u), mv = median(r->scratch_v);
+  const T magnitude = std::sqrt(mu * mu + mv * mv);
+  const T standard_error = T(1.2533) * r->noise_px / std::sqrt(static_cast<T>(count));
+  return magnitude > options.min_median_px && magnitude > options.sigmas * standard_error;
+}
+
+}  // namespace detail
+
 /// Flags the cells of each box whose features' residual vectors share a significant median, and turns
 /// their Static labels Dynamic (Candidate labels, features without evidence, stay). residuals[i]: measured
 /// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
@@ -99,89 +179,28 @@ void flag_coherent_cells(const Points& points, detail::NonDeduced<ArrayView<Vec2
   CoherentMotionResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
+  if (!detail::coherent_start(n, nb, residuals, options, labels, in_object_mask, object_box_bits, eligible, out))
+    return;
   const int g = options.grid;
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_cells_tested = r.num_cells_flagged = r.num_flagged = 0;
-  r.cells.clear();
-  std::string why;
-  if (options.validate(&why) != Status::Ok) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid options: " + why;
-    return;
-  }
-  if (!residuals.given) {
-    r.status = Status::InvalidInput;
-    r.reason = "residuals is required (" + std::to_string(n) + " points)";
-    return;
-  }
-  if (!detail::flags_fit(residuals, n, "residuals", "points", &why) ||
-      !detail::flags_fit(in_object_mask, n, "in_object_mask", "points", &why) ||
-      !detail::flags_fit(object_box_bits, n, "object_box_bits", "points", &why) ||
-      !detail::flags_fit(eligible, n, "eligible", "points", &why)) {
-    r.status = Status::InvalidInput;
-    r.reason = why;
-    return;
-  }
   const std::size_t cells_per_box = static_cast<std::size_t>(g * g);
-  r.cells.assign(nb * cells_per_box, 0);
-  if (n == 0 || nb == 0) {
-    r.status = Status::Skipped;
-    r.reason = n == 0 ? "no features" : "no boxes";
-    return;
-  }
-  if (!labels) {
-    r.status = Status::InvalidInput;
-    r.reason = "labels is required";
-    return;
-  }
   r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, options.min_noise_px) : options.min_noise_px;
   r.scratch_order.resize(n);
   r.scratch_cell.resize(n);
   r.scratch_start.resize(cells_per_box + 1);
   r.scratch_u.resize(n);
   r.scratch_v.resize(n);
-  std::uint32_t* start = r.scratch_start.data();
   for (std::size_t b = 0; b < nb; ++b) {
     const Box<T>& box = detail::subbox_as_box(boxes[b]);
     if (!box.valid()) continue;
-    // Counting sort of the box's object features with a residual by cell (allocation-free).
-    std::fill(start, start + cells_per_box + 1, 0u);
-    for (std::size_t i = 0; i < n; ++i) {
-      int c = -1;
-      if ((!eligible.given || eligible[i]) && detail::subbox_in_object(in_object_mask, object_box_bits, i, b) &&
-          residuals[i].allFinite())
-        c = detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
-      r.scratch_cell[i] = static_cast<std::int8_t>(c);  // grid <= 8: cells 0-63
-      if (c >= 0) ++start[c + 1];
-    }
-    for (std::size_t c = 0; c < cells_per_box; ++c) start[c + 1] += start[c];
-    for (std::size_t i = 0; i < n; ++i) {
-      const int c = r.scratch_cell[i];
-      if (c >= 0) r.scratch_order[start[c]++] = static_cast<std::uint32_t>(i);
-    }
-    // start[c] is now the end of cell c; cell c begins at start[c - 1] (0 for the first).
+    detail::sort_box_features_by_cell(points, residuals, box, b, g, in_object_mask, object_box_bits, eligible, &r);
     for (std::size_t c = 0; c < cells_per_box; ++c) {
-      const std::uint32_t begin = c == 0 ? 0u : start[c - 1], end = start[c];
-      const std::size_t count = end - begin;
-      if (count < options.min_points) continue;
+      const std::uint32_t begin = c == 0 ? 0u : r.scratch_start[c - 1], end = r.scratch_start[c];
+      if (end - begin < options.min_points) continue;
       ++r.num_cells_tested;
-      for (std::uint32_t k = begin; k < end; ++k) {
-        r.scratch_u[k - begin] = residuals[r.scratch_order[k]].x();
-        r.scratch_v[k - begin] = residuals[r.scratch_order[k]].y();
-      }
-      const auto median = [count](std::vector<T>& v) {
-        const auto mid = v.begin() + static_cast<std::ptrdiff_t>(count / 2);
-        std::nth_element(v.begin(), mid, v.begin() + static_cast<std::ptrdiff_t>(count));
-        return *mid;
-      };
-      const T mu = median(r.scratch_u), mv = median(r.scratch_v);
-      const T magnitude = std::sqrt(mu * mu + mv * mv);
-      const T standard_error = T(1.2533) * r.noise_px / std::sqrt(static_cast<T>(count));
-      if (!(magnitude > options.min_median_px && magnitude > options.sigmas * standard_error)) continue;
+      if (!detail::cell_moves_coherently(residuals, begin, end, options, &r)) continue;
       r.cells[b * cells_per_box + c] = 1;
       ++r.num_cells_flagged;
-      for (std::uint32_t k = begin; k < end; ++k) {
+      for (std::uint32_t k = begin; k < end; ++k) {  // Static turns Dynamic; Candidate (no evidence) stays
         FeatureLabel& l = labels[r.scratch_order[k]];
         if (l != FeatureLabel::Static) continue;
         l = FeatureLabel::Dynamic;
