@@ -270,6 +270,108 @@ void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometr
 }
 }  // namespace detail
 
+namespace detail {
+
+/// Algorithm 1's votes: every labelled feature counts (dynamic or static) in the cell of every box that
+/// contains it (boxes may overlap); with object_mask_votes_only, only in its own object's boxes.
+template <class T, class Points, class Boxes>
+void subbox_count_votes(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
+                        const SubBoxOptions<T>& options, std::size_t cells_per_box, FlagView in_object_mask,
+                        BoxBitsView object_box_bits, SubBoxResult<T>* r) {
+  const std::size_t n = static_cast<std::size_t>(points.size());
+  for (std::size_t b = 0; b < static_cast<std::size_t>(boxes.size()); ++b) {
+    const Box<T>& box = subbox_as_box(boxes[b]);
+    if (!box.valid()) {
+      ++r->num_invalid_boxes;
+      continue;
+    }
+    std::uint32_t* dc = r->dyn_count.data() + b * cells_per_box;
+    std::uint32_t* sc = r->static_count.data() + b * cells_per_box;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (options.object_mask_votes_only && !subbox_in_object(in_object_mask, object_box_bits, i, b)) continue;
+      const int c = subbox_cell(box, options.grid, point_x<T>(points[i]), point_y<T>(points[i]));
+      if (c < 0) continue;
+      if (geometric[i] == FeatureLabel::Dynamic) ++dc[c];
+      else if (geometric[i] == FeatureLabel::Static) ++sc[c];
+    }
+  }
+}
+
+/// Algorithm 1 line 14 in one pass against the voted states `st` (1 dynamic, 0 static, 2 empty), so
+/// merging never chains: a cell touching a voted dynamic one (4- or 8-neighbours) becomes dynamic when
+/// it is empty or its dynamic share reaches merge_ratio.
+template <class T>
+void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::uint32_t* sc,
+                  const SubBoxOptions<T>& options, std::uint8_t* cells, SubBoxVote* vote) {
+  const int g = options.grid;
+  for (int row = 0; row < g; ++row)
+    for (int col = 0; col < g; ++col) {
+      const std::size_t c = static_cast<std::size_t>(row * g + col);
+      if (st[c] == 1) {
+        cells[c] = 1;
+        continue;
+      }
+      bool touches = false;
+      for (int dr = -1; dr <= 1 && !touches; ++dr)
+        for (int dcol = -1; dcol <= 1 && !touches; ++dcol) {
+          if ((dr == 0 && dcol == 0) || (!options.merge_8_neighbours && dr != 0 && dcol != 0)) continue;
+          const int rr = row + dr, cc = col + dcol;
+          if (rr < 0 || cc < 0 || rr >= g || cc >= g) continue;
+          touches = st[static_cast<std::size_t>(rr * g + cc)] == 1;
+        }
+      const std::uint32_t total = dc[c] + sc[c];
+      const bool weak = st[c] == 2 || T(dc[c]) >= options.merge_ratio * T(total);
+      cells[c] = (touches && weak) ? 1 : 0;
+      vote->num_merged_cells += cells[c];
+    }
+}
+
+/// Algorithm 1's sigma2 rule: more than sigma2 dynamic cells make the whole box dynamic, except cells
+/// with at least whole_box_spare_min_points votes and a dynamic share of at most whole_box_spare_max_ratio.
+template <class T>
+void subbox_whole_box(const std::uint32_t* dc, const std::uint32_t* sc, const SubBoxOptions<T>& options,
+                      std::size_t cells_per_box, std::uint8_t* cells, SubBoxVote* vote) {
+  vote->whole_box = true;
+  for (std::size_t c = 0; c < cells_per_box; ++c) {
+    const std::uint32_t total = dc[c] + sc[c];
+    const bool spared = options.whole_box_spare_min_points > 0 && total >= options.whole_box_spare_min_points &&
+                        T(dc[c]) <= options.whole_box_spare_max_ratio * T(total);
+    cells[c] = spared ? 0 : 1;
+    vote->num_spared_cells += spared;
+  }
+  vote->num_dynamic_cells = static_cast<int>(cells_per_box) - vote->num_spared_cells;
+}
+
+/// Box b's cells: voted, merged, the whole box by sigma2, and with static_needs_evidence a static cell
+/// needs its own evidence (an empty cell, or one over static_max_dynamic_ratio dynamic, is dynamic).
+template <class T>
+void subbox_decide_cells(std::size_t b, std::size_t cells_per_box, const SubBoxOptions<T>& options,
+                         SubBoxResult<T>* r) {
+  std::uint8_t* cells = r->cells.data() + b * cells_per_box;
+  const std::uint32_t* dc = r->dyn_count.data() + b * cells_per_box;
+  const std::uint32_t* sc = r->static_count.data() + b * cells_per_box;
+  std::uint8_t st[64] = {};  // voted states; merging reads these, so it never chains
+  for (std::size_t c = 0; c < cells_per_box; ++c) st[c] = subbox_cell_vote(dc[c], sc[c], options);
+  SubBoxVote& vote = r->votes[b];
+  subbox_merge(st, dc, sc, options, cells, &vote);
+  for (std::size_t c = 0; c < cells_per_box; ++c) vote.num_dynamic_cells += cells[c];
+  if (vote.num_dynamic_cells > options.sigma2) {
+    subbox_whole_box(dc, sc, options, cells_per_box, cells, &vote);
+    ++r->num_whole_boxes;
+  }
+  if (options.static_needs_evidence && !vote.whole_box)
+    for (std::size_t c = 0; c < cells_per_box; ++c) {
+      if (cells[c]) continue;
+      const std::uint32_t total = dc[c] + sc[c];
+      if (st[c] == 2 || T(dc[c]) > options.static_max_dynamic_ratio * T(total)) {
+        cells[c] = 1;
+        ++vote.num_dynamic_cells;
+      }
+    }
+}
+
+}  // namespace detail
+
 /// Runs Algorithm 1 on every box, writing into `out` (buffers reused across frames).
 /// points: the features; geometric: their geometric labels (Dynamic / Static; Candidate = unlabelled,
 /// not counted; required, one per point); boxes: container of Box<T> or Detection<T> (the boxes to
@@ -289,86 +391,15 @@ void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, co
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
-  const int g = options.grid;
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
   if (!detail::subbox_geometric_fits(geometric, n, &r) ||
       !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r))
     return;
-  const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
-
-  // Votes: every labelled feature counts in every box containing it (boxes may overlap).
-  for (std::size_t b = 0; b < nb; ++b) {
-    const Box<T>& box = detail::subbox_as_box(boxes[b]);
-    if (!box.valid()) {
-      ++r.num_invalid_boxes;
-      continue;
-    }
-    std::uint32_t* dc = r.dyn_count.data() + b * cells_per_box;
-    std::uint32_t* sc = r.static_count.data() + b * cells_per_box;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (options.object_mask_votes_only && !detail::subbox_in_object(in_object_mask, object_box_bits, i, b)) continue;
-      const int c = detail::subbox_cell(box, g, point_x<T>(points[i]), point_y<T>(points[i]));
-      if (c < 0) continue;
-      if (geometric[i] == FeatureLabel::Dynamic) ++dc[c];
-      else if (geometric[i] == FeatureLabel::Static) ++sc[c];
-    }
-  }
-
-  // Cell states: 1 dynamic, 0 static with evidence, 2 empty (no evidence).
-  for (std::size_t b = 0; b < nb; ++b) {
-    if (!detail::subbox_as_box(boxes[b]).valid()) continue;
-    std::uint8_t* cells = r.cells.data() + b * cells_per_box;
-    const std::uint32_t* dc = r.dyn_count.data() + b * cells_per_box;
-    const std::uint32_t* sc = r.static_count.data() + b * cells_per_box;
-    std::uint8_t st[64];  // voted states; merging reads these, so it never chains
-    for (std::size_t c = 0; c < cells_per_box; ++c) st[c] = detail::subbox_cell_vote(dc[c], sc[c], options);
-    // Merge (Algorithm 1 line 14) in one pass against the voted dynamic cells, so merging does not chain.
-    SubBoxVote& vote = r.votes[b];
-    for (int row = 0; row < g; ++row)
-      for (int col = 0; col < g; ++col) {
-        const std::size_t c = static_cast<std::size_t>(row * g + col);
-        if (st[c] == 1) {
-          cells[c] = 1;
-          continue;
-        }
-        bool touches = false;
-        for (int dr = -1; dr <= 1 && !touches; ++dr)
-          for (int dcol = -1; dcol <= 1 && !touches; ++dcol) {
-            if ((dr == 0 && dcol == 0) || (!options.merge_8_neighbours && dr != 0 && dcol != 0)) continue;
-            const int rr = row + dr, cc = col + dcol;
-            if (rr < 0 || cc < 0 || rr >= g || cc >= g) continue;
-            touches = st[static_cast<std::size_t>(rr * g + cc)] == 1;
-          }
-        const std::uint32_t total = dc[c] + sc[c];
-        const bool weak = st[c] == 2 || T(dc[c]) >= options.merge_ratio * T(total);
-        cells[c] = (touches && weak) ? 1 : 0;
-        vote.num_merged_cells += cells[c];
-      }
-    for (std::size_t c = 0; c < cells_per_box; ++c) vote.num_dynamic_cells += cells[c];
-    if (vote.num_dynamic_cells > options.sigma2) {
-      vote.whole_box = true;
-      ++r.num_whole_boxes;
-      for (std::size_t c = 0; c < cells_per_box; ++c) {
-        const std::uint32_t total = dc[c] + sc[c];
-        const bool spared = options.whole_box_spare_min_points > 0 && total >= options.whole_box_spare_min_points &&
-                            T(dc[c]) <= options.whole_box_spare_max_ratio * T(total);
-        cells[c] = spared ? 0 : 1;
-        vote.num_spared_cells += spared;
-      }
-      vote.num_dynamic_cells = static_cast<int>(cells_per_box) - vote.num_spared_cells;
-    }
-    if (options.static_needs_evidence && !vote.whole_box)
-      for (std::size_t c = 0; c < cells_per_box; ++c) {
-        if (cells[c]) continue;
-        const std::uint32_t total = dc[c] + sc[c];
-        if (st[c] == 2 || T(dc[c]) > options.static_max_dynamic_ratio * T(total)) {
-          cells[c] = 1;
-          ++vote.num_dynamic_cells;
-        }
-      }
-  }
-
+  const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, options.grid);
+  detail::subbox_count_votes(points, geometric, boxes, options, cells_per_box, in_object_mask, object_box_bits, &r);
+  for (std::size_t b = 0; b < nb; ++b)
+    if (detail::subbox_as_box(boxes[b]).valid()) detail::subbox_decide_cells(b, cells_per_box, options, &r);
   detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
 }
