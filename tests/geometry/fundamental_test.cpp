@@ -254,6 +254,26 @@ TYPED_TEST(FundamentalTyped, CollinearAndDuplicatePointsAreRejected) {
   EXPECT_EQ(seven.count, 0);
 }
 
+TYPED_TEST(FundamentalTyped, NoBaselineIsDegenerateBeforeAnySample) {
+  using T = TypeParam;
+  // Every correspondence at the same pixel in both images: any F = [e]x fits, no 7-point sample can give a
+  // model, so the call says Degenerate without drawing the max_iterations samples that would all fail.
+  const auto d = make_two_view<T>(TwoViewOptions{});
+  const auto r = estimate_fundamental_ransac(d.points1, d.points1, FundamentalOptions<T>{});
+  EXPECT_EQ(r.status, Status::Degenerate);
+  EXPECT_NE(r.reason.find("no baseline"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.iterations, 0u);
+  EXPECT_EQ(r.num_inliers, 0u);
+  EXPECT_EQ(r.inlier_mask, std::vector<std::uint8_t>(d.points1.size(), 0));
+  // One correspondence that moved is enough for samples holding it to give a model (an F = [e]x through
+  // its two pixels, which every still one fits): RANSAC runs and finds it.
+  std::vector<Vec2<T>> moved = d.points1;
+  moved[0] += Vec2<T>(T(3), T(1));
+  const auto m = estimate_fundamental_ransac(d.points1, moved, FundamentalOptions<T>{});
+  EXPECT_GT(m.iterations, 0u);
+  EXPECT_EQ(m.reason.find("no baseline"), std::string::npos) << m.reason;
+}
+
 TYPED_TEST(FundamentalTyped, NonFiniteCorrespondencesAreSkipped) {
   using T = TypeParam;
   auto d = make_two_view<T>(TwoViewOptions{});

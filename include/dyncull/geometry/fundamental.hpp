@@ -460,6 +460,14 @@ class FundamentalEstimator {
 
   std::size_t num_data() const { return normalisable_ ? index_.size() : 0; }
   std::size_t num_input_finite() const { return index_.size(); }
+  /// False when every correspondence is at the same pixel in both images (a camera that did not move, and
+  /// nothing else did): every skew-symmetric F = [e]x fits them, so each 7-point sample has a null space of
+  /// dimension 3 and no sample can produce a model.
+  bool has_baseline() const {
+    for (std::size_t i = 0; i < ux1_.size(); ++i)
+      if (ux1_[i] != ux2_[i] || uy1_[i] != uy2_[i]) return true;
+    return false;
+  }
   std::uint32_t index(std::size_t i) const { return index_[i]; }
 
   int minimal_solve(const std::uint32_t* sample, Model* models) const {
@@ -741,7 +749,8 @@ FundamentalSolutions<T> fundamental_7point(const C1& points1, const C2& points2)
 
 /// LO-RANSAC estimate of F from corresponding containers (any point type with PointTraits).
 /// Status: Ok; TooFewPoints (< 7 finite correspondences); InvalidInput (size mismatch, bad options);
-/// Degenerate (no model, or one homography explains the inliers: F, mask and counts are still filled).
+/// Degenerate (no baseline: every correspondence at the same pixel in both images, found before any
+/// sample; no model; or one homography explains the inliers: F, mask and counts are still filled).
 /// Writes into `out`, reusing its buffers and the workspace's (the homography test, off in the culling
 /// stages, still allocates its own).
 template <class T, class C1, class C2>
@@ -770,6 +779,11 @@ void estimate_fundamental_ransac(const C1& points1, const C2& points2, const Fun
   if (est.num_data() == 0) {
     r.status = Status::Degenerate;
     r.reason = "all points coincide in one image";
+    return;
+  }
+  if (!est.has_baseline()) {  // every sample would fail in the solver: max_iterations of them, for nothing
+    r.status = Status::Degenerate;
+    r.reason = "no correspondence moved between the images (no baseline): F is not determined by the data";
     return;
   }
   RansacResult<Mat3<T>>& rr = workspace->ransac_result;
