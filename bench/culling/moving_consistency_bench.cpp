@@ -76,6 +76,28 @@ void BM_MovingConsistency_Dyncull(benchmark::State& state) {
 }
 BENCHMARK(BM_MovingConsistency_Dyncull)->Args({0, 0})->Args({2, 0})->Args({0, 1})->Args({2, 1})->Unit(benchmark::kMicrosecond);
 
+// A camera that did not move, with nothing moving in view: range(0) = 0 gives every track the same pixel in
+// both frames (no baseline: no 7-point sample can give a model), 1 gives them 0.25 px of noise at both ends
+// (nearly still: every F = [e]x fits within the noise). Counter `ransac_iterations` = samples drawn per call.
+void BM_MovingConsistency_StillCamera(benchmark::State& state) {
+  test::SceneConfig config;
+  config.static_camera = true;
+  config.walking = config.sitting = config.chair = false;
+  config.num_uniform = 760;
+  config.pixel_noise = state.range(0) == 0 ? 0.0 : 0.25;
+  const auto scene = test::make_culling_scene<float>(config);
+  const MovingConsistencyOptions<float> o;
+  MovingConsistencyResult<float> r;
+  for (auto _ : state) {
+    check_moving_consistency(scene.prev_keypoints, scene.keypoints, o, &r, scene.track_valid);
+    benchmark::DoNotOptimize(r.labels.data());
+  }
+  state.counters["ransac_iterations"] = double(r.ransac_iterations);
+  state.counters["degenerate"] = r.status == Status::Degenerate;
+  state.counters["tracks"] = double(r.num_valid);
+}
+BENCHMARK(BM_MovingConsistency_StillCamera)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 // The floor: F-RANSAC on all valid tracks plus one batch eq. 3 pass (what the check must not exceed by 1.2x).
 void BM_MovingConsistency_PartsFloor(benchmark::State& state) {
   const Data& d = data();

@@ -20,5 +20,15 @@ template FundamentalResult<double> estimate_fundamental_ransac(const std::vector
 template FundamentalResult<float> fundamental_8point(const std::vector<Vec2<float>>&, const std::vector<Vec2<float>>&);
 template FundamentalResult<double> fundamental_8point(const std::vector<Vec2<double>>&,
                                                       const std::vector<Vec2<double>>&);
+template void estimate_fundamental_ransac(const std::vector<Vec2<float>>&, const std::vector<Vec2<float>>&,
+                                          const FundamentalOptions<float>&, FundamentalWorkspace<float>*,
+                                          FundamentalResult<float>*);
+template void estimate_fundamental_ransac(const std::vector<Vec2<double>>&, const std::vector<Vec2<double>>&,
+                                          const FundamentalOptions<double>&, FundamentalWorkspace<double>*,
+                                          FundamentalResult<double>*);
+template void fundamental_8point(const std::vector<Vec2<float>>&, const std::vector<Vec2<float>>&,
+                                 FundamentalWorkspace<float>*, FundamentalResult<float>*);
+template void fundamental_8point(const std::vector<Vec2<double>>&, const std::vector<Vec2<double>>&,
+                                 FundamentalWorkspace<double>*, FundamentalResult<double>*);
 
 }  // namespace dyncull

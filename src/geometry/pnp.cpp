@@ -15,5 +15,11 @@ template PnpResult<float> solve_pnp_ransac(const std::vector<Vec3<float>>&, cons
                                            const PinholeCamera<float>&, const PnpOptions<float>&);
 template PnpResult<double> solve_pnp_ransac(const std::vector<Vec3<double>>&, const std::vector<Vec2<double>>&,
                                             const PinholeCamera<double>&, const PnpOptions<double>&);
+template void solve_pnp_ransac(const std::vector<Vec3<float>>&, const std::vector<Vec2<float>>&,
+                               const PinholeCamera<float>&, const PnpOptions<float>&, PnpWorkspace<float>*,
+                               PnpResult<float>*);
+template void solve_pnp_ransac(const std::vector<Vec3<double>>&, const std::vector<Vec2<double>>&,
+                               const PinholeCamera<double>&, const PnpOptions<double>&, PnpWorkspace<double>*,
+                               PnpResult<double>*);
 
 }  // namespace dyncull

@@ -10,6 +10,7 @@
 #include <string>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -253,6 +254,26 @@ TYPED_TEST(FundamentalTyped, CollinearAndDuplicatePointsAreRejected) {
   EXPECT_EQ(seven.count, 0);
 }
 
+TYPED_TEST(FundamentalTyped, NoBaselineIsDegenerateBeforeAnySample) {
+  using T = TypeParam;
+  // Every correspondence at the same pixel in both images: any F = [e]x fits, no 7-point sample can give a
+  // model, so the call says Degenerate without drawing the max_iterations samples that would all fail.
+  const auto d = make_two_view<T>(TwoViewOptions{});
+  const auto r = estimate_fundamental_ransac(d.points1, d.points1, FundamentalOptions<T>{});
+  EXPECT_EQ(r.status, Status::Degenerate);
+  EXPECT_NE(r.reason.find("no baseline"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.iterations, 0u);
+  EXPECT_EQ(r.num_inliers, 0u);
+  EXPECT_EQ(r.inlier_mask, std::vector<std::uint8_t>(d.points1.size(), 0));
+  // One correspondence that moved is enough for samples holding it to give a model (an F = [e]x through
+  // its two pixels, which every still one fits): RANSAC runs and finds it.
+  std::vector<Vec2<T>> moved = d.points1;
+  moved[0] += Vec2<T>(T(3), T(1));
+  const auto m = estimate_fundamental_ransac(d.points1, moved, FundamentalOptions<T>{});
+  EXPECT_GT(m.iterations, 0u);
+  EXPECT_EQ(m.reason.find("no baseline"), std::string::npos) << m.reason;
+}
+
 TYPED_TEST(FundamentalTyped, NonFiniteCorrespondencesAreSkipped) {
   using T = TypeParam;
   auto d = make_two_view<T>(TwoViewOptions{});
@@ -269,6 +290,55 @@ TYPED_TEST(FundamentalTyped, NonFiniteCorrespondencesAreSkipped) {
   EXPECT_EQ(estimate_fundamental_ransac(bad, bad, FundamentalOptions<T>{}).status, Status::TooFewPoints);
   EXPECT_EQ(fundamental_7point(bad, bad).status, Status::NonFinite);
   EXPECT_EQ(fundamental_8point(bad, bad).status, Status::TooFewPoints);
+}
+
+/// Inputs of different sizes and outcomes in turn (large, small with NaN, all coincident, medium): a workspace
+/// kept across them must not carry anything from one call into the next.
+template <class T>
+std::vector<TwoViewData<T>> varied_inputs() {
+  std::vector<TwoViewData<T>> out;
+  TwoViewOptions o;
+  out.push_back(make_two_view<T>(o));
+  o.num_points = 60;
+  o.seed = 7;
+  out.push_back(make_two_view<T>(o));
+  out.back().points1[3].x() = std::numeric_limits<T>::quiet_NaN();
+  TwoViewData<T> same = out.back();
+  for (auto& p : same.points1) p = Vec2<T>(T(5), T(6));
+  out.push_back(same);
+  o.num_points = 300;
+  o.seed = 8;
+  out.push_back(make_two_view<T>(o));
+  return out;
+}
+
+template <class T>
+void expect_same_result(const FundamentalResult<T>& kept, const FundamentalResult<T>& fresh, std::size_t call) {
+  EXPECT_EQ(kept.status, fresh.status) << "call " << call;
+  EXPECT_EQ(kept.reason, fresh.reason) << "call " << call;
+  EXPECT_TRUE(kept.F == fresh.F) << "call " << call;  // bit for bit
+  EXPECT_EQ(kept.inlier_mask, fresh.inlier_mask) << "call " << call;
+  EXPECT_EQ(kept.num_inliers, fresh.num_inliers) << "call " << call;
+  EXPECT_EQ(kept.iterations, fresh.iterations) << "call " << call;
+  EXPECT_EQ(kept.score, fresh.score) << "call " << call;
+}
+
+TYPED_TEST(FundamentalTyped, KeptWorkspaceGivesTheFreshResultWhateverCameBefore) {
+  using T = TypeParam;
+  const std::vector<TwoViewData<T>> inputs = varied_inputs<T>();
+  FundamentalOptions<T> fo;
+  FundamentalWorkspace<T> workspace;
+  FundamentalResult<T> ransac_kept, eight_kept;
+  for (int round = 0; round < 2; ++round) {
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      const TwoViewData<T>& d = inputs[k];
+      estimate_fundamental_ransac(d.points1, d.points2, fo, &workspace, &ransac_kept);
+      expect_same_result(ransac_kept, estimate_fundamental_ransac(d.points1, d.points2, fo), k);
+      fundamental_8point(d.points1, d.points2, &workspace, &eight_kept);
+      expect_same_result(eight_kept, fundamental_8point(d.points1, d.points2), k);
+    }
+  }
+  EXPECT_EQ(ransac_kept.status, Status::Ok);  // the last input is an ordinary one
 }
 
 TYPED_TEST(FundamentalTyped, BadOptions) {

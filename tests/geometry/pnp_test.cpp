@@ -155,6 +155,34 @@ TYPED_TEST(PnpTest, RansacDeterministicForSeed) {
   EXPECT_EQ(a.iterations, b.iterations);
 }
 
+TYPED_TEST(PnpTest, KeptWorkspaceGivesTheFreshResultWhateverCameBefore) {
+  using T = TypeParam;
+  // Sizes and outcomes in turn (large, too few points, small, medium): nothing may carry over.
+  std::vector<dyncull::test::PnpScene<T>> scenes = {make_pnp_scene<T>(46, 1000, 0.5, 0.3),
+                                                    make_pnp_scene<T>(47, 3, 0.5, 0.0),
+                                                    make_pnp_scene<T>(48, 40, 0.5, 0.2),
+                                                    make_pnp_scene<T>(49, 300, 0.5, 0.4)};
+  PnpOptions<T> o;
+  dyncull::PnpWorkspace<T> workspace;
+  dyncull::PnpResult<T> kept;
+  for (int round = 0; round < 2; ++round) {
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+      const auto& s = scenes[k];
+      dyncull::solve_pnp_ransac(s.world, s.pixels, s.camera, o, &workspace, &kept);
+      const auto fresh = dyncull::solve_pnp_ransac(s.world, s.pixels, s.camera, o);
+      EXPECT_EQ(kept.status, fresh.status) << "scene " << k;
+      EXPECT_EQ(kept.reason, fresh.reason) << "scene " << k;
+      EXPECT_EQ(kept.cam_from_world.R, fresh.cam_from_world.R) << "scene " << k;  // bit for bit
+      EXPECT_EQ(kept.cam_from_world.t, fresh.cam_from_world.t) << "scene " << k;
+      EXPECT_EQ(kept.inlier_mask, fresh.inlier_mask) << "scene " << k;
+      EXPECT_EQ(kept.num_inliers, fresh.num_inliers) << "scene " << k;
+      EXPECT_EQ(kept.iterations, fresh.iterations) << "scene " << k;
+      EXPECT_EQ(kept.rmse_px, fresh.rmse_px) << "scene " << k;
+    }
+  }
+  EXPECT_EQ(kept.status, Status::Ok);  // the last scene is an ordinary one
+}
+
 TYPED_TEST(PnpTest, HuberRefinementResistsOutliers) {
   using T = TypeParam;
   auto s = make_pnp_scene<T>(45, 200, 0.5, 0.0);

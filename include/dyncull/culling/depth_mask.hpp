@@ -215,6 +215,7 @@ struct DepthBand {
 /// Scratch of depth_mask kept by a caller that runs it every frame.
 struct DepthMaskScratch {
   std::vector<detail::DepthBand> bands;  ///< per box, its depth band
+  std::vector<std::uint32_t> histogram;  ///< the histogram fallback's and the occluded-centre search's bins
 };
 
 namespace detail {
@@ -683,22 +684,32 @@ void set_band_threshold(const RawRange<Raw>& range, double thr_raw, double upm, 
   if (integral) band->hi = std::ceil(band->hi);
 }
 
-/// Threshold and band of one box (no raster). Returns the info; `band` receives the predicate.
+/// Every field of `info` back to its default, its reason's buffer kept (no allocation for the next text).
+inline void reset_box_info(DepthMaskBoxInfo* info) {
+  std::string reason = std::move(info->reason);
+  reason.clear();
+  *info = DepthMaskBoxInfo{};
+  info->reason = std::move(reason);
+}
+
+/// Threshold and band of one box (no raster) into `out` (its reason's buffer reused); `band` receives the
+/// predicate. `histogram`: scratch of the histogram fallback.
 template <class Raw, class T>
-DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>& box,
-                          const DepthMaskOptions& o, DepthBand* band) {
-  DepthMaskBoxInfo info;
+void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>& box, const DepthMaskOptions& o,
+              std::vector<std::uint32_t>* histogram, DepthMaskBoxInfo* out, DepthBand* band) {
+  DepthMaskBoxInfo& info = *out;
+  reset_box_info(&info);
   *band = DepthBand{};
   if (!box.valid()) {
     info.status = Status::InvalidInput;
     info.reason = "box is non-finite or inverted";
-    return info;
+    return;
   }
   info.rect = pixel_rect(box, v.width, v.height);
   if (info.rect.empty()) {
     info.status = Status::Skipped;
     info.reason = "box has no pixel inside the image";
-    return info;
+    return;
   }
   const PixelRect& rc = info.rect;
   const double upm = static_cast<double>(v.units_per_metre);
@@ -748,7 +759,7 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     else if (dc > 0) set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
     else whole_box();
     info.masks_missing = band->missing == MissingDepth::InMask || band->all;
-    return info;
+    return;
   }
 
   const double e = eps_raw(o.eps_m);
@@ -768,7 +779,8 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     // mostly fall in the same bin, so a single histogram serialises on its own increments (store to
     // load forwarding); four interleaved copies, summed afterwards, let them overlap.
     const std::size_t nh = static_cast<std::size_t>(nb) + 1;
-    std::vector<std::uint32_t> hist4(4 * nh, 0u);
+    std::vector<std::uint32_t>& hist4 = *histogram;
+    hist4.assign(4 * nh, 0u);
     int step = o.histogram_stride_px;
     if (step <= 0) {
       const double per_sample = static_cast<double>(rc.area()) / std::max(1, o.histogram_target_samples);
@@ -838,14 +850,15 @@ DepthMaskBoxInfo plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, c
     }
   }
   info.masks_missing = band->missing == MissingDepth::InMask || band->all;
-  return info;
+  return;
 }
 
 /// DepthMaskOptions::occluded_centre_search for box b against box a (both planned). Returns true and
 /// moves b's threshold when b's centre depth belongs to a's object.
 template <class Raw>
 bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range, const DepthMaskOptions& o,
-                            const DepthMaskBoxInfo& a, DepthMaskBoxInfo* b, DepthBand* band) {
+                            const DepthMaskBoxInfo& a, std::vector<std::uint32_t>* histogram, DepthMaskBoxInfo* b,
+                            DepthBand* band) {
   const PixelRect& rb = b->rect;
   const PixelRect& ra = a.rect;
   const int cu = (rb.c0 + rb.c1 - 1) / 2, cv = (rb.r0 + rb.r1 - 1) / 2;
@@ -855,7 +868,8 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
   const double upm = static_cast<double>(v.units_per_metre);
   const double bin_m = std::max(o.histogram_bin_m, 1e-3);
   const int nb = clamped_int(std::ceil(o.histogram_max_m / bin_m), 3, std::numeric_limits<int>::max());
-  std::vector<std::uint32_t> hist(static_cast<std::size_t>(nb), 0u);
+  std::vector<std::uint32_t>& hist = *histogram;
+  hist.assign(static_cast<std::size_t>(nb), 0u);
   const double per_sample = static_cast<double>(rb.area()) / std::max(1, o.histogram_target_samples);
   const int step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
   std::size_t valid = 0, near_centre = 0;
@@ -945,7 +959,8 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
   if (!detail::depth_mask_inputs_valid(depth, options, &info.status, &info.reason)) return info;
   const auto range = detail::valid_raw_range(depth);
   detail::DepthBand band;
-  info = detail::plan_box(depth, range, box, options, &band);
+  std::vector<std::uint32_t> histogram;
+  detail::plan_box(depth, range, box, options, &histogram, &info, &band);
   if (info.ok() && !out.empty())
     info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, band, options.mask_value, out);
   return info;
@@ -956,8 +971,8 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
 /// Non-finite points are Dynamic (InvalidInput). Bad boxes are reported per box; the call fails
 /// only when the depth image is missing (Skipped), or the mask has the wrong size, the depth view or
 /// the options do not pass their validate() (InvalidInput; every point then stays Static).
-/// This form writes into `*result` and reuses its and `*scratch`'s buffers (no allocation once warm,
-/// apart from the per-box reason texts of boxes the plain rule does not fit).
+/// This form writes into `*result` and reuses its and `*scratch`'s buffers (no allocation once warm at the
+/// largest box count).
 template <class Raw, class Boxes, class Points>
 void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& points, const DepthMaskOptions& options,
                 DepthMaskResult* result, DepthMaskScratch* scratch, MaskView out = {}) {
@@ -965,7 +980,6 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
   DepthMaskResult& r = *result;
   r.status = Status::Ok;
   r.reason.clear();
-  r.boxes.clear();
   r.num_static = r.num_candidate = r.num_dynamic = r.num_in_boxes = r.num_mask_pixels = 0;
   const std::size_t n = points.size();
   r.labels.assign(n, FeatureLabel::Static);
@@ -973,24 +987,29 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
   r.box_index.assign(n, -1);
   r.box_bits.assign(n, 0u);
   if (depth.empty()) {
+    r.boxes.clear();
     r.status = Status::Skipped;
     r.reason.assign("no depth image");
     return;
   }
   if (!out.empty() && (out.width != depth.width || out.height != depth.height)) {
+    r.boxes.clear();
     r.status = Status::InvalidInput;
     r.reason.assign("mask size differs from the depth image");
     return;
   }
-  if (!detail::depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) return;
+  if (!detail::depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) {
+    r.boxes.clear();
+    return;
+  }
   const auto range = detail::valid_raw_range(depth);
   std::vector<detail::DepthBand>& bands = scratch->bands;
   bands.assign(boxes.size(), detail::DepthBand{});
-  r.boxes.reserve(boxes.size());
+  r.boxes.resize(boxes.size());  // the kept elements' reason buffers are reused
   std::size_t bad = 0;
   for (std::size_t b = 0; b < boxes.size(); ++b) {
-    r.boxes.push_back(detail::plan_box(depth, range, detail::as_box(boxes[b]), options, &bands[b]));
-    if (!r.boxes.back().ok()) ++bad;
+    detail::plan_box(depth, range, detail::as_box(boxes[b]), options, &scratch->histogram, &r.boxes[b], &bands[b]);
+    if (!r.boxes[b].ok()) ++bad;
   }
   if (options.occluded_centre_search && options.mode == DepthMaskMode::Robust &&
       options.form == DepthThresholdForm::DldSlam) {
@@ -998,7 +1017,8 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
       if (!r.boxes[b].ok() || r.boxes[b].outcome == DepthMaskOutcome::WholeBox) continue;
       for (std::size_t a = 0; a < r.boxes.size(); ++a) {
         if (a == b || !r.boxes[a].ok()) continue;
-        if (detail::replan_occluded_centre(depth, range, options, r.boxes[a], &r.boxes[b], &bands[b])) break;
+        if (detail::replan_occluded_centre(depth, range, options, r.boxes[a], &scratch->histogram, &r.boxes[b],
+                                           &bands[b])) break;
       }
     }
   }

@@ -85,11 +85,13 @@ struct MovingConsistencyResult {
   std::size_t ransac_iterations = 0;
   bool fitted_outside_boxes = false;  ///< the SG-SLAM subset was used for F
 
-  // Scratch reused across frames (compacted tracks); not part of the result's meaning.
+  // Scratch reused across frames (compacted tracks, the F fits); not part of the result's meaning.
   std::vector<Vec2<T>> scratch_prev, scratch_cur, scratch_fit_prev, scratch_fit_cur, scratch_refit_prev,
       scratch_refit_cur;
   std::vector<std::uint32_t> scratch_index, scratch_fit_index;
   std::vector<T> scratch_distance;
+  FundamentalWorkspace<T> scratch_fundamental;
+  FundamentalResult<T> scratch_ransac_fit, scratch_polished_fit;
 };
 
 /// Runs the check on n tracks prev[i] -> cur[i] (any point containers of equal size), writing into `out`
@@ -154,7 +156,7 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
   }
   const bool subset =
       in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes && outside < m;
-  FundamentalResult<T> fr;
+  FundamentalResult<T>& fr = r.scratch_ransac_fit;
   if (subset) {
     r.scratch_fit_prev.clear();
     r.scratch_fit_cur.clear();
@@ -165,12 +167,13 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
       r.scratch_fit_cur.push_back(r.scratch_cur[k]);
       r.scratch_fit_index.push_back(r.scratch_index[k]);
     }
-    fr = estimate_fundamental_ransac(r.scratch_fit_prev, r.scratch_fit_cur, options.fundamental);
+    estimate_fundamental_ransac(r.scratch_fit_prev, r.scratch_fit_cur, options.fundamental, &r.scratch_fundamental,
+                                &fr);
     r.fitted_outside_boxes = true;
     r.num_fit = r.scratch_fit_index.size();
     for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r.inlier_mask[r.scratch_fit_index[k]] = fr.inlier_mask[k];
   } else {
-    fr = estimate_fundamental_ransac(r.scratch_prev, r.scratch_cur, options.fundamental);
+    estimate_fundamental_ransac(r.scratch_prev, r.scratch_cur, options.fundamental, &r.scratch_fundamental, &fr);
     r.num_fit = m;
     for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r.inlier_mask[r.scratch_index[k]] = fr.inlier_mask[k];
   }
@@ -181,7 +184,7 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
     // Degenerate = one homography explains the tracks (static camera, pure rotation, planar scene):
     // F is not determined, so its epipolar lines carry no evidence of motion.
     r.status = fr.status;
-    r.reason = std::string("fundamental matrix not usable: ") + fr.reason;
+    r.reason.assign("fundamental matrix not usable: ").append(fr.reason);  // into the kept buffer
     for (auto& m8 : r.inlier_mask) m8 = 0;
     r.num_inliers = 0;
     return;
@@ -201,7 +204,8 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
       r.scratch_refit_cur.push_back(fit_cur[k]);
     }
     if (r.scratch_refit_prev.size() < 16) break;
-    const FundamentalResult<T> polished = fundamental_8point(r.scratch_refit_prev, r.scratch_refit_cur);
+    FundamentalResult<T>& polished = r.scratch_polished_fit;
+    fundamental_8point(r.scratch_refit_prev, r.scratch_refit_cur, &r.scratch_fundamental, &polished);
     if (!polished.ok()) break;
     r.F = polished.F;
   }

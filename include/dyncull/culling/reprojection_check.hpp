@@ -129,11 +129,13 @@ struct ReprojectionCheckResult {
   std::size_t num_depth_dynamic = 0;  ///< dynamic by the depth residual while the pixel residual was within its limit
   bool fitted_outside_boxes = false;
 
-  // Scratch reused across frames; not part of the result's meaning.
+  // Scratch reused across frames (compacted tracks, the pose fit); not part of the result's meaning.
   std::vector<Vec3<T>> scratch_points;
   std::vector<Vec2<T>> scratch_pixels;
   std::vector<std::uint32_t> scratch_index;
   std::vector<T> scratch_values;
+  PnpWorkspace<T> scratch_pnp;
+  PnpResult<T> scratch_pose_fit;
 };
 
 /// Runs the check on n tracks: points[i] is the 3-D point of track i in any fixed frame (world, or the
@@ -226,10 +228,11 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
   }
   r.fitted_outside_boxes = subset;
   r.num_fit = r.scratch_index.size();
-  const PnpResult<T> pr = solve_pnp_ransac(r.scratch_points, r.scratch_pixels, camera, options.pnp);
+  PnpResult<T>& pr = r.scratch_pose_fit;
+  solve_pnp_ransac(r.scratch_points, r.scratch_pixels, camera, options.pnp, &r.scratch_pnp, &pr);
   if (!pr.ok() || !pr.cam_from_world.all_finite()) {
     r.status = pr.ok() ? Status::NonFinite : pr.status;
-    r.reason = std::string("pose not found: ") + (pr.ok() ? "non-finite pose" : pr.reason);
+    r.reason.assign("pose not found: ").append(pr.ok() ? "non-finite pose" : pr.reason);  // into the kept buffer
     return;
   }
   r.cam_from_world = pr.cam_from_world;

@@ -432,35 +432,42 @@ class FundamentalEstimator {
   static constexpr int kSampleSize = 7;
   static constexpr int kMaxModels = 3;
 
+  FundamentalEstimator() = default;
   template <class C1, class C2>
-  FundamentalEstimator(const C1& points1, const C2& points2, bool sampson_weighted_refit = true)
-      : weighted_(sampson_weighted_refit) {
+  FundamentalEstimator(const C1& points1, const C2& points2, bool sampson_weighted_refit = true) {
+    load(points1, points2, sampson_weighted_refit);
+  }
+
+  /// Takes the finite correspondences of points1 / points2, reusing this estimator's buffers (they only
+  /// grow), so an estimator kept across calls allocates nothing once it has held the largest input.
+  template <class C1, class C2>
+  void load(const C1& points1, const C2& points2, bool sampson_weighted_refit = true) {
+    weighted_ = sampson_weighted_refit;
     const std::size_t n = std::min<std::size_t>(points1.size(), points2.size());
-    px1_.reserve(n), py1_.reserve(n), px2_.reserve(n), py2_.reserve(n), index_.reserve(n);
-    std::vector<double> ux1, uy1, ux2, uy2;
-    ux1.reserve(n), uy1.reserve(n), ux2.reserve(n), uy2.reserve(n);
+    for (auto* v : {&px1_, &py1_, &px2_, &py2_}) v->clear(), v->reserve(n);
+    for (auto* v : {&ux1_, &uy1_, &ux2_, &uy2_}) v->clear(), v->reserve(n);
+    index_.clear(), index_.reserve(n);
     for (std::size_t i = 0; i < n; ++i) {
       const double a = point_x<double>(points1[i]), b = point_y<double>(points1[i]);
       const double c = point_x<double>(points2[i]), d = point_y<double>(points2[i]);
       if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(c) || !std::isfinite(d)) continue;
-      ux1.push_back(a), uy1.push_back(b), ux2.push_back(c), uy2.push_back(d);
+      ux1_.push_back(a), uy1_.push_back(b), ux2_.push_back(c), uy2_.push_back(d);
       px1_.push_back(float(a)), py1_.push_back(float(b)), px2_.push_back(float(c)), py2_.push_back(float(d));
       index_.push_back(static_cast<std::uint32_t>(i));
     }
-    const std::size_t m = index_.size();
-    normalisable_ = detail::make_normaliser(ux1.data(), uy1.data(), m, &n1_) &&
-                    detail::make_normaliser(ux2.data(), uy2.data(), m, &n2_);
-    nx1_.resize(m), ny1_.resize(m), nx2_.resize(m), ny2_.resize(m);
-    for (std::size_t i = 0; i < m; ++i) {
-      nx1_[i] = n1_.s * (ux1[i] - n1_.cx), ny1_[i] = n1_.s * (uy1[i] - n1_.cy);
-      nx2_[i] = n2_.s * (ux2[i] - n2_.cx), ny2_[i] = n2_.s * (uy2[i] - n2_.cy);
-    }
-    weights_.resize(m);
-    rows_.resize(9, static_cast<Eigen::Index>(m));
+    normalise();
   }
 
   std::size_t num_data() const { return normalisable_ ? index_.size() : 0; }
   std::size_t num_input_finite() const { return index_.size(); }
+  /// False when every correspondence is at the same pixel in both images (a camera that did not move, and
+  /// nothing else did): every skew-symmetric F = [e]x fits them, so each 7-point sample has a null space of
+  /// dimension 3 and no sample can produce a model.
+  bool has_baseline() const {
+    for (std::size_t i = 0; i < ux1_.size(); ++i)
+      if (ux1_[i] != ux2_[i] || uy1_[i] != uy2_[i]) return true;
+    return false;
+  }
   std::uint32_t index(std::size_t i) const { return index_[i]; }
 
   int minimal_solve(const std::uint32_t* sample, Model* models) const {
@@ -600,7 +607,7 @@ class FundamentalEstimator {
   }
 
  private:
-  bool weighted_;
+  bool weighted_ = true;
   bool normalisable_ = false;
   detail::Normaliser n1_, n2_;
   std::vector<float> px1_, py1_, px2_, py2_;     // pixels, for residuals (float: see residuals_sq)
@@ -608,32 +615,75 @@ class FundamentalEstimator {
   std::vector<double> nx1_, ny1_, nx2_, ny2_;    // Hartley-normalised, for the solvers
   std::vector<std::uint32_t> index_;
   mutable std::vector<double> weights_;          // refit scratch, sized once
-  mutable detail::RowsMatrix rows_;              // refit scratch (9 x n), sized once
+  mutable detail::RowsMatrix rows_;              // refit scratch (9 x n or wider), grown only
+  std::vector<double> ux1_, uy1_, ux2_, uy2_;    // pixels in double, the normaliser's input
+
+  void normalise() {
+    const std::size_t m = index_.size();
+    n1_ = n2_ = detail::Normaliser{};
+    normalisable_ = detail::make_normaliser(ux1_.data(), uy1_.data(), m, &n1_) &&
+                    detail::make_normaliser(ux2_.data(), uy2_.data(), m, &n2_);
+    nx1_.resize(m), ny1_.resize(m), nx2_.resize(m), ny2_.resize(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      nx1_[i] = n1_.s * (ux1_[i] - n1_.cx), ny1_[i] = n1_.s * (uy1_[i] - n1_.cy);
+      nx2_[i] = n2_.s * (ux2_[i] - n2_.cx), ny2_[i] = n2_.s * (uy2_[i] - n2_.cy);
+    }
+    weights_.resize(m);
+    // Eigen reallocates on any change of size: grow only (the 8-point uses the leading columns).
+    if (rows_.cols() < static_cast<Eigen::Index>(m)) rows_.resize(9, static_cast<Eigen::Index>(m));
+  }
 };
+
+/// Buffers F estimation reuses from call to call: a caller that keeps one across frames (with the result it
+/// writes into) allocates nothing once they have held the largest input, failures' reasons aside.
+template <class T>
+struct FundamentalWorkspace {
+  FundamentalEstimator<T> estimator;
+  RansacWorkspace<T> ransac;
+  RansacResult<Mat3<T>> ransac_result;
+  std::vector<std::uint32_t> indices;  // the estimator's data taken by a fit (all, or the inliers)
+};
+
+namespace detail {
+/// Clears every field of `r` (keeping its buffers) and sizes its mask to n zeros.
+template <class T>
+void reset_fundamental_result(std::size_t n, FundamentalResult<T>* r) {
+  r->status = Status::Ok;
+  r->reason.clear();
+  r->F.setZero();
+  r->inlier_mask.assign(n, 0);
+  r->num_inliers = r->iterations = 0;
+  r->score = r->homography_inlier_fraction = 0;
+}
+}  // namespace detail
 
 /// Normalised 8-point algorithm on all correspondences (least squares, rank 2 enforced). Non-finite
 /// correspondences are skipped; fewer than 8 usable ones give TooFewPoints, a non-unique solution Degenerate.
-template <class C1, class C2, class T = typename PointTraits<container_point_t<C1>>::Scalar>
-FundamentalResult<T> fundamental_8point(const C1& points1, const C2& points2) {
-  FundamentalResult<T> r;
-  r.inlier_mask.assign(points1.size(), 0);
+/// Writes into `out`, reusing its buffers and the workspace's.
+template <class T, class C1, class C2>
+void fundamental_8point(const C1& points1, const C2& points2, FundamentalWorkspace<T>* workspace,
+                        FundamentalResult<T>* out) {
+  FundamentalResult<T>& r = *out;
+  detail::reset_fundamental_result(points1.size(), &r);
   if (points1.size() != points2.size()) {
     r.status = Status::InvalidInput;
     r.reason = "points1 and points2 differ in size";
-    return r;
+    return;
   }
-  FundamentalEstimator<T> est(points1, points2, false);
+  FundamentalEstimator<T>& est = workspace->estimator;
+  est.load(points1, points2, false);
   if (est.num_input_finite() < 8) {
     r.status = Status::TooFewPoints;
     r.reason = std::to_string(est.num_input_finite()) + " finite correspondences, the 8-point algorithm needs 8";
-    return r;
+    return;
   }
   if (est.num_data() == 0) {
     r.status = Status::Degenerate;
     r.reason = "all points coincide in one image";
-    return r;
+    return;
   }
-  std::vector<std::uint32_t> all(est.num_data());
+  std::vector<std::uint32_t>& all = workspace->indices;
+  all.resize(est.num_data());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
   // Reuse the estimator's normalised arrays through an unweighted refit.
   Mat3<T> F = Mat3<T>::Zero();
@@ -641,16 +691,24 @@ FundamentalResult<T> fundamental_8point(const C1& points1, const C2& points2) {
     r.status = Status::Degenerate;
     r.reason = "correspondences do not determine F (null space of dimension >= 2: duplicate or collinear "
                "points, or a planar scene / pure rotation without noise)";
-    return r;
+    return;
   }
   if (!F.allFinite()) {  // wild but finite coordinates can still defeat the solver
     r.status = Status::Degenerate;
     r.reason = "the 8-point solve produced a non-finite F (coordinates too large or too small)";
-    return r;
+    return;
   }
   r.F = F;
   for (std::size_t i = 0; i < est.num_data(); ++i) r.inlier_mask[est.index(i)] = 1;
   r.num_inliers = est.num_data();
+}
+
+/// Convenience overload with its own workspace and a fresh result.
+template <class C1, class C2, class T = typename PointTraits<container_point_t<C1>>::Scalar>
+FundamentalResult<T> fundamental_8point(const C1& points1, const C2& points2) {
+  FundamentalWorkspace<T> workspace;
+  FundamentalResult<T> r;
+  fundamental_8point(points1, points2, &workspace, &r);
   return r;
 }
 
@@ -691,48 +749,58 @@ FundamentalSolutions<T> fundamental_7point(const C1& points1, const C2& points2)
 
 /// LO-RANSAC estimate of F from corresponding containers (any point type with PointTraits).
 /// Status: Ok; TooFewPoints (< 7 finite correspondences); InvalidInput (size mismatch, bad options);
-/// Degenerate (no model, or one homography explains the inliers: F, mask and counts are still filled).
+/// Degenerate (no baseline: every correspondence at the same pixel in both images, found before any
+/// sample; no model; or one homography explains the inliers: F, mask and counts are still filled).
+/// Writes into `out`, reusing its buffers and the workspace's (the homography test, off in the culling
+/// stages, still allocates its own).
 template <class T, class C1, class C2>
-FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& points2,
-                                                 const FundamentalOptions<T>& options) {
+void estimate_fundamental_ransac(const C1& points1, const C2& points2, const FundamentalOptions<T>& options,
+                                 FundamentalWorkspace<T>* workspace, FundamentalResult<T>* out) {
   static_assert(is_point_container_v<C1> && is_point_container_v<C2>,
                 "dyncull: point containers need size(), operator[] and points with PointTraits");
-  FundamentalResult<T> r;
-  r.inlier_mask.assign(points1.size(), 0);
+  FundamentalResult<T>& r = *out;
+  detail::reset_fundamental_result(points1.size(), &r);
   if (points1.size() != points2.size()) {
     r.status = Status::InvalidInput;
     r.reason = "points1 and points2 differ in size";
-    return r;
+    return;
   }
   if (options.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
-    return r;
+    return;
   }
-  const FundamentalEstimator<T> est(points1, points2, options.sampson_weighted_refit);
+  FundamentalEstimator<T>& est = workspace->estimator;
+  est.load(points1, points2, options.sampson_weighted_refit);
   if (est.num_input_finite() < 7) {
     r.status = Status::TooFewPoints;
     r.reason = std::to_string(est.num_input_finite()) + " finite correspondences, F-RANSAC needs at least 7";
-    return r;
+    return;
   }
   if (est.num_data() == 0) {
     r.status = Status::Degenerate;
     r.reason = "all points coincide in one image";
-    return r;
+    return;
   }
-  auto rr = ransac(est, options.ransac);
+  if (!est.has_baseline()) {  // every sample would fail in the solver: max_iterations of them, for nothing
+    r.status = Status::Degenerate;
+    r.reason = "no correspondence moved between the images (no baseline): F is not determined by the data";
+    return;
+  }
+  RansacResult<Mat3<T>>& rr = workspace->ransac_result;
+  ransac(est, options.ransac, &workspace->ransac, &rr);
   r.status = rr.status;
-  r.reason = std::move(rr.reason);
+  r.reason = rr.reason;
   r.iterations = rr.iterations;
   r.score = rr.score;
-  if (rr.inlier_mask.size() != est.num_data()) return r;  // failed before any model
+  if (rr.inlier_mask.size() != est.num_data()) return;  // failed before any model
   if (r.ok() && !rr.model.allFinite()) {  // wild but finite coordinates can still defeat the solver
     r.status = Status::Degenerate;
     r.reason = "RANSAC produced a non-finite F (coordinates too large or too small)";
-    return r;
+    return;
   }
   r.F = rr.model;
-  std::vector<std::uint32_t> inliers;
-  inliers.reserve(rr.num_inliers);
+  std::vector<std::uint32_t>& inliers = workspace->indices;
+  inliers.clear();
   for (std::size_t i = 0; i < est.num_data(); ++i) {
     if (!rr.inlier_mask[i]) continue;
     r.inlier_mask[est.index(i)] = 1;
@@ -749,6 +817,15 @@ FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& po
                  "% of the inliers (planar scene, pure rotation or no motion): F is not determined by the data";
     }
   }
+}
+
+/// Convenience overload with its own workspace and a fresh result.
+template <class T, class C1, class C2>
+FundamentalResult<T> estimate_fundamental_ransac(const C1& points1, const C2& points2,
+                                                 const FundamentalOptions<T>& options) {
+  FundamentalWorkspace<T> workspace;
+  FundamentalResult<T> r;
+  estimate_fundamental_ransac(points1, points2, options, &workspace, &r);
   return r;
 }
 
@@ -764,6 +841,16 @@ extern template FundamentalResult<float> fundamental_8point(const std::vector<Ve
                                                             const std::vector<Vec2<float>>&);
 extern template FundamentalResult<double> fundamental_8point(const std::vector<Vec2<double>>&,
                                                              const std::vector<Vec2<double>>&);
+extern template void estimate_fundamental_ransac(const std::vector<Vec2<float>>&, const std::vector<Vec2<float>>&,
+                                                 const FundamentalOptions<float>&, FundamentalWorkspace<float>*,
+                                                 FundamentalResult<float>*);
+extern template void estimate_fundamental_ransac(const std::vector<Vec2<double>>&, const std::vector<Vec2<double>>&,
+                                                 const FundamentalOptions<double>&, FundamentalWorkspace<double>*,
+                                                 FundamentalResult<double>*);
+extern template void fundamental_8point(const std::vector<Vec2<float>>&, const std::vector<Vec2<float>>&,
+                                        FundamentalWorkspace<float>*, FundamentalResult<float>*);
+extern template void fundamental_8point(const std::vector<Vec2<double>>&, const std::vector<Vec2<double>>&,
+                                        FundamentalWorkspace<double>*, FundamentalResult<double>*);
 #endif
 
 }  // namespace dyncull

@@ -150,6 +150,16 @@ template <class T, class Points3, class Points2>
 PnpResult<T> solve_pnp_ransac(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
                               const PnpOptions<T>& options = {});
 
+/// Buffers PnP-RANSAC reuses from call to call (defined below).
+template <class T>
+struct PnpWorkspace;
+
+/// solve_pnp_ransac writing into `out`, reusing its buffers and the workspace's: a caller that keeps both
+/// across frames allocates nothing once they have held the largest input (failures' reasons aside).
+template <class T, class Points3, class Points2>
+void solve_pnp_ransac(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
+                      const PnpOptions<T>& options, PnpWorkspace<T>* workspace, PnpResult<T>* out);
+
 // ---------------------------------------------------------------------------------------------
 // Implementation
 // ---------------------------------------------------------------------------------------------
@@ -647,10 +657,12 @@ void require_finite_pose(const char* who, std::size_t n_total, PnpResult<T>* res
   res->rmse_px = 0;
 }
 
-/// Relabels `res` at its pose: inlier mask (caller order), count and inlier RMSE.
+/// Relabels `res` at its pose: inlier mask (caller order), count and inlier RMSE. `residuals`: scratch.
 template <class T>
-void label_pnp(const PnpData<T>& d, std::size_t n_total, double max_residual, PnpResult<T>* res) {
-  std::vector<T> r(d.size());
+void label_pnp(const PnpData<T>& d, std::size_t n_total, double max_residual, std::vector<T>* residuals,
+               PnpResult<T>* res) {
+  std::vector<T>& r = *residuals;
+  r.resize(d.size());
   pnp_residuals_sq(d, res->cam_from_world, 0, d.size(), r.data());
   res->inlier_mask.assign(n_total, 0);
   const T thr = static_cast<T>(max_residual * max_residual);
@@ -665,6 +677,12 @@ void label_pnp(const PnpData<T>& d, std::size_t n_total, double max_residual, Pn
   }
   res->num_inliers = count;
   res->rmse_px = count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+}
+
+template <class T>
+void label_pnp(const PnpData<T>& d, std::size_t n_total, double max_residual, PnpResult<T>* res) {
+  std::vector<T> residuals;
+  label_pnp(d, n_total, max_residual, &residuals, res);
 }
 
 /// Best P3P pose on a spread-out triple, scored by the robust cost over all points.
@@ -770,6 +788,15 @@ Status pnp_dlt_data(const PnpData<T>& d, Rigid3<T>* out, std::string* reason) {
 
 }  // namespace detail
 
+template <class T>
+struct PnpWorkspace {
+  detail::PnpData<T> data;
+  RansacWorkspace<T> ransac;
+  RansacResult<Rigid3<T>> ransac_result;
+  std::vector<std::uint32_t> inliers;  // the data the final refinement takes
+  std::vector<T> residuals;            // the final labelling's
+};
+
 template <class T, class Points3, class Points2>
 PnpResult<T> solve_pnp_dlt(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera) {
   PnpResult<T> res;
@@ -852,50 +879,65 @@ PnpResult<T> solve_pnp(const Points3& world, const Points2& pixels, const Pinhol
 }
 
 template <class T, class Points3, class Points2>
-PnpResult<T> solve_pnp_ransac(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
-                              const PnpOptions<T>& options) {
-  PnpResult<T> res;
-  if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) return res;
+void solve_pnp_ransac(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
+                      const PnpOptions<T>& options, PnpWorkspace<T>* workspace, PnpResult<T>* out) {
+  PnpResult<T>& res = *out;
+  res.status = Status::Ok;
+  res.reason.clear();
+  res.cam_from_world = Rigid3<T>();
+  res.inlier_mask.clear();
+  res.num_inliers = res.iterations = 0;
+  res.rmse_px = 0;
+  if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) return;
   if (options.validate(&res.reason) != Status::Ok) {
     res.status = Status::InvalidInput;
     res.reason = "solve_pnp_ransac: " + res.reason;
     res.inlier_mask.assign(static_cast<std::size_t>(world.size()), 0);
-    return res;
+    return;
   }
   const std::size_t n_total = static_cast<std::size_t>(world.size());
-  detail::PnpData<T> d;
+  detail::PnpData<T>& d = workspace->data;
   const std::size_t skipped = detail::load_pnp_data(world, pixels, camera, &d);
   if (d.size() < 4) {
     res.status = skipped > 0 && d.size() + skipped >= 4 ? Status::NonFinite : Status::TooFewPoints;
     res.reason = "solve_pnp_ransac: " + std::to_string(d.size()) + " finite correspondences, need at least 4";
     res.inlier_mask.assign(n_total, 0);
-    return res;
+    return;
   }
   detail::PnpEstimator<T> est(d);
-  auto rr = ransac(est, options.ransac);
+  RansacResult<Rigid3<T>>& rr = workspace->ransac_result;
+  ransac(est, options.ransac, &workspace->ransac, &rr);
   res.iterations = rr.iterations;
   if (!rr.ok()) {
     res.status = rr.status;
     res.reason = "solve_pnp_ransac: " + rr.reason;
     res.inlier_mask.assign(n_total, 0);
-    return res;
+    return;
   }
   res.cam_from_world = rr.model;
   if (options.refine) {
-    std::vector<std::uint32_t> idx;
-    idx.reserve(rr.num_inliers);
+    std::vector<std::uint32_t>& idx = workspace->inliers;
+    idx.clear();
     for (std::size_t i = 0; i < d.size(); ++i)
       if (rr.inlier_mask[i]) idx.push_back(static_cast<std::uint32_t>(i));
     const auto r = detail::refine_pose_data(d, idx.data(), idx.size(), rr.model, options.refinement);
     if (r.ok()) res.cam_from_world = r.cam_from_world;
   }
   detail::require_finite_pose("solve_pnp_ransac", n_total, &res);
-  if (!res.ok()) return res;
-  detail::label_pnp(d, n_total, options.ransac.max_residual, &res);
+  if (!res.ok()) return;
+  detail::label_pnp(d, n_total, options.ransac.max_residual, &workspace->residuals, &res);
   if (res.num_inliers < 4) {
     res.status = Status::Degenerate;
     res.reason = "solve_pnp_ransac: only " + std::to_string(res.num_inliers) + " inliers at the best pose";
   }
+}
+
+template <class T, class Points3, class Points2>
+PnpResult<T> solve_pnp_ransac(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
+                              const PnpOptions<T>& options) {
+  PnpWorkspace<T> workspace;
+  PnpResult<T> res;
+  solve_pnp_ransac(world, pixels, camera, options, &workspace, &res);
   return res;
 }
 
@@ -906,6 +948,12 @@ extern template PnpResult<float> solve_pnp_ransac(const std::vector<Vec3<float>>
 extern template PnpResult<double> solve_pnp_ransac(const std::vector<Vec3<double>>&,
                                                    const std::vector<Vec2<double>>&, const PinholeCamera<double>&,
                                                    const PnpOptions<double>&);
+extern template void solve_pnp_ransac(const std::vector<Vec3<float>>&, const std::vector<Vec2<float>>&,
+                                      const PinholeCamera<float>&, const PnpOptions<float>&, PnpWorkspace<float>*,
+                                      PnpResult<float>*);
+extern template void solve_pnp_ransac(const std::vector<Vec3<double>>&, const std::vector<Vec2<double>>&,
+                                      const PinholeCamera<double>&, const PnpOptions<double>&,
+                                      PnpWorkspace<double>*, PnpResult<double>*);
 #endif
 
 }  // namespace dyncull

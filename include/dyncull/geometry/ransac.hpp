@@ -90,6 +90,14 @@ inline std::size_t ransac_required_iterations(double inlier_ratio, int sample_si
   return std::max<std::size_t>(1, static_cast<std::size_t>(k));  // checked: 0 < k < cap
 }
 
+/// Buffers a RANSAC reuses from call to call (residuals and inlier indices, one entry per datum): a caller
+/// that keeps one across frames allocates nothing once they have reached the largest data size.
+template <class Scalar>
+struct RansacWorkspace {
+  std::vector<Scalar> residuals;
+  std::vector<std::uint32_t> inliers;
+};
+
 namespace detail {
 template <class...> using ransac_void_t = void;
 
@@ -163,16 +171,18 @@ class RansacRunner {
   // inliers) fails after d residuals instead of hundreds.
   static constexpr std::size_t kProbe = 32;
 
-  RansacRunner(const Estimator& estimator, const RansacOptions& options)
-      : est_(estimator), opt_(options), n_(estimator.num_data()) {
+  RansacRunner(const Estimator& estimator, const RansacOptions& options, RansacWorkspace<Scalar>* workspace)
+      : est_(estimator), opt_(options), n_(estimator.num_data()), residuals_(workspace->residuals),
+        inliers_(workspace->inliers) {
     thr_sq_ = static_cast<Scalar>(opt_.max_residual * opt_.max_residual);
     lo_min_support_ = std::max<std::size_t>(2 * static_cast<std::size_t>(kSampleSize), n_ / 10);
     residuals_.resize(n_);
     inliers_.resize(n_);
   }
 
-  RansacResult<Model> run() {
-    RansacResult<Model> result;
+  /// Writes into `out`, reset by the caller (its buffers are reused).
+  void run(RansacResult<Model>* out) {
+    RansacResult<Model>& result = *out;
     Random rng(opt_.seed);
     std::uint32_t sample[kSampleSize];
     Model models[kMaxModels];
@@ -233,7 +243,7 @@ class RansacRunner {
       result.status = Status::Degenerate;
       result.reason = "no minimal sample produced a model (" + std::to_string(solver_failures) + " of " +
                       std::to_string(it) + " samples failed in the solver; degenerate or non-finite data)";
-      return result;
+      return;
     }
     // Final LO, unless the kept model is already the fixed point of an LO run.
     if (opt_.local_optimisation && !lo_converged_) local_optimise(&result.model, &best_cost, &best_inliers, false);
@@ -257,10 +267,10 @@ class RansacRunner {
       result.reason = "best model has " + std::to_string(count) + " inliers, fewer than the minimal sample (" +
                       std::to_string(kSampleSize) + ")";
     }
-    return result;
   }
 
  private:
+
   void draw_sample(Random& rng, std::uint32_t* sample) {
     const auto n = static_cast<std::uint32_t>(n_);
     for (int i = 0; i < kSampleSize; ++i) {
@@ -373,8 +383,8 @@ class RansacRunner {
   const RansacOptions& opt_;
   std::size_t n_;
   Scalar thr_sq_;
-  std::vector<Scalar> residuals_;
-  std::vector<std::uint32_t> inliers_;
+  std::vector<Scalar>& residuals_;
+  std::vector<std::uint32_t>& inliers_;
   bool lo_converged_ = false;  // the best model is an LO fixed point: a further refit cannot improve it
   std::size_t lo_min_support_ = 0;  // inliers a new best needs before it is locally optimised
 };
@@ -393,8 +403,11 @@ class RansacRunner {
 /// The range overload enables early bail-out while scoring, the indexed one a 32-point pre-test of each
 /// hypothesis. LO runs for new bests with at least max(2 kSampleSize, n / 10) inliers, and once at the end.
 /// Residuals are squared; NaN residuals count as outliers. Deterministic for options.seed.
+/// Writes into `out`; its buffers and the workspace's are reused, so a caller that keeps both across calls
+/// allocates nothing once they have grown to the largest data size (reasons of failures aside).
 template <class Estimator>
-RansacResult<typename Estimator::Model> ransac(const Estimator& estimator, const RansacOptions& options) {
+void ransac(const Estimator& estimator, const RansacOptions& options,
+            RansacWorkspace<typename Estimator::Scalar>* workspace, RansacResult<typename Estimator::Model>* out) {
   static_assert(detail::has_model_type<Estimator>::value, "dyncull::ransac: Estimator needs `using Model = ...;`");
   static_assert(detail::has_scalar_type<Estimator>::value,
                 "dyncull::ransac: Estimator needs `using Scalar = float|double;`");
@@ -411,32 +424,44 @@ RansacResult<typename Estimator::Model> ransac(const Estimator& estimator, const
   static_assert(detail::has_refit<Estimator>::value,
                 "dyncull::ransac: Estimator needs `bool refit(const std::uint32_t*, std::size_t, Model*) const`");
 
-  RansacResult<typename Estimator::Model> result;
-  std::string why;
-  if (options.validate(&why) != Status::Ok) {
+  RansacResult<typename Estimator::Model>& result = *out;
+  result.status = Status::Ok;
+  result.reason.clear();
+  result.inlier_mask.clear();
+  result.num_inliers = result.iterations = 0;
+  result.score = 0;
+  if (options.validate(&result.reason) != Status::Ok) {
     result.status = Status::InvalidInput;
-    result.reason = why;
-    return result;
+    return;
   }
   if (Estimator::kSampleSize <= 0 || Estimator::kMaxModels <= 0) {
     result.status = Status::InvalidInput;
     result.reason = "estimator kSampleSize and kMaxModels must be positive";
-    return result;
+    return;
   }
   const std::size_t n = estimator.num_data();
   if (n < static_cast<std::size_t>(Estimator::kSampleSize)) {
     result.status = Status::TooFewPoints;
     result.reason = std::to_string(n) + " data, the minimal sample needs " + std::to_string(Estimator::kSampleSize);
     result.inlier_mask.assign(n, 0);
-    return result;
+    return;
   }
   if (n > static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max())) {
     result.status = Status::InvalidInput;
     result.reason = "more than 2^32 - 1 data";
-    return result;
+    return;
   }
-  detail::RansacRunner<Estimator> runner(estimator, options);
-  return runner.run();
+  detail::RansacRunner<Estimator> runner(estimator, options, workspace);
+  runner.run(&result);
+}
+
+/// Convenience overload with its own workspace and a fresh result.
+template <class Estimator>
+RansacResult<typename Estimator::Model> ransac(const Estimator& estimator, const RansacOptions& options) {
+  RansacWorkspace<typename Estimator::Scalar> workspace;
+  RansacResult<typename Estimator::Model> result;
+  ransac(estimator, options, &workspace, &result);
+  return result;
 }
 
 }  // namespace dyncull

@@ -47,11 +47,14 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
       r->subbox.status = v.subbox.status;
       r->subbox.num_dynamic = v.subbox.num_dynamic;
     }
-    r->subbox.reason = "baseline of " + std::to_string(frame.evidence_frames) +
-                       " frame(s) too short for static evidence (subbox.min_evidence_frames): " +
-                       (recalled > 0 ? "the last vote of " + std::to_string(recalled) +
-                                           " tracked box(es) kept, the box rule elsewhere"
-                                     : std::string("the box rule decides"));
+    // Appended piece by piece into the kept buffer: numbers' texts fit the small-string buffer.
+    std::string& why = r->subbox.reason;
+    why.assign("baseline of ").append(std::to_string(frame.evidence_frames));
+    why.append(" frame(s) too short for static evidence (subbox.min_evidence_frames): ");
+    if (recalled > 0)
+      why.append("the last vote of ").append(std::to_string(recalled)).append(" tracked box(es) kept, the box rule elsewhere");
+    else
+      why.append("the box rule decides");
   } else if (options.subbox.requires_fit_outside_boxes && !geometric.fit_outside_boxes &&
              std::any_of(semantic.in_dyn_box.begin(), semantic.in_dyn_box.end(),
                          [](std::uint8_t f) { return f != 0; })) {
