@@ -16,6 +16,7 @@
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/validation.hpp"
 #include "dyncull/geometry/pnp.hpp"
+#include "dyncull/geometry/pose_covariance.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -25,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -138,24 +140,15 @@ struct ReprojectionCheckResult {
   PnpResult<T> scratch_pose_fit;
 };
 
-/// Runs the check on n tracks: points[i] is the 3-D point of track i in any fixed frame (world, or the
-/// reference keyframe's camera), pixels[i] its position in the current image; camera: the current
-/// image's intrinsics. Non-finite points (no depth) are not evaluated. valid: optional per-track flag;
-/// in_box: optional per-track flag (1 = inside a dynamic-class box: excluded from the fit when possible,
-/// tighter threshold). depth: the current depth image, used by the depth residual when enabled.
-/// InvalidInput (nothing read) when points and pixels differ in size, a given flag view does not hold
-/// pixels.size() flags, or the options (ReprojectionCheckOptions::validate), the depth view or the camera
-/// are invalid.
-/// Writes into `out` (buffers reused).
-template <class T, class Points3, class Pixels, class Raw = float>
-void check_reprojection(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera,
-                        const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* out,
-                        FlagView valid = nullptr, FlagView in_box = nullptr,
-                        const DepthView<Raw>& depth = DepthView<Raw>{}) {
-  static_assert(is_point_container_v<Points3> && is_point_container_v<Pixels>,
-                "dyncull::check_reprojection: points and pixels must hold points (see PointTraits)");
+namespace detail {
+
+/// Every track a candidate with no residual yet; false (status and reason set) when the inputs break
+/// the contract.
+template <class T, class Raw>
+bool reprojection_start(std::size_t n, std::size_t n_points, FlagView valid, FlagView in_box,
+                        const PinholeCamera<T>& camera, const ReprojectionCheckOptions<T>& options,
+                        const DepthView<Raw>& depth, ReprojectionCheckResult<T>* out) {
   ReprojectionCheckResult<T>& r = *out;
-  const std::size_t n = static_cast<std::size_t>(pixels.size());
   r.status = Status::Ok;
   r.reason.clear();
   r.num_tracks = n;
@@ -169,34 +162,29 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
   r.uncertainty_px.assign(n, Constants<T>::nan());
   r.depth_residual_m.assign(n, Constants<T>::nan());
   r.inlier_mask.assign(n, 0);
-  if (static_cast<std::size_t>(points.size()) != n) {
+  auto stop = [&](std::string why) {
     r.status = Status::InvalidInput;
-    r.reason = "points and pixels differ in size";
-    return;
-  }
+    r.reason = std::move(why);
+    return false;
+  };
+  if (n_points != n) return stop("points and pixels differ in size");
   std::string why;
-  if (!detail::flags_fit(valid, n, "valid", "tracks", &why) ||
-      !detail::flags_fit(in_box, n, "in_box", "tracks", &why)) {
-    r.status = Status::InvalidInput;
-    r.reason = why;
-    return;
-  }
-  if (options.validate(&why) != Status::Ok) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid options: " + why;
-    return;
-  }
-  if (depth.validate(&why) != Status::Ok) {
-    r.status = Status::InvalidInput;
-    r.reason = why;
-    return;
-  }
-  if (!camera.valid()) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid camera intrinsics";
-    return;
-  }
-  // Usable tracks: valid, finite pixel and point. Count those outside boxes for the fit subset.
+  if (!flags_fit(valid, n, "valid", "tracks", &why) || !flags_fit(in_box, n, "in_box", "tracks", &why))
+    return stop(why);
+  if (options.validate(&why) != Status::Ok) return stop("invalid options: " + why);
+  if (depth.validate(&why) != Status::Ok) return stop(why);
+  if (!camera.valid()) return stop("invalid camera intrinsics");
+  return true;
+}
+
+/// The pose by PnP-RANSAC on the usable tracks (valid, finite point and pixel), on those outside the
+/// boxes alone when there are enough of them (SG-SLAM's fit subset); false (status and reason set)
+/// with too few tracks or no pose.
+template <class T, class Points3, class Pixels>
+bool reprojection_fit(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera, FlagView valid,
+                      FlagView in_box, const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* out) {
+  ReprojectionCheckResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(pixels.size());
   std::size_t usable = 0, outside = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (valid.given && !valid[i]) continue;
@@ -211,7 +199,7 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
     r.status = Status::Skipped;
     r.reason = std::to_string(usable) + " tracks with a 3-D point, the reprojection check needs at least " +
                std::to_string(options.min_tracks < 4 ? 4 : options.min_tracks);
-    return;
+    return false;
   }
   const bool subset = in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes;
   r.scratch_points.clear();
@@ -233,103 +221,115 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
   if (!pr.ok() || !pr.cam_from_world.all_finite()) {
     r.status = pr.ok() ? Status::NonFinite : pr.status;
     r.reason.assign("pose not found: ").append(pr.ok() ? "non-finite pose" : pr.reason);  // into the kept buffer
-    return;
+    return false;
   }
   r.cam_from_world = pr.cam_from_world;
   r.num_inliers = pr.num_inliers;
   for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r.scratch_index.size(); ++k)
     r.inlier_mask[r.scratch_index[k]] = pr.inlier_mask[k];
-  // Pose covariance from the fit inliers (left perturbation [w, v]: d pc = -[pc]x w + v), in double.
-  const Mat3<T>& R = r.cam_from_world.R;
-  const Vec3<T>& t = r.cam_from_world.t;
-  auto jacobian = [&](const Vec3<T>& pc) {
-    Eigen::Matrix<double, 2, 6> J;
-    const double x = double(pc.x()), y = double(pc.y()), z = double(pc.z()), iz = 1.0 / z;
-    const double fx = double(camera.fx), fy = double(camera.fy);
-    Eigen::Matrix<double, 2, 3> P;
-    P << fx * iz, 0, -fx * x * iz * iz, 0, fy * iz, -fy * y * iz * iz;
-    Mat3<double> S;
-    S << 0, -z, y, z, 0, -x, -y, x, 0;  // [pc]x
-    J.template leftCols<3>() = -P * S;
-    J.template rightCols<3>() = P;
-    return J;
-  };
-  Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
-  bool use_cov = options.uncertainty_sigmas > T(0);
-  if (use_cov) {
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r.scratch_points.size(); ++k) {
-      if (!pr.inlier_mask[k]) continue;
-      const Vec3<T> pc = R * r.scratch_points[k] + t;
-      if (!(pc.z() > T(0))) continue;
-      const Eigen::Matrix<double, 2, 6> J = jacobian(pc);
-      H.noalias() += J.transpose() * J;
-    }
-    const double sigma = std::max(pr.rmse_px, double(options.min_noise_px));
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
-    if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-      cov = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity()) * (sigma * sigma);
-      use_cov = cov.allFinite();
-    } else {
-      use_cov = false;
+  return true;
+}
+
+/// Track i's residuals at the fitted pose and its label: dynamic when the pixel residual exceeds its
+/// limit (tighter in a box; widened to uncertainty_sigmas times the pose's spread there when `cov`), or
+/// when the depth residual exceeds max_depth_residual_sigmas of the sensor's axial noise; a point behind
+/// the camera is dynamic.
+template <class T, class Raw>
+bool reprojection_label(std::size_t i, const Vec3<T>& X, T u, T v, T limit, const PinholeCamera<T>& camera,
+                        const PoseCovariance* cov, const DepthView<Raw>* depth,
+                        const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* r) {
+  const Vec3<T> pc = r->cam_from_world.R * X + r->cam_from_world.t;
+  T res = std::numeric_limits<T>::infinity();
+  if (pc.z() > T(0)) {
+    const T du = camera.fx * pc.x() / pc.z() + camera.cx - u, dv = camera.fy * pc.y() / pc.z() + camera.cy - v;
+    res = std::sqrt(du * du + dv * dv);
+    r->residual_vec[i] = Vec2<T>(-du, -dv);
+    if (cov) {
+      const T sd = projected_spread_px(camera, pc, *cov);
+      r->uncertainty_px[i] = sd;
+      limit = std::max(limit, options.uncertainty_sigmas * sd);
     }
   }
-  // Residual of every usable track at the fitted pose; a point behind the camera is dynamic.
-  const T t_out = options.max_residual_px, t_in = options.max_residual_in_boxes_px;
+  r->residual_px[i] = res;
+  bool dyn = !(res <= limit);
+  if (depth && pc.z() > T(0)) {
+    int pu = 0, pv = 0;
+    const float measured = pixel_of(u, v, depth->width, depth->height, &pu, &pv) ? depth->depth_m(pu, pv) : 0.f;
+    if (measured > 0.f) {
+      const T dz = static_cast<T>(measured) - pc.z();
+      r->depth_residual_m[i] = dz;
+      const T sigma = axial_depth_sigma_m(pc.z(), options.depth_sigma_base_m, options.depth_sigma_quadratic,
+                                          options.depth_sigma_reference_m);
+      const bool depth_dyn = std::abs(dz) > options.max_depth_residual_sigmas * T(1.4142135623730951) * sigma;
+      r->num_depth_dynamic += depth_dyn && !dyn;
+      dyn = dyn || depth_dyn;
+    }
+  }
+  return dyn;
+}
+
+/// Noise of the static tracks: the robust spread (1.4826 MAD about zero) of the fit inliers' residual
+/// components, which are zero-mean at the fit.
+template <class T>
+void reprojection_inlier_noise(ReprojectionCheckResult<T>* r) {
+  const PnpResult<T>& pr = r->scratch_pose_fit;
+  r->scratch_values.clear();
+  for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r->scratch_index.size(); ++k) {
+    const Vec2<T>& e = r->residual_vec[r->scratch_index[k]];
+    if (!pr.inlier_mask[k] || !e.allFinite()) continue;
+    r->scratch_values.push_back(std::abs(e.x()));
+    r->scratch_values.push_back(std::abs(e.y()));
+  }
+  if (!r->scratch_values.empty()) {
+    auto mid = r->scratch_values.begin() + static_cast<std::ptrdiff_t>(r->scratch_values.size() / 2);
+    std::nth_element(r->scratch_values.begin(), mid, r->scratch_values.end());
+    r->inlier_noise_px = T(1.4826) * *mid;
+  }
+}
+
+}  // namespace detail
+
+/// Runs the check on n tracks: points[i] is the 3-D point of track i in any fixed frame (world, or the
+/// reference keyframe's camera), pixels[i] its position in the current image; camera: the current
+/// image's intrinsics. Non-finite points (no depth) are not evaluated. valid: optional per-track flag;
+/// in_box: optional per-track flag (1 = inside a dynamic-class box: excluded from the fit when possible,
+/// tighter threshold). depth: the current depth image, used by the depth residual when enabled.
+/// InvalidInput (nothing read) when points and pixels differ in size, a given flag view does not hold
+/// pixels.size() flags, or the options (ReprojectionCheckOptions::validate), the depth view or the camera
+/// are invalid.
+/// Writes into `out` (buffers reused).
+template <class T, class Points3, class Pixels, class Raw = float>
+void check_reprojection(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera,
+                        const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* out,
+                        FlagView valid = nullptr, FlagView in_box = nullptr,
+                        const DepthView<Raw>& depth = DepthView<Raw>{}) {
+  static_assert(is_point_container_v<Points3> && is_point_container_v<Pixels>,
+                "dyncull::check_reprojection: points and pixels must hold points (see PointTraits)");
+  ReprojectionCheckResult<T>& r = *out;
+  const std::size_t n = static_cast<std::size_t>(pixels.size());
+  if (!detail::reprojection_start(n, static_cast<std::size_t>(points.size()), valid, in_box, camera, options, depth,
+                                  out))
+    return;
+  if (!detail::reprojection_fit(points, pixels, camera, valid, in_box, options, out)) return;
+  // The pose's uncertainty widens each track's limit by the spread it gives that track's projection.
+  PoseCovariance cov = PoseCovariance::Zero();
+  const bool use_cov = options.uncertainty_sigmas > T(0) &&
+                       pose_covariance(r.scratch_points, r.scratch_pose_fit.inlier_mask, r.cam_from_world, camera,
+                                       std::max(r.scratch_pose_fit.rmse_px, double(options.min_noise_px)), &cov);
   const bool use_depth = options.max_depth_residual_sigmas > T(0) && !depth.empty();
-  auto depth_sigma = [&](T z) {
-    return axial_depth_sigma_m(z, options.depth_sigma_base_m, options.depth_sigma_quadratic,
-                               options.depth_sigma_reference_m);
-  };
   for (std::size_t i = 0; i < n; ++i) {
     if (valid.given && !valid[i]) continue;
     const Vec3<T> X(point_x<T>(points[i]), point_y<T>(points[i]), point_z<T>(points[i]));
     const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
     if (!X.allFinite() || !std::isfinite(u) || !std::isfinite(v)) continue;
-    const Vec3<T> pc = R * X + t;
-    T res = std::numeric_limits<T>::infinity();
-    T limit = (in_box.given && in_box[i]) ? t_in : t_out;
-    if (pc.z() > T(0)) {
-      const T du = camera.fx * pc.x() / pc.z() + camera.cx - u, dv = camera.fy * pc.y() / pc.z() + camera.cy - v;
-      res = std::sqrt(du * du + dv * dv);
-      r.residual_vec[i] = Vec2<T>(-du, -dv);
-      if (use_cov) {
-        const Eigen::Matrix<double, 2, 6> J = jacobian(pc);
-        const T sd = static_cast<T>(std::sqrt(std::max(0.0, (J * cov * J.transpose()).trace())));
-        r.uncertainty_px[i] = sd;
-        limit = std::max(limit, options.uncertainty_sigmas * sd);
-      }
-    }
-    r.residual_px[i] = res;
-    bool dyn = !(res <= limit);
-    if (use_depth && pc.z() > T(0)) {
-      int pu = 0, pv = 0;
-      const float measured = pixel_of(u, v, depth.width, depth.height, &pu, &pv) ? depth.depth_m(pu, pv) : 0.f;
-      if (measured > 0.f) {
-        const T dz = static_cast<T>(measured) - pc.z();
-        r.depth_residual_m[i] = dz;
-        const bool depth_dyn = std::abs(dz) > options.max_depth_residual_sigmas * T(1.4142135623730951) * depth_sigma(pc.z());
-        r.num_depth_dynamic += depth_dyn && !dyn;
-        dyn = dyn || depth_dyn;
-      }
-    }
+    const T limit = (in_box.given && in_box[i]) ? options.max_residual_in_boxes_px : options.max_residual_px;
+    const bool dyn = detail::reprojection_label(i, X, u, v, limit, camera, use_cov ? &cov : nullptr,
+                                                use_depth ? &depth : nullptr, options, &r);
     r.labels[i] = dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;
     r.num_dynamic += dyn;
     r.num_static += !dyn;
   }
-  // Noise of the static tracks: robust spread of the inliers' residual components (zero-mean at the fit).
-  r.scratch_values.clear();
-  for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r.scratch_index.size(); ++k) {
-    const Vec2<T>& e = r.residual_vec[r.scratch_index[k]];
-    if (!pr.inlier_mask[k] || !e.allFinite()) continue;
-    r.scratch_values.push_back(std::abs(e.x()));
-    r.scratch_values.push_back(std::abs(e.y()));
-  }
-  if (!r.scratch_values.empty()) {
-    auto mid = r.scratch_values.begin() + static_cast<std::ptrdiff_t>(r.scratch_values.size() / 2);
-    std::nth_element(r.scratch_values.begin(), mid, r.scratch_values.end());
-    r.inlier_noise_px = T(1.4826) * *mid;
-  }
+  detail::reprojection_inlier_noise(&r);
 }
 
 /// Convenience overload returning a fresh result.
