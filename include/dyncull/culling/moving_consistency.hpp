@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -94,6 +95,121 @@ struct MovingConsistencyResult {
   FundamentalResult<T> scratch_ransac_fit, scratch_polished_fit;
 };
 
+namespace detail {
+
+/// Every track a candidate with no distance yet; false (status and reason set) when the inputs break
+/// the contract.
+template <class T>
+bool consistency_start(std::size_t n, std::size_t n_prev, FlagView valid, FlagView in_box,
+                       const MovingConsistencyOptions<T>& options, MovingConsistencyResult<T>* out) {
+  MovingConsistencyResult<T>& r = *out;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_tracks = n;
+  r.num_valid = r.num_fit = r.num_inliers = r.num_dynamic = r.num_static = r.ransac_iterations = 0;
+  r.fitted_outside_boxes = false;
+  r.F.setZero();
+  r.labels.assign(n, FeatureLabel::Candidate);
+  r.distance_px.assign(n, Constants<T>::nan());
+  r.inlier_mask.assign(n, 0);
+  auto stop = [&](std::string why) {
+    r.status = Status::InvalidInput;
+    r.reason = std::move(why);
+    return false;
+  };
+  if (n_prev != n) return stop("prev and cur differ in size");
+  std::string why;
+  if (!flags_fit(valid, n, "valid", "tracks", &why) || !flags_fit(in_box, n, "in_box", "tracks", &why))
+    return stop(why);
+  if (options.validate(&why) != Status::Ok) return stop("invalid options: " + why);
+  return true;
+}
+
+/// The valid, finite tracks compacted into the scratch (their indices in scratch_index); returns those
+/// outside the boxes, for SG-SLAM's fit subset.
+template <class T, class C1, class C2>
+std::size_t consistency_compact(const C1& prev, const C2& cur, FlagView valid, FlagView in_box,
+                                MovingConsistencyResult<T>* r) {
+  r->scratch_prev.clear();
+  r->scratch_cur.clear();
+  r->scratch_index.clear();
+  std::size_t outside = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(cur.size()); ++i) {
+    if (valid.given && !valid[i]) continue;
+    const T x1 = point_x<T>(prev[i]), y1 = point_y<T>(prev[i]), x2 = point_x<T>(cur[i]), y2 = point_y<T>(cur[i]);
+    if (!std::isfinite(x1) || !std::isfinite(y1) || !std::isfinite(x2) || !std::isfinite(y2)) continue;
+    r->scratch_prev.emplace_back(x1, y1);
+    r->scratch_cur.emplace_back(x2, y2);
+    r->scratch_index.push_back(static_cast<std::uint32_t>(i));
+    outside += !(in_box.given && in_box[i]);
+  }
+  return outside;
+}
+
+/// F by RANSAC on the compacted tracks, on those outside the boxes alone when `subset`; false (status
+/// and reason set) when F is not usable: Degenerate means one homography explains the tracks (static
+/// camera, pure rotation, planar scene), so F's epipolar lines carry no evidence of motion.
+template <class T>
+bool consistency_fit(bool subset, FlagView in_box, const MovingConsistencyOptions<T>& options,
+                     MovingConsistencyResult<T>* out) {
+  MovingConsistencyResult<T>& r = *out;
+  const std::size_t m = r.scratch_index.size();
+  FundamentalResult<T>& fr = r.scratch_ransac_fit;
+  if (subset) {
+    r.scratch_fit_prev.clear();
+    r.scratch_fit_cur.clear();
+    r.scratch_fit_index.clear();
+    for (std::size_t k = 0; k < m; ++k) {
+      if (in_box[r.scratch_index[k]]) continue;
+      r.scratch_fit_prev.push_back(r.scratch_prev[k]);
+      r.scratch_fit_cur.push_back(r.scratch_cur[k]);
+      r.scratch_fit_index.push_back(r.scratch_index[k]);
+    }
+  }
+  const std::vector<std::uint32_t>& fit_index = subset ? r.scratch_fit_index : r.scratch_index;
+  estimate_fundamental_ransac(subset ? r.scratch_fit_prev : r.scratch_prev, subset ? r.scratch_fit_cur : r.scratch_cur,
+                              options.fundamental, &r.scratch_fundamental, &fr);
+  r.fitted_outside_boxes = subset;
+  r.num_fit = fit_index.size();
+  for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r.inlier_mask[fit_index[k]] = fr.inlier_mask[k];
+  r.num_inliers = fr.num_inliers;
+  r.ransac_iterations = fr.iterations;
+  r.F = fr.F;
+  if (fr.ok()) return true;
+  r.status = fr.status;
+  r.reason.assign("fundamental matrix not usable: ").append(fr.reason);  // into the kept buffer
+  for (auto& m8 : r.inlier_mask) m8 = 0;
+  r.num_inliers = 0;
+  return false;
+}
+
+/// Polishes F by the 8-point algorithm on the fit tracks within max_epipolar_distance_px of it,
+/// refit_iterations times (stops early below 16 tracks or on a failed fit).
+template <class T>
+void consistency_refit(bool subset, const MovingConsistencyOptions<T>& options, MovingConsistencyResult<T>* r) {
+  const std::vector<Vec2<T>>& fit_prev = subset ? r->scratch_fit_prev : r->scratch_prev;
+  const std::vector<Vec2<T>>& fit_cur = subset ? r->scratch_fit_cur : r->scratch_cur;
+  for (int it = 0; it < options.refit_iterations; ++it) {
+    if (epipolar_distances(r->F, fit_prev, fit_cur, r->scratch_distance.data(), EpipolarDistance::PointToLine) !=
+        Status::Ok)
+      break;  // the final pass reports it
+    r->scratch_refit_prev.clear();
+    r->scratch_refit_cur.clear();
+    for (std::size_t k = 0; k < fit_prev.size(); ++k) {
+      if (!(r->scratch_distance[k] <= options.max_epipolar_distance_px)) continue;
+      r->scratch_refit_prev.push_back(fit_prev[k]);
+      r->scratch_refit_cur.push_back(fit_cur[k]);
+    }
+    if (r->scratch_refit_prev.size() < 16) break;
+    FundamentalResult<T>& polished = r->scratch_polished_fit;
+    fundamental_8point(r->scratch_refit_prev, r->scratch_refit_cur, &r->scratch_fundamental, &polished);
+    if (!polished.ok()) break;
+    r->F = polished.F;
+  }
+}
+
+}  // namespace detail
+
 /// Runs the check on n tracks prev[i] -> cur[i] (any point containers of equal size), writing into `out`
 /// (buffers reused). valid: optional per-track flag (0 = no track, e.g. LK failed); in_box: optional
 /// per-track flag (1 = inside a dynamic-class box: excluded from the F fit when possible, tighter threshold).
@@ -106,46 +222,8 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
                 "dyncull::check_moving_consistency: prev and cur must hold points (see PointTraits)");
   MovingConsistencyResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(cur.size());
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_tracks = n;
-  r.num_valid = r.num_fit = r.num_inliers = r.num_dynamic = r.num_static = r.ransac_iterations = 0;
-  r.fitted_outside_boxes = false;
-  r.F.setZero();
-  r.labels.assign(n, FeatureLabel::Candidate);
-  r.distance_px.assign(n, Constants<T>::nan());
-  r.inlier_mask.assign(n, 0);
-  if (static_cast<std::size_t>(prev.size()) != n) {
-    r.status = Status::InvalidInput;
-    r.reason = "prev and cur differ in size";
-    return;
-  }
-  std::string why;
-  if (!detail::flags_fit(valid, n, "valid", "tracks", &why) ||
-      !detail::flags_fit(in_box, n, "in_box", "tracks", &why)) {
-    r.status = Status::InvalidInput;
-    r.reason = why;
-    return;
-  }
-  if (options.validate(&why) != Status::Ok) {
-    r.status = Status::InvalidInput;
-    r.reason = "invalid options: " + why;
-    return;
-  }
-  // Compact the valid, finite tracks; count those outside boxes for the SG-SLAM fit subset.
-  r.scratch_prev.clear();
-  r.scratch_cur.clear();
-  r.scratch_index.clear();
-  std::size_t outside = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (valid.given && !valid[i]) continue;
-    const T x1 = point_x<T>(prev[i]), y1 = point_y<T>(prev[i]), x2 = point_x<T>(cur[i]), y2 = point_y<T>(cur[i]);
-    if (!std::isfinite(x1) || !std::isfinite(y1) || !std::isfinite(x2) || !std::isfinite(y2)) continue;
-    r.scratch_prev.emplace_back(x1, y1);
-    r.scratch_cur.emplace_back(x2, y2);
-    r.scratch_index.push_back(static_cast<std::uint32_t>(i));
-    outside += !(in_box.given && in_box[i]);
-  }
+  if (!detail::consistency_start(n, static_cast<std::size_t>(prev.size()), valid, in_box, options, out)) return;
+  const std::size_t outside = detail::consistency_compact<T>(prev, cur, valid, in_box, out);
   const std::size_t m = r.scratch_index.size();
   r.num_valid = m;
   if (m < options.min_tracks || m < 8) {
@@ -156,59 +234,9 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
   }
   const bool subset =
       in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes && outside < m;
-  FundamentalResult<T>& fr = r.scratch_ransac_fit;
-  if (subset) {
-    r.scratch_fit_prev.clear();
-    r.scratch_fit_cur.clear();
-    r.scratch_fit_index.clear();
-    for (std::size_t k = 0; k < m; ++k) {
-      if (in_box[r.scratch_index[k]]) continue;
-      r.scratch_fit_prev.push_back(r.scratch_prev[k]);
-      r.scratch_fit_cur.push_back(r.scratch_cur[k]);
-      r.scratch_fit_index.push_back(r.scratch_index[k]);
-    }
-    estimate_fundamental_ransac(r.scratch_fit_prev, r.scratch_fit_cur, options.fundamental, &r.scratch_fundamental,
-                                &fr);
-    r.fitted_outside_boxes = true;
-    r.num_fit = r.scratch_fit_index.size();
-    for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r.inlier_mask[r.scratch_fit_index[k]] = fr.inlier_mask[k];
-  } else {
-    estimate_fundamental_ransac(r.scratch_prev, r.scratch_cur, options.fundamental, &r.scratch_fundamental, &fr);
-    r.num_fit = m;
-    for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r.inlier_mask[r.scratch_index[k]] = fr.inlier_mask[k];
-  }
-  r.num_inliers = fr.num_inliers;
-  r.ransac_iterations = fr.iterations;
-  r.F = fr.F;
-  if (!fr.ok()) {
-    // Degenerate = one homography explains the tracks (static camera, pure rotation, planar scene):
-    // F is not determined, so its epipolar lines carry no evidence of motion.
-    r.status = fr.status;
-    r.reason.assign("fundamental matrix not usable: ").append(fr.reason);  // into the kept buffer
-    for (auto& m8 : r.inlier_mask) m8 = 0;
-    r.num_inliers = 0;
-    return;
-  }
+  if (!detail::consistency_fit(subset, in_box, options, out)) return;
   r.scratch_distance.resize(m);
-  const std::vector<Vec2<T>>& fit_prev = subset ? r.scratch_fit_prev : r.scratch_prev;
-  const std::vector<Vec2<T>>& fit_cur = subset ? r.scratch_fit_cur : r.scratch_cur;
-  for (int it = 0; it < options.refit_iterations; ++it) {
-    if (epipolar_distances(r.F, fit_prev, fit_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine) !=
-        Status::Ok)
-      break;  // the final pass below reports it
-    r.scratch_refit_prev.clear();
-    r.scratch_refit_cur.clear();
-    for (std::size_t k = 0; k < fit_prev.size(); ++k) {
-      if (!(r.scratch_distance[k] <= options.max_epipolar_distance_px)) continue;
-      r.scratch_refit_prev.push_back(fit_prev[k]);
-      r.scratch_refit_cur.push_back(fit_cur[k]);
-    }
-    if (r.scratch_refit_prev.size() < 16) break;
-    FundamentalResult<T>& polished = r.scratch_polished_fit;
-    fundamental_8point(r.scratch_refit_prev, r.scratch_refit_cur, &r.scratch_fundamental, &polished);
-    if (!polished.ok()) break;
-    r.F = polished.F;
-  }
+  detail::consistency_refit(subset, options, out);
   const Status ds =
       epipolar_distances(r.F, r.scratch_prev, r.scratch_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine);
   if (ds != Status::Ok) {
@@ -217,14 +245,14 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
     r.reason = std::string("epipolar distances not usable (") + to_string(ds) + "): F is zero or not finite";
     return;
   }
+  // DFD-SLAM eq. 3: a track further than the threshold from its epipolar line is dynamic.
   const T t_out = options.max_epipolar_distance_px, t_in = options.max_epipolar_distance_in_boxes_px;
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t i = r.scratch_index[k];
     const T d = r.scratch_distance[k];
     r.distance_px[i] = d;
     if (!std::isfinite(d)) continue;  // at the epipole: the line is undefined, no evidence
-    const T t = (in_box.given && in_box[i]) ? t_in : t_out;
-    const bool dyn = d > t;
+    const bool dyn = d > ((in_box.given && in_box[i]) ? t_in : t_out);
     r.labels[i] = dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;
     r.num_dynamic += dyn;
     r.num_static += !dyn;
