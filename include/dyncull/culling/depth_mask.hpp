@@ -485,14 +485,140 @@ struct ParabolaEnvelope {
   }
 };
 
+/// The 8-neighbourhood pass of rasterise_missing_nearest over the classified rect (`cls`: 0 no depth,
+/// 1 in band, 2 out of it): a hole with a measured 4-neighbour, else a measured diagonal one, is decided
+/// by them (in on a tie) and OR-ed into `o_row(y)`; the others become kUnresolvedHole and their rows are
+/// flagged. Returns the holes set in.
+constexpr std::uint8_t kUnresolvedHole = 3;
+template <class OutRow>
+std::size_t resolve_holes_by_neighbours(std::uint8_t* cls, int w, int h, std::uint8_t value, OutRow&& o_row,
+                                        std::vector<std::uint8_t>* row_unresolved, bool* any_unresolved) {
+  const auto W = static_cast<std::size_t>(w);
+  auto seen = [](std::uint8_t k) { return k == 1 ? 1u : (k == 2 ? 2u : 0u); };  // bit 0 in band, bit 1 out
+  std::size_t count = 0;
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* c = cls + static_cast<std::size_t>(y) * W;
+    const std::uint8_t* up = y > 0 ? c - W : nullptr;
+    const std::uint8_t* down = y + 1 < h ? c + W : nullptr;
+    std::uint8_t* o = o_row(y);
+    for (int x = 0; x < w; ++x) {
+      // Next hole of the row (memchr: a vectorised scan over the measured pixels).
+      const void* hole = std::memchr(c + x, 0, static_cast<std::size_t>(w - x));
+      if (!hole) break;
+      x = static_cast<int>(static_cast<const std::uint8_t*>(hole) - c);
+      unsigned edge = 0, corner = 0;
+      if (x > 0) edge |= seen(c[x - 1]);
+      if (x + 1 < w) edge |= seen(c[x + 1]);
+      if (up) {
+        edge |= seen(up[x]);
+        if (x > 0) corner |= seen(up[x - 1]);
+        if (x + 1 < w) corner |= seen(up[x + 1]);
+      }
+      if (down) {
+        edge |= seen(down[x]);
+        if (x > 0) corner |= seen(down[x - 1]);
+        if (x + 1 < w) corner |= seen(down[x + 1]);
+      }
+      const unsigned nearest = edge ? edge : corner;
+      if (nearest == 0) {
+        c[x] = kUnresolvedHole;
+        (*row_unresolved)[static_cast<std::size_t>(y)] = 1;
+        *any_unresolved = true;
+      } else if (nearest & 1u) {  // an in-band pixel among the nearest (ties: in)
+        o[x] = static_cast<std::uint8_t>(o[x] | value);
+        ++count;
+      }
+    }
+  }
+  return count;
+}
+
+/// The first pass of the distance transform: each pixel's distance along its column to the nearest
+/// in-band (col_in) and out-of-band (col_out) pixel, `none` where the column has none; two sweeps.
+inline void column_distances(const std::uint8_t* cls, int w, int h, std::int16_t none, std::int16_t* col_in,
+                             std::int16_t* col_out) {
+  const auto W = static_cast<std::size_t>(w);
+  for (int y = 0; y < h; ++y) {  // nearest above (or at)
+    const std::uint8_t* c = cls + static_cast<std::size_t>(y) * W;
+    std::int16_t* gi = col_in + static_cast<std::size_t>(y) * W;
+    std::int16_t* go = col_out + static_cast<std::size_t>(y) * W;
+    const std::int16_t* ui = y > 0 ? gi - W : nullptr;
+    const std::int16_t* uo = y > 0 ? go - W : nullptr;
+    for (int x = 0; x < w; ++x) {
+      const std::int16_t above_in = ui ? std::min<std::int16_t>(static_cast<std::int16_t>(ui[x] + 1), none) : none;
+      const std::int16_t above_out = uo ? std::min<std::int16_t>(static_cast<std::int16_t>(uo[x] + 1), none) : none;
+      gi[x] = c[x] == 1 ? std::int16_t(0) : above_in;
+      go[x] = c[x] == 2 ? std::int16_t(0) : above_out;
+    }
+  }
+  for (int y = h - 2; y >= 0; --y) {  // ... or below
+    std::int16_t* gi = col_in + static_cast<std::size_t>(y) * W;
+    std::int16_t* go = col_out + static_cast<std::size_t>(y) * W;
+    for (int x = 0; x < w; ++x) {
+      gi[x] = std::min<std::int16_t>(gi[x], static_cast<std::int16_t>(gi[x + w] + 1));
+      go[x] = std::min<std::int16_t>(go[x], static_cast<std::int16_t>(go[x + w] + 1));
+    }
+  }
+}
+
+/// One row's unresolved holes by the second pass: min over columns q of (x - q)^2 + the squared column
+/// distance (fi, fo: kNoParabola where the column has none), in band when the nearest in-band pixel is
+/// no farther than the nearest out-of-band one. Each hole scans its row outwards until (x - q)^2 exceeds
+/// the best found, or, when the holes are wide, reads the exact parabola envelopes (linear in the row):
+/// whichever is cheaper by the holes' run lengths. Returns the holes set in.
+inline std::size_t resolve_row_by_distance(const std::uint8_t* c, const std::int32_t* fi, const std::int32_t* fo,
+                                           int w, std::uint8_t value, ParabolaEnvelope* env_in,
+                                           ParabolaEnvelope* env_out, std::uint8_t* o) {
+  // Scanning a run of L pixels without depth visits about L^2 / 2 columns; the two envelopes cost roughly
+  // 6 visits per column of the row (a rough reading on the real TUM frame): take the cheaper.
+  long long scan_cost = 0;
+  for (int x = 0, run = 0; x <= w; ++x) {
+    if (x < w && c[x] == kUnresolvedHole) {
+      ++run;
+    } else {
+      scan_cost += static_cast<long long>(run) * run / 2;
+      run = 0;
+    }
+  }
+  const bool use_envelope = scan_cost > 6LL * w;
+  if (use_envelope) {
+    env_in->build(fi, w);
+    env_out->build(fo, w);
+  }
+  std::size_t count = 0;
+  int j_in = 0, j_out = 0;
+  for (int x = 0; x < w; ++x) {
+    if (c[x] != kUnresolvedHole) continue;
+    std::int32_t best_in = fi[x], best_out = fo[x];
+    if (use_envelope) {
+      best_in = static_cast<std::int32_t>(std::min<long long>(env_in->at(fi, x, &j_in), kNoParabola));
+      best_out = static_cast<std::int32_t>(std::min<long long>(env_out->at(fo, x, &j_out), kNoParabola));
+    } else {
+      const int reach = std::max(x, w - 1 - x);
+      for (int r = 1; r <= reach; ++r) {
+        const std::int32_t r2 = r * r;
+        if (r2 > std::min(best_in, best_out)) break;
+        if (x - r >= 0) {
+          best_in = std::min(best_in, r2 + fi[x - r]);
+          best_out = std::min(best_out, r2 + fo[x - r]);
+        }
+        if (x + r < w) {
+          best_in = std::min(best_in, r2 + fi[x + r]);
+          best_out = std::min(best_out, r2 + fo[x + r]);
+        }
+      }
+    }
+    if (best_in > best_out) continue;  // ties, and a rect without measured pixels: in
+    o[x] = static_cast<std::uint8_t>(o[x] | value);
+    ++count;
+  }
+  return count;
+}
+
 /// MissingDepth::Nearest over a rect, exactly the rule of nearest_measured_in_band at every pixel
-/// without depth. A hole with a measured pixel among its 8 neighbours is decided by them; for the others,
-/// two column sweeps give each pixel's distance along its column to the nearest in-band
-/// and out-of-band pixel (the first pass of the distance transform); then each pixel without depth scans
-/// its row outwards, min over columns q of (x - q)^2 + column distance^2, until (x - q)^2 exceeds the
-/// best found. A row whose holes are wide takes the exact parabola envelopes instead (linear in the
-/// row), whichever is cheaper by the holes' run lengths. ORs `value` into the pixels
-/// that are in and returns how many. Allocates O(rect area): the pipeline's point labels never call it.
+/// without depth: the 8-neighbourhood decides most holes; the rest take the two-pass distance transform
+/// (column distances, then each row). ORs `value` into the pixels that are in and returns how many.
+/// Allocates O(rect area): the pipeline's point labels never call it.
 template <class Raw>
 std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rect,
                                       const DepthBand& band, std::uint8_t value, MaskView out) {
@@ -516,131 +642,26 @@ std::size_t rasterise_missing_nearest(const DepthView<Raw>& v, const RawRange<Ra
   std::vector<std::uint8_t> cls(n);
   for (int y = 0; y < h; ++y)
     classify_row(v.row(rect.r0 + y) + rect.c0, w, range, band, cls.data() + static_cast<std::size_t>(y) * W);
-  // Most holes are single pixels or slivers: a measured 4-neighbour (distance 1), else a measured
-  // diagonal one (distance sqrt 2), is the nearest, and the decision is exact from the 8-neighbourhood.
-  // The rest (class 3) need the distance transform below.
-  constexpr std::uint8_t kUnresolved = 3;
+  auto o_row = [&](int y) { return out.row(rect.r0 + y) + rect.c0; };
   std::vector<std::uint8_t> row_unresolved(static_cast<std::size_t>(h), 0);
   bool any_unresolved = false;
-  std::size_t count = 0;
-  for (int y = 0; y < h; ++y) {
-    std::uint8_t* c = cls.data() + static_cast<std::size_t>(y) * W;
-    const std::uint8_t* up = y > 0 ? c - W : nullptr;
-    const std::uint8_t* down = y + 1 < h ? c + W : nullptr;
-    std::uint8_t* o = out.row(rect.r0 + y) + rect.c0;
-    for (int x = 0; x < w; ++x) {
-      // Next hole of the row (memchr: a vectorised scan over the measured pixels).
-      const void* hole = std::memchr(c + x, 0, static_cast<std::size_t>(w - x));
-      if (!hole) break;
-      x = static_cast<int>(static_cast<const std::uint8_t*>(hole) - c);
-      // Measured neighbours in and out of the band: bit 0 = some in band, bit 1 = some out of it.
-      auto seen = [](std::uint8_t k) { return k == 1 ? 1u : (k == 2 ? 2u : 0u); };
-      unsigned edge = 0, corner = 0;
-      if (x > 0) edge |= seen(c[x - 1]);
-      if (x + 1 < w) edge |= seen(c[x + 1]);
-      if (up) {
-        edge |= seen(up[x]);
-        if (x > 0) corner |= seen(up[x - 1]);
-        if (x + 1 < w) corner |= seen(up[x + 1]);
-      }
-      if (down) {
-        edge |= seen(down[x]);
-        if (x > 0) corner |= seen(down[x - 1]);
-        if (x + 1 < w) corner |= seen(down[x + 1]);
-      }
-      const unsigned nearest = edge ? edge : corner;
-      if (nearest == 0) {
-        c[x] = kUnresolved;
-        row_unresolved[static_cast<std::size_t>(y)] = 1;
-        any_unresolved = true;
-      } else if (nearest & 1u) {  // an in-band pixel among the nearest (ties: in)
-        o[x] = static_cast<std::uint8_t>(o[x] | value);
-        ++count;
-      }
-    }
-  }
+  std::size_t count = resolve_holes_by_neighbours(cls.data(), w, h, value, o_row, &row_unresolved, &any_unresolved);
   if (!any_unresolved) return count;
   std::vector<std::int16_t> col_in(n), col_out(n);
-  for (int y = 0; y < h; ++y) {  // nearest above (or at)
-    const std::uint8_t* c = cls.data() + static_cast<std::size_t>(y) * W;
-    std::int16_t* gi = col_in.data() + static_cast<std::size_t>(y) * W;
-    std::int16_t* go = col_out.data() + static_cast<std::size_t>(y) * W;
-    const std::int16_t* ui = y > 0 ? gi - W : nullptr;
-    const std::int16_t* uo = y > 0 ? go - W : nullptr;
-    for (int x = 0; x < w; ++x) {
-      const std::int16_t above_in = ui ? std::min<std::int16_t>(static_cast<std::int16_t>(ui[x] + 1), none) : none;
-      const std::int16_t above_out = uo ? std::min<std::int16_t>(static_cast<std::int16_t>(uo[x] + 1), none) : none;
-      gi[x] = c[x] == 1 ? std::int16_t(0) : above_in;
-      go[x] = c[x] == 2 ? std::int16_t(0) : above_out;
-    }
-  }
-  for (int y = h - 2; y >= 0; --y) {  // ... or below
-    std::int16_t* gi = col_in.data() + static_cast<std::size_t>(y) * W;
-    std::int16_t* go = col_out.data() + static_cast<std::size_t>(y) * W;
-    for (int x = 0; x < w; ++x) {
-      gi[x] = std::min<std::int16_t>(gi[x], static_cast<std::int16_t>(gi[x + w] + 1));
-      go[x] = std::min<std::int16_t>(go[x], static_cast<std::int16_t>(go[x + w] + 1));
-    }
-  }
+  column_distances(cls.data(), w, h, none, col_in.data(), col_out.data());
   // Per row with an unresolved hole: squared column distances, kNoParabola where the column has none (larger than
-  // any in-rect squared distance, (w + h)^2 < 2^30, so every sum below stays in int32 and needs no branch).
+  // any in-rect squared distance, (w + h)^2 < 2^30, so every sum stays in int32 and needs no branch).
   std::vector<std::int32_t> f_in(W), f_out(W);
   ParabolaEnvelope env_in, env_out;
   for (int y = 0; y < h; ++y) {
     if (!row_unresolved[static_cast<std::size_t>(y)]) continue;
     const std::size_t i0 = static_cast<std::size_t>(y) * W;
-    const std::uint8_t* c = cls.data() + i0;
-    const std::int16_t* gi = col_in.data() + i0;
-    const std::int16_t* go = col_out.data() + i0;
-    std::int32_t* fi = f_in.data();
-    std::int32_t* fo = f_out.data();
     for (int q = 0; q < w; ++q) {
-      fi[q] = gi[q] < none ? std::int32_t(gi[q]) * gi[q] : kNoParabola;
-      fo[q] = go[q] < none ? std::int32_t(go[q]) * go[q] : kNoParabola;
+      const std::int16_t gi = col_in[i0 + static_cast<std::size_t>(q)], go = col_out[i0 + static_cast<std::size_t>(q)];
+      f_in[static_cast<std::size_t>(q)] = gi < none ? std::int32_t(gi) * gi : kNoParabola;
+      f_out[static_cast<std::size_t>(q)] = go < none ? std::int32_t(go) * go : kNoParabola;
     }
-    // Scanning a run of L pixels without depth visits about L^2 / 2 columns; the two envelopes cost roughly
-    // 6 visits per column of the row (a rough reading on the real TUM frame): take the cheaper.
-    long long scan_cost = 0;
-    for (int x = 0, run = 0; x <= w; ++x) {
-      if (x < w && c[x] == kUnresolved) {
-        ++run;
-      } else {
-        scan_cost += static_cast<long long>(run) * run / 2;
-        run = 0;
-      }
-    }
-    const bool use_envelope = scan_cost > 6LL * w;
-    if (use_envelope) {
-      env_in.build(fi, w);
-      env_out.build(fo, w);
-    }
-    std::uint8_t* o = out.row(rect.r0 + y) + rect.c0;
-    int j_in = 0, j_out = 0;
-    for (int x = 0; x < w; ++x) {
-      if (c[x] != kUnresolved) continue;
-      std::int32_t best_in = fi[x], best_out = fo[x];
-      if (use_envelope) {
-        best_in = static_cast<std::int32_t>(std::min<long long>(env_in.at(fi, x, &j_in), kNoParabola));
-        best_out = static_cast<std::int32_t>(std::min<long long>(env_out.at(fo, x, &j_out), kNoParabola));
-      } else {
-        const int reach = std::max(x, w - 1 - x);
-        for (int r = 1; r <= reach; ++r) {
-          const std::int32_t r2 = r * r;
-          if (r2 > std::min(best_in, best_out)) break;
-          if (x - r >= 0) {
-            best_in = std::min(best_in, r2 + fi[x - r]);
-            best_out = std::min(best_out, r2 + fo[x - r]);
-          }
-          if (x + r < w) {
-            best_in = std::min(best_in, r2 + fi[x + r]);
-            best_out = std::min(best_out, r2 + fo[x + r]);
-          }
-        }
-      }
-      if (best_in > best_out) continue;  // ties, and a rect without measured pixels: in
-      o[x] = static_cast<std::uint8_t>(o[x] | value);
-      ++count;
-    }
+    count += resolve_row_by_distance(cls.data() + i0, f_in.data(), f_out.data(), w, value, &env_in, &env_out, o_row(y));
   }
   return count;
 }
@@ -692,6 +713,110 @@ inline void reset_box_info(DepthMaskBoxInfo* info) {
   info->reason = std::move(reason);
 }
 
+/// DLD-SLAM eq. 1's inputs in raw units: the four corner depths and the centre depth d_c. Robust mode
+/// walks each corner inwards to its first measured pixel and takes the centre patch's lower median;
+/// the paper's plain form reads the pixels themselves (no depth counts as 0).
+template <class Raw>
+void box_corner_and_centre_depths(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rc,
+                                  const DepthMaskOptions& o, double corner[4], double* dc) {
+  const int x0 = rc.c0, y0 = rc.r0, x1 = rc.c1 - 1, y1 = rc.r1 - 1;
+  const int cu = (x0 + x1) / 2, cv = (y0 + y1) / 2;  // integer centre, as DLD-SLAM's reference code
+  if (o.mode == DepthMaskMode::Robust) {
+    const int steps = o.corner_search_px >= 0 ? o.corner_search_px : std::min(rc.width(), rc.height()) / 2;
+    corner[0] = walk_inwards(v, range, x0, y0, 1, 1, steps, rc);
+    corner[1] = walk_inwards(v, range, x1, y0, -1, 1, steps, rc);
+    corner[2] = walk_inwards(v, range, x0, y1, 1, -1, steps, rc);
+    corner[3] = walk_inwards(v, range, x1, y1, -1, -1, steps, rc);
+    *dc = patch_lower_median(v, range, cu, cv, o.centre_patch_radius_px, rc);
+    return;
+  }
+  const int cx[4] = {x0, x1, x0, x1}, cy[4] = {y0, y0, y1, y1};
+  for (int k = 0; k < 4; ++k) {
+    const Raw d = v.raw(cx[k], cy[k]);
+    corner[k] = raw_valid(d, range) ? static_cast<double>(d) : 0.0;  // "0 counts as 0"
+  }
+  const Raw d = v.raw(cu, cv);
+  *dc = raw_valid(d, range) ? static_cast<double>(d) : 0.0;
+}
+
+/// The histogram of the rect's depths sampled every `step` pixels (histogram_stride_px, or the stride
+/// giving about histogram_target_samples), in bins of bin_raw; bin nb counts the pixels without depth.
+/// Returns the samples taken. Neighbouring pixels mostly fall in the same bin, so a single histogram
+/// serialises on its own increments (store to load forwarding): four interleaved copies, summed after,
+/// let them overlap.
+template <class Raw>
+std::size_t depth_histogram(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rc,
+                            const DepthMaskOptions& o, double bin_raw, int nb, std::vector<std::uint32_t>* histogram) {
+  const std::size_t nh = static_cast<std::size_t>(nb) + 1;
+  std::vector<std::uint32_t>& hist4 = *histogram;
+  hist4.assign(4 * nh, 0u);
+  int step = o.histogram_stride_px;
+  if (step <= 0) {
+    const double per_sample = static_cast<double>(rc.area()) / std::max(1, o.histogram_target_samples);
+    step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
+  }
+  const float inv_bin = static_cast<float>(1.0 / bin_raw);
+  const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
+  // Bin index clamped in float before the conversion (a valid float depth may be 1e20 m).
+  const float last_bin = static_cast<float>(nb - 1);
+  auto bin_of = [&](Raw r) {
+    const float f = static_cast<float>(r);
+    const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
+    // checked: f >= vlo >= 0 when ok, clamped to last_bin in float: hot loop, no helper call.
+    return static_cast<std::size_t>(ok ? static_cast<int>(std::min(last_bin, f * inv_bin)) : nb);  // checked: above
+  };
+  std::uint32_t* h0 = hist4.data();
+  std::uint32_t* h1 = h0 + nh;
+  std::uint32_t* h2 = h1 + nh;
+  std::uint32_t* h3 = h2 + nh;
+  for (int y = rc.r0; y < rc.r1; y += step) {
+    const Raw* d = v.row(y);
+    int x = rc.c0;
+    for (; x + 3 * step < rc.c1; x += 4 * step) {
+      ++h0[bin_of(d[x])];
+      ++h1[bin_of(d[x + step])];
+      ++h2[bin_of(d[x + 2 * step])];
+      ++h3[bin_of(d[x + 3 * step])];
+    }
+    for (; x < rc.c1; x += step) ++h0[bin_of(d[x])];
+  }
+  for (std::size_t b = 0; b < nh; ++b) h0[b] += h1[b] + h2[b] + h3[b];
+  return static_cast<std::size_t>((rc.height() + step - 1) / step) * static_cast<std::size_t>((rc.width() + step - 1) / step);
+}
+
+/// The last bin of the foreground cluster: from d_c's bin (or, without d_c, the nearest bin holding 5 %
+/// of the valid pixels) onwards over bins holding histogram_occupied_fraction of them, across gaps of at
+/// most histogram_max_gap_bins, no deeper than max_object_depth_extent_m behind the seed. `seed_raw`
+/// receives the seed depth.
+inline int foreground_cluster_end(const std::uint32_t* hist, int nb, std::size_t valid, double dc, double bin_raw,
+                                  double upm, const DepthMaskOptions& o, double* seed_raw) {
+  const float inv_bin = static_cast<float>(1.0 / bin_raw);
+  // checked: a fraction in [0, 1] (validate) of the valid pixel count, which fits 32 bits.
+  const auto occupied = static_cast<std::uint32_t>(
+      std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));  // checked: above
+  int start = -1;
+  if (dc > 0) {
+    start = detail::clamped_bin(dc * inv_bin, nb);
+  } else {
+    const auto seed = static_cast<std::uint32_t>(std::max(1.0, 0.05 * static_cast<double>(valid)));  // checked: 5 % of a count
+    for (int b = 0; b < nb && start < 0; ++b)
+      if (hist[static_cast<std::size_t>(b)] >= seed) start = b;
+    if (start < 0) start = 0;
+  }
+  *seed_raw = dc > 0 ? dc : (start + 0.5) * bin_raw;
+  const int last_allowed = detail::clamped_bin((*seed_raw + o.max_object_depth_extent_m * upm) * inv_bin, nb);
+  int end = start, gap = 0;
+  for (int b = start + 1; b <= last_allowed; ++b) {
+    if (hist[static_cast<std::size_t>(b)] >= occupied) {
+      end = b;
+      gap = 0;
+    } else if (++gap > o.histogram_max_gap_bins) {
+      break;
+    }
+  }
+  return end;
+}
+
 /// Threshold and band of one box (no raster) into `out` (its reason's buffer reused); `band` receives the
 /// predicate. `histogram`: scratch of the histogram fallback.
 template <class Raw, class T>
@@ -713,27 +838,9 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
   }
   const PixelRect& rc = info.rect;
   const double upm = static_cast<double>(v.units_per_metre);
-  const int x0 = rc.c0, y0 = rc.r0, x1 = rc.c1 - 1, y1 = rc.r1 - 1;
-  const int cu = (x0 + x1) / 2, cv = (y0 + y1) / 2;  // integer centre, as DLD-SLAM's reference code
   const bool robust = o.mode == DepthMaskMode::Robust;
-
   double corner[4], dc;
-  if (robust) {
-    const int steps = o.corner_search_px >= 0 ? o.corner_search_px : std::min(rc.width(), rc.height()) / 2;
-    corner[0] = walk_inwards(v, range, x0, y0, 1, 1, steps, rc);
-    corner[1] = walk_inwards(v, range, x1, y0, -1, 1, steps, rc);
-    corner[2] = walk_inwards(v, range, x0, y1, 1, -1, steps, rc);
-    corner[3] = walk_inwards(v, range, x1, y1, -1, -1, steps, rc);
-    dc = patch_lower_median(v, range, cu, cv, o.centre_patch_radius_px, rc);
-  } else {
-    const int cx[4] = {x0, x1, x0, x1}, cy[4] = {y0, y0, y1, y1};
-    for (int k = 0; k < 4; ++k) {
-      const Raw d = v.raw(cx[k], cy[k]);
-      corner[k] = raw_valid(d, range) ? static_cast<double>(d) : 0.0;  // "0 counts as 0"
-    }
-    const Raw d = v.raw(cu, cv);
-    dc = raw_valid(d, range) ? static_cast<double>(d) : 0.0;
-  }
+  box_corner_and_centre_depths(v, range, rc, o, corner, &dc);
   const double dmax = std::max(std::max(corner[0], corner[1]), std::max(corner[2], corner[3]));
   info.d_max_m = dmax / upm;
   info.d_c_m = dc / upm;
@@ -741,7 +848,6 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
   auto eps_raw = [&](double eps_m) { return integral ? std::round(eps_m * upm) : eps_m * upm; };
   band->missing = robust ? o.missing_depth : MissingDepth::OutOfMask;
   band->lo = range.lo;
-
   auto set_threshold = [&](double thr_raw, DepthMaskOutcome outcome) {
     set_band_threshold(range, thr_raw, upm, outcome, &info, band);
   };
@@ -750,7 +856,6 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
     band->none = false;
     band->all = true;
   };
-
   if (o.form == DepthThresholdForm::DynamicVins) {
     const double e = eps_raw(o.dynamic_vins_eps_m);
     info.rule_applies = true;
@@ -761,7 +866,7 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
     info.masks_missing = band->missing == MissingDepth::InMask || band->all;
     return;
   }
-
+  // DLD-SLAM eq. 1-2: the rule applies when the background is deeper than the centre by more than eps.
   const double e = eps_raw(o.eps_m);
   info.rule_applies = dc > 0 && dmax - dc > e;
   if (robust && o.near_margin_m > 0 && dc > 0) band->lo = std::max(range.lo, dc - eps_raw(o.near_margin_m));
@@ -775,82 +880,21 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
     const double bin_raw = std::max(o.histogram_bin_m, 1e-3) * upm;
     const int nb = clamped_int(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3)), 1,
                                std::numeric_limits<int>::max() - 1);
-    // One extra bin collects invalid pixels, so the scatter loop has no branch. Neighbouring pixels
-    // mostly fall in the same bin, so a single histogram serialises on its own increments (store to
-    // load forwarding); four interleaved copies, summed afterwards, let them overlap.
-    const std::size_t nh = static_cast<std::size_t>(nb) + 1;
-    std::vector<std::uint32_t>& hist4 = *histogram;
-    hist4.assign(4 * nh, 0u);
-    int step = o.histogram_stride_px;
-    if (step <= 0) {
-      const double per_sample = static_cast<double>(rc.area()) / std::max(1, o.histogram_target_samples);
-      step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
-    }
-    const float inv_bin = static_cast<float>(1.0 / bin_raw);
-    const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
-    // Bin index clamped in float before the conversion (a valid float depth may be 1e20 m).
-    const float last_bin = static_cast<float>(nb - 1);
-    auto bin_of = [&](Raw r) {
-      const float f = static_cast<float>(r);
-      const bool ok = (unsigned(f >= vlo) & unsigned(f <= vhi)) != 0;
-      // checked: f >= vlo >= 0 when ok, clamped to last_bin in float: hot loop, no helper call.
-      return static_cast<std::size_t>(ok ? static_cast<int>(std::min(last_bin, f * inv_bin)) : nb);  // checked: above
-    };
-    std::uint32_t* h0 = hist4.data();
-    std::uint32_t* h1 = h0 + nh;
-    std::uint32_t* h2 = h1 + nh;
-    std::uint32_t* h3 = h2 + nh;
-    for (int y = rc.r0; y < rc.r1; y += step) {
-      const Raw* d = v.row(y);
-      int x = rc.c0;
-      for (; x + 3 * step < rc.c1; x += 4 * step) {
-        ++h0[bin_of(d[x])];
-        ++h1[bin_of(d[x + step])];
-        ++h2[bin_of(d[x + 2 * step])];
-        ++h3[bin_of(d[x + 3 * step])];
-      }
-      for (; x < rc.c1; x += step) ++h0[bin_of(d[x])];
-    }
-    for (std::size_t b = 0; b < nh; ++b) h0[b] += h1[b] + h2[b] + h3[b];
-    const std::uint32_t* hist = h0;
-    const std::size_t sampled = static_cast<std::size_t>((rc.height() + step - 1) / step) *
-                                static_cast<std::size_t>((rc.width() + step - 1) / step);
+    const std::size_t sampled = depth_histogram(v, range, rc, o, bin_raw, nb, histogram);
+    const std::uint32_t* hist = histogram->data();
     const std::size_t valid = sampled - hist[static_cast<std::size_t>(nb)];
     info.num_valid_pixels = valid;
     if (static_cast<double>(valid) < o.min_valid_fraction * static_cast<double>(sampled) || valid == 0) {
       whole_box();
       info.reason = "too few pixels with depth: whole box";
     } else {
-      // checked: a fraction in [0, 1] (validate) of the valid pixel count, which fits 32 bits.
-      const auto occupied = static_cast<std::uint32_t>(
-          std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));  // checked: above
-      int start = -1;
-      if (dc > 0) {
-        start = detail::clamped_bin(dc * inv_bin, nb);
-      } else {
-        // No centre depth: the nearest bin holding 5 % of the valid pixels seeds the cluster.
-        const auto seed = static_cast<std::uint32_t>(std::max(1.0, 0.05 * static_cast<double>(valid)));  // checked: 5 % of a count
-        for (int b = 0; b < nb && start < 0; ++b)
-          if (hist[static_cast<std::size_t>(b)] >= seed) start = b;
-        if (start < 0) start = 0;
-      }
-      const double seed_raw = dc > 0 ? dc : (start + 0.5) * bin_raw;
-      const int last_allowed = detail::clamped_bin((seed_raw + o.max_object_depth_extent_m * upm) * inv_bin, nb);
-      int end = start, gap = 0;
-      for (int b = start + 1; b <= last_allowed; ++b) {
-        if (hist[static_cast<std::size_t>(b)] >= occupied) {
-          end = b;
-          gap = 0;
-        } else if (++gap > o.histogram_max_gap_bins) {
-          break;
-        }
-      }
+      double seed_raw = 0;
+      const int end = foreground_cluster_end(hist, nb, valid, dc, bin_raw, upm, o, &seed_raw);
       set_threshold((end + 1) * bin_raw, DepthMaskOutcome::HistogramFallback);
       if (info.d_c_m == 0) info.d_c_m = seed_raw / upm;
     }
   }
   info.masks_missing = band->missing == MissingDepth::InMask || band->all;
-  return;
 }
 
 /// DepthMaskOptions::occluded_centre_search for box b against box a (both planned). Returns true and
