@@ -290,6 +290,73 @@ double walk_inwards(const DepthView<Raw>& v, const RawRange<Raw>& range, int u, 
   return 0;
 }
 
+/// One row of rasterise_pass for 16-bit depth: ORs `value` into o[c0, c1) where d is in [lo, lo + span)
+/// (or, with missing_in, outside the valid range [vlo, vlo + vspan]); returns how many. Single unsigned
+/// compares: d in [lo, hi) <=> (uint16)(d - lo) < hi - lo.
+inline std::size_t rasterise_row_u16(const std::uint16_t* d, std::uint8_t* o, int c0, int c1, std::uint16_t lo,
+                                     std::uint16_t span, std::uint16_t vlo, std::uint16_t vspan, bool missing_in,
+                                     std::uint8_t value) {
+  const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
+  std::size_t row_count = 0;
+  int x = c0;
+#if defined(__SSE2__)
+  // Explicit SSE2 (x86-64 baseline): g++ does not vectorise this loop at -O2, where it ran 4x
+  // slower. x < span <=> subs_epu16(x, span - 1) == 0 (span > 0); x > vspan <=> subs(x, vspan) != 0.
+  if (span > 0) {
+    const __m128i lo8 = _mm_set1_epi16(static_cast<short>(lo));
+    const __m128i span_m1 = _mm_set1_epi16(static_cast<short>(span - 1));
+    const __m128i vlo8 = _mm_set1_epi16(static_cast<short>(vlo));
+    const __m128i vspan8 = _mm_set1_epi16(static_cast<short>(vspan));
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i miss_on = missing_in ? _mm_set1_epi16(-1) : zero;
+    const __m128i val = _mm_set1_epi8(static_cast<char>(value));
+    // Set lanes are -1: subtracting them counts per 16-bit lane (no popcnt in baseline x86-64).
+    __m128i counts = zero;
+    for (; x + 16 <= c1; x += 16) {
+      const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + x));
+      const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + x + 8));
+      const __m128i in_a = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(a, lo8), span_m1), zero);
+      const __m128i in_b = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(b, lo8), span_m1), zero);
+      const __m128i ok_a = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(a, vlo8), vspan8), zero);
+      const __m128i ok_b = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(b, vlo8), vspan8), zero);
+      const __m128i m_a = _mm_or_si128(in_a, _mm_andnot_si128(ok_a, miss_on));
+      const __m128i m_b = _mm_or_si128(in_b, _mm_andnot_si128(ok_b, miss_on));
+      const __m128i m = _mm_packs_epi16(m_a, m_b);  // 0xFFFF -> 0xFF, 0 -> 0
+      __m128i* dst = reinterpret_cast<__m128i*>(o + x);
+      _mm_storeu_si128(dst, _mm_or_si128(_mm_loadu_si128(dst), _mm_and_si128(m, val)));
+      counts = _mm_sub_epi16(_mm_sub_epi16(counts, m_a), m_b);
+    }
+    alignas(16) std::int32_t lanes[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), _mm_madd_epi16(counts, _mm_set1_epi16(1)));
+    row_count += static_cast<std::size_t>(lanes[0] + lanes[1] + lanes[2] + lanes[3]);
+  }
+#endif
+  for (; x < c1; ++x) {
+    const bool in = static_cast<std::uint16_t>(d[x] - lo) < span;
+    const bool miss = static_cast<std::uint16_t>(d[x] - vlo) > vspan;
+    const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (miss ? miss_value : 0));
+    o[x] = static_cast<std::uint8_t>(o[x] | m);
+    row_count += (in || (miss && missing_in)) ? 1u : 0u;
+  }
+  return row_count;
+}
+
+/// One row of rasterise_pass for any other depth type (NaN: no depth).
+template <class Raw>
+std::size_t rasterise_row(const Raw* d, std::uint8_t* o, int c0, int c1, Raw lo, Raw hi, Raw vlo, Raw vhi,
+                          bool missing_in, std::uint8_t value) {
+  const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
+  unsigned row_count = 0;
+  for (int x = c0; x < c1; ++x) {
+    const bool in = (unsigned(d[x] >= lo) & unsigned(d[x] < hi)) != 0;
+    const bool valid = (unsigned(d[x] >= vlo) & unsigned(d[x] <= vhi)) != 0;  // NaN: invalid
+    const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (valid ? 0 : miss_value));
+    o[x] = static_cast<std::uint8_t>(o[x] | m);
+    row_count += m != 0;
+  }
+  return row_count;
+}
+
 /// One pass over the rect: OR `value` where the band holds, with missing pixels in when `missing_in`;
 /// returns the number of set pixels.
 template <class Raw>
@@ -306,77 +373,18 @@ std::size_t rasterise_pass(const DepthView<Raw>& v, const RawRange<Raw>& range, 
     return static_cast<std::size_t>(rect.area());
   }
   if constexpr (std::is_same<Raw, std::uint16_t>::value) {
-    // Single unsigned compares: d in [lo, hi) <=> (uint16)(d - lo) < hi - lo.
     // checked: for uint16 raw the band and the valid range lie in [1, 65536] with lo <= hi
     // (valid_raw_range, plan_band): every bound and span below fits 16 bits.
     const auto lo = static_cast<std::uint16_t>(band.lo);                               // checked: above
     const auto span = static_cast<std::uint16_t>(std::max(0.0, band.hi - band.lo));  // checked: above
     const auto vlo = static_cast<std::uint16_t>(range.lo);                           // checked: above
     const auto vspan = static_cast<std::uint16_t>(range.hi - range.lo);              // checked: above
-    const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
-    for (int y = r0; y < r1; ++y) {
-      const std::uint16_t* d = v.row(y);
-      std::uint8_t* o = out.row(y);
-      std::size_t row_count = 0;
-      int x = c0;
-#if defined(__SSE2__)
-      // Explicit SSE2 (x86-64 baseline): g++ does not vectorise this loop at -O2, where it ran 4x
-      // slower. x < span <=> subs_epu16(x, span - 1) == 0 (span > 0); x > vspan <=> subs(x, vspan) != 0.
-      if (span > 0) {
-        const __m128i lo8 = _mm_set1_epi16(static_cast<short>(lo));
-        const __m128i span_m1 = _mm_set1_epi16(static_cast<short>(span - 1));
-        const __m128i vlo8 = _mm_set1_epi16(static_cast<short>(vlo));
-        const __m128i vspan8 = _mm_set1_epi16(static_cast<short>(vspan));
-        const __m128i zero = _mm_setzero_si128();
-        const __m128i miss_on = missing_in ? _mm_set1_epi16(-1) : zero;
-        const __m128i val = _mm_set1_epi8(static_cast<char>(value));
-        // Set lanes are -1: subtracting them counts per 16-bit lane (no popcnt in baseline x86-64).
-        __m128i counts = zero;
-        for (; x + 16 <= c1; x += 16) {
-          const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + x));
-          const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + x + 8));
-          const __m128i in_a = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(a, lo8), span_m1), zero);
-          const __m128i in_b = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(b, lo8), span_m1), zero);
-          const __m128i ok_a = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(a, vlo8), vspan8), zero);
-          const __m128i ok_b = _mm_cmpeq_epi16(_mm_subs_epu16(_mm_sub_epi16(b, vlo8), vspan8), zero);
-          const __m128i m_a = _mm_or_si128(in_a, _mm_andnot_si128(ok_a, miss_on));
-          const __m128i m_b = _mm_or_si128(in_b, _mm_andnot_si128(ok_b, miss_on));
-          const __m128i m = _mm_packs_epi16(m_a, m_b);  // 0xFFFF -> 0xFF, 0 -> 0
-          __m128i* dst = reinterpret_cast<__m128i*>(o + x);
-          _mm_storeu_si128(dst, _mm_or_si128(_mm_loadu_si128(dst), _mm_and_si128(m, val)));
-          counts = _mm_sub_epi16(_mm_sub_epi16(counts, m_a), m_b);
-        }
-        alignas(16) std::int32_t lanes[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(lanes), _mm_madd_epi16(counts, _mm_set1_epi16(1)));
-        row_count += static_cast<std::size_t>(lanes[0] + lanes[1] + lanes[2] + lanes[3]);
-      }
-#endif
-      for (; x < c1; ++x) {
-        const bool in = static_cast<std::uint16_t>(d[x] - lo) < span;
-        const bool miss = static_cast<std::uint16_t>(d[x] - vlo) > vspan;
-        const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (miss ? miss_value : 0));
-        o[x] = static_cast<std::uint8_t>(o[x] | m);
-        row_count += (in || (miss && missing_in)) ? 1u : 0u;
-      }
-      count += row_count;
-    }
+    for (int y = r0; y < r1; ++y)
+      count += rasterise_row_u16(v.row(y), out.row(y), c0, c1, lo, span, vlo, vspan, missing_in, value);
   } else {
     const Raw lo = static_cast<Raw>(band.lo), hi = static_cast<Raw>(band.hi);
     const Raw vlo = static_cast<Raw>(range.lo), vhi = static_cast<Raw>(range.hi);
-    const std::uint8_t miss_value = missing_in ? value : std::uint8_t(0);
-    for (int y = r0; y < r1; ++y) {
-      const Raw* d = v.row(y);
-      std::uint8_t* o = out.row(y);
-      unsigned row_count = 0;
-      for (int x = c0; x < c1; ++x) {
-        const bool in = (unsigned(d[x] >= lo) & unsigned(d[x] < hi)) != 0;
-        const bool valid = (unsigned(d[x] >= vlo) & unsigned(d[x] <= vhi)) != 0;  // NaN: invalid
-        const std::uint8_t m = static_cast<std::uint8_t>((in ? value : 0) | (valid ? 0 : miss_value));
-        o[x] = static_cast<std::uint8_t>(o[x] | m);
-        row_count += m != 0;
-      }
-      count += row_count;
-    }
+    for (int y = r0; y < r1; ++y) count += rasterise_row(v.row(y), out.row(y), c0, c1, lo, hi, vlo, vhi, missing_in, value);
   }
   return count;
 }
@@ -1010,6 +1018,68 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
   return info;
 }
 
+namespace detail {
+
+/// Every point static; false (status and reason set, no box planned) without depth, with a mask of
+/// another size than the depth image, or with invalid inputs.
+template <class Raw>
+bool depth_mask_start(const DepthView<Raw>& depth, std::size_t n, const DepthMaskOptions& options, MaskView out,
+                      DepthMaskResult* result) {
+  DepthMaskResult& r = *result;
+  r.status = Status::Ok;
+  r.reason.clear();
+  r.num_static = r.num_candidate = r.num_dynamic = r.num_in_boxes = r.num_mask_pixels = 0;
+  r.labels.assign(n, FeatureLabel::Static);
+  r.reasons.assign(n, CullReason::None);
+  r.box_index.assign(n, -1);
+  r.box_bits.assign(n, 0u);
+  bool ok = true;
+  if (depth.empty()) {
+    r.status = Status::Skipped;
+    r.reason.assign("no depth image");
+    ok = false;
+  } else if (!out.empty() && (out.width != depth.width || out.height != depth.height)) {
+    r.status = Status::InvalidInput;
+    r.reason.assign("mask size differs from the depth image");
+    ok = false;
+  } else if (!depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) {
+    ok = false;
+  }
+  if (!ok) r.boxes.clear();
+  return ok;
+}
+
+/// Labels one point by the planned boxes it falls in (pixel lu, lv): Dynamic (reason DepthMask) inside a
+/// box's band, Candidate in a box whose rule does not apply; box_bits records every band that holds it.
+template <class Raw>
+void label_by_bands(std::size_t i, int lu, int lv, const DepthView<Raw>& depth, const RawRange<Raw>& range,
+                    const std::vector<DepthBand>& bands, DepthMaskResult* result) {
+  DepthMaskResult& r = *result;
+  bool inside_any = false;
+  for (std::size_t b = 0; b < r.boxes.size(); ++b) {
+    const DepthMaskBoxInfo& info = r.boxes[b];
+    if (!info.ok() || lu < info.rect.c0 || lu >= info.rect.c1 || lv < info.rect.r0 || lv >= info.rect.r1) continue;
+    inside_any = true;
+    if (info.outcome == DepthMaskOutcome::NotApplied) {
+      if (r.labels[i] == FeatureLabel::Static) {
+        r.labels[i] = FeatureLabel::Candidate;
+        r.reasons[i] = CullReason::DepthMask;
+        r.box_index[i] = static_cast<std::int32_t>(b);
+      }
+    } else if (band_contains(depth, range, bands[b], info.rect, lu, lv)) {
+      if (r.labels[i] != FeatureLabel::Dynamic) {
+        r.labels[i] = FeatureLabel::Dynamic;
+        r.reasons[i] = CullReason::DepthMask;
+        r.box_index[i] = static_cast<std::int32_t>(b);
+      }
+      if (b < 32) r.box_bits[i] |= 1u << b;
+    }
+  }
+  r.num_in_boxes += inside_any;
+}
+
+}  // namespace detail
+
 /// Masks every box and labels every point: Dynamic (DepthMask) when the point's pixel (rounded)
 /// is in a box's mask, Candidate when it lies in a box whose plain rule did not apply, else Static.
 /// Non-finite points are Dynamic (InvalidInput). Bad boxes are reported per box; the call fails
@@ -1022,36 +1092,14 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
                 DepthMaskResult* result, DepthMaskScratch* scratch, MaskView out = {}) {
   static_assert(is_point_container_v<Points>, "depth_mask: points must be a container of points");
   DepthMaskResult& r = *result;
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_static = r.num_candidate = r.num_dynamic = r.num_in_boxes = r.num_mask_pixels = 0;
   const std::size_t n = points.size();
-  r.labels.assign(n, FeatureLabel::Static);
-  r.reasons.assign(n, CullReason::None);
-  r.box_index.assign(n, -1);
-  r.box_bits.assign(n, 0u);
-  if (depth.empty()) {
-    r.boxes.clear();
-    r.status = Status::Skipped;
-    r.reason.assign("no depth image");
-    return;
-  }
-  if (!out.empty() && (out.width != depth.width || out.height != depth.height)) {
-    r.boxes.clear();
-    r.status = Status::InvalidInput;
-    r.reason.assign("mask size differs from the depth image");
-    return;
-  }
-  if (!detail::depth_mask_inputs_valid(depth, options, &r.status, &r.reason)) {
-    r.boxes.clear();
-    return;
-  }
+  if (!detail::depth_mask_start(depth, n, options, out, result)) return;
   const auto range = detail::valid_raw_range(depth);
   std::vector<detail::DepthBand>& bands = scratch->bands;
   bands.assign(boxes.size(), detail::DepthBand{});
   r.boxes.resize(boxes.size());  // the kept elements' reason buffers are reused
   std::size_t bad = 0;
-  for (std::size_t b = 0; b < boxes.size(); ++b) {
+  for (std::size_t b = 0; b < boxes.size(); ++b) {  // DLD-SLAM eq. 1-2 per box
     detail::plan_box(depth, range, detail::as_box(boxes[b]), options, &scratch->histogram, &r.boxes[b], &bands[b]);
     if (!r.boxes[b].ok()) ++bad;
   }
@@ -1080,7 +1128,6 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
     r.reason += std::to_string(boxes.size());
     r.reason += " boxes skipped";
   }
-
   for (std::size_t i = 0; i < n; ++i) {
     using S = typename PointTraits<container_point_t<Points>>::Scalar;
     const S px = point_x(points[i]), py = point_y(points[i]);
@@ -1092,27 +1139,7 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
     }
     int lu = -1, lv = -1;  // outside every rect when the point is outside the image
     pixel_of(static_cast<double>(px), static_cast<double>(py), depth.width, depth.height, &lu, &lv);
-    bool inside_any = false;
-    for (std::size_t b = 0; b < r.boxes.size(); ++b) {
-      const DepthMaskBoxInfo& info = r.boxes[b];
-      if (!info.ok() || lu < info.rect.c0 || lu >= info.rect.c1 || lv < info.rect.r0 || lv >= info.rect.r1) continue;
-      inside_any = true;
-      if (info.outcome == DepthMaskOutcome::NotApplied) {
-        if (r.labels[i] == FeatureLabel::Static) {
-          r.labels[i] = FeatureLabel::Candidate;
-          r.reasons[i] = CullReason::DepthMask;
-          r.box_index[i] = static_cast<std::int32_t>(b);
-        }
-      } else if (detail::band_contains(depth, range, bands[b], info.rect, lu, lv)) {
-        if (r.labels[i] != FeatureLabel::Dynamic) {
-          r.labels[i] = FeatureLabel::Dynamic;
-          r.reasons[i] = CullReason::DepthMask;
-          r.box_index[i] = static_cast<std::int32_t>(b);
-        }
-        if (b < 32) r.box_bits[i] |= 1u << b;
-      }
-    }
-    r.num_in_boxes += inside_any;
+    detail::label_by_bands(i, lu, lv, depth, range, bands, &r);
     r.num_dynamic += r.labels[i] == FeatureLabel::Dynamic;
     r.num_candidate += r.labels[i] == FeatureLabel::Candidate;
   }
