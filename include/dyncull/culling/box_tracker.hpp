@@ -101,90 +101,13 @@ class BoxTracker {
       r.status = Status::InvalidInput;
       return;
     }
-    // Predicted boxes of the existing tracks.
-    std::vector<Box<T>>& predicted = predicted_;
-    predicted.resize(tracks_.size());
-    for (std::size_t t = 0; t < tracks_.size(); ++t) {
-      const Box<T>& b = tracks_[t].detection.box;
-      const Vec2<T>& v = tracks_[t].velocity;
-      predicted[t] = Box<T>{b.x0 + v.x(), b.y0 + v.y(), b.x1 + v.x(), b.y1 + v.y()};
-    }
-    // Greedy association by IoU, best pairs first (a handful of boxes: O(n^2 log n) is nothing).
-    std::vector<Pair>& pairs = pairs_;
-    pairs.clear();
-    std::size_t invalid = 0;
-    for (std::size_t d = 0; d < detections.size(); ++d) {
-      if (!detections[d].box.valid()) {
-        ++invalid;
-        continue;
-      }
-      for (std::size_t t = 0; t < tracks_.size(); ++t) {
-        if (options_.same_class_only && detections[d].class_id != tracks_[t].detection.class_id) continue;
-        const T o = iou(detections[d].box, predicted[t]);
-        if (o >= options_.min_iou) pairs.push_back(Pair{o, d, t});
-      }
-    }
-    std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
-      return a.iou > b.iou || (a.iou == b.iou && (a.det < b.det || (a.det == b.det && a.track < b.track)));
-    });
-    std::vector<std::int64_t>& det_track = det_track_;
-    std::vector<std::uint8_t>& track_used = track_used_;
-    det_track.assign(detections.size(), -1);
-    track_used.assign(tracks_.size(), 0);
-    for (const Pair& p : pairs) {
-      if (det_track[p.det] >= 0 || track_used[p.track]) continue;
-      det_track[p.det] = static_cast<std::int64_t>(p.track);
-      track_used[p.track] = 1;
-    }
-
-    std::vector<TrackedBox<T>>& next = next_;
-    next.clear();
-    next.reserve(tracks_.size() + detections.size());
-    for (std::size_t d = 0; d < detections.size(); ++d) {
-      if (!detections[d].box.valid()) continue;
-      TrackedBox<T> tb;
-      if (det_track[d] >= 0) {
-        const TrackedBox<T>& old = tracks_[static_cast<std::size_t>(det_track[d])];
-        // Velocity from the last real detection, spread over the frames it was missed.
-        const Vec2<T> shift = (detections[d].box.centre() - old.last_centre) / T(old.missed + 1);
-        tb = old;
-        tb.velocity = (T(1) - options_.velocity_smoothing) * old.velocity + options_.velocity_smoothing * shift;
-        ++tb.hits;
-        ++r.num_matched;
-      } else {
-        tb.id = next_id_++;
-        tb.hits = 1;
-        ++r.num_new;
-      }
-      tb.detection = detections[d];
-      tb.last_centre = detections[d].box.centre();
-      tb.missed = 0;
-      r.boxes.push_back(detections[d]);
-      r.carried.push_back(0);
-      r.track_id.push_back(tb.id);
-      next.push_back(tb);
-    }
-    for (std::size_t t = 0; t < tracks_.size(); ++t) {
-      if (track_used[t]) continue;
-      TrackedBox<T> tb = tracks_[t];
-      ++tb.missed;
-      const Box<T> moved = predicted[t].padded(options_.grow_px_per_frame);
-      const bool outside = moved.x1 < T(0) || moved.y1 < T(0) || moved.x0 > T(width - 1) || moved.y0 > T(height - 1);
-      if (tb.missed > options_.max_missed_frames || outside || !moved.valid()) {
-        ++r.num_dropped;
-        continue;
-      }
-      // The unclipped box is kept for the next prediction; the output is clipped to the image.
-      tb.detection.box = moved;
-      Detection<T> out = tb.detection;
-      out.box = moved.clipped(width, height);
-      r.boxes.push_back(out);
-      r.carried.push_back(1);
-      r.track_id.push_back(tb.id);
-      ++r.num_carried;
-      next.push_back(tb);
-    }
-    tracks_.swap(next);
+    predict();
+    const std::size_t invalid = associate(detections);
+    next_.clear();
+    next_.reserve(tracks_.size() + detections.size());
+    take_detections(detections, &r);
+    carry_missed_tracks(width, height, &r);
+    tracks_.swap(next_);
     if (invalid) {
       r.reason.assign(std::to_string(invalid));
       r.reason += " invalid detection(s) ignored";
@@ -205,6 +128,99 @@ class BoxTracker {
   }
 
  private:
+  /// Each track's box moved by its velocity.
+  void predict() {
+    predicted_.resize(tracks_.size());
+    for (std::size_t t = 0; t < tracks_.size(); ++t) {
+      const Box<T>& b = tracks_[t].detection.box;
+      const Vec2<T>& v = tracks_[t].velocity;
+      predicted_[t] = Box<T>{b.x0 + v.x(), b.y0 + v.y(), b.x1 + v.x(), b.y1 + v.y()};
+    }
+  }
+
+  /// Greedy association by IoU with the predicted boxes, best pairs first (a handful of boxes: O(n^2 log n)
+  /// is nothing): det_track_[d] is detection d's track or -1. Returns the invalid detections skipped.
+  std::size_t associate(const std::vector<Detection<T>>& detections) {
+    pairs_.clear();
+    std::size_t invalid = 0;
+    for (std::size_t d = 0; d < detections.size(); ++d) {
+      if (!detections[d].box.valid()) {
+        ++invalid;
+        continue;
+      }
+      for (std::size_t t = 0; t < tracks_.size(); ++t) {
+        if (options_.same_class_only && detections[d].class_id != tracks_[t].detection.class_id) continue;
+        const T o = iou(detections[d].box, predicted_[t]);
+        if (o >= options_.min_iou) pairs_.push_back(Pair{o, d, t});
+      }
+    }
+    std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) {
+      return a.iou > b.iou || (a.iou == b.iou && (a.det < b.det || (a.det == b.det && a.track < b.track)));
+    });
+    det_track_.assign(detections.size(), -1);
+    track_used_.assign(tracks_.size(), 0);
+    for (const Pair& p : pairs_) {
+      if (det_track_[p.det] >= 0 || track_used_[p.track]) continue;
+      det_track_[p.det] = static_cast<std::int64_t>(p.track);
+      track_used_[p.track] = 1;
+    }
+    return invalid;
+  }
+
+  /// Every valid detection continues its track (velocity smoothed from the last real detection) or
+  /// starts a new one.
+  void take_detections(const std::vector<Detection<T>>& detections, BoxTrackerResult<T>* r) {
+    for (std::size_t d = 0; d < detections.size(); ++d) {
+      if (!detections[d].box.valid()) continue;
+      TrackedBox<T> tb;
+      if (det_track_[d] >= 0) {
+        const TrackedBox<T>& old = tracks_[static_cast<std::size_t>(det_track_[d])];
+        // Velocity from the last real detection, spread over the frames it was missed.
+        const Vec2<T> shift = (detections[d].box.centre() - old.last_centre) / T(old.missed + 1);
+        tb = old;
+        tb.velocity = (T(1) - options_.velocity_smoothing) * old.velocity + options_.velocity_smoothing * shift;
+        ++tb.hits;
+        ++r->num_matched;
+      } else {
+        tb.id = next_id_++;
+        tb.hits = 1;
+        ++r->num_new;
+      }
+      tb.detection = detections[d];
+      tb.last_centre = detections[d].box.centre();
+      tb.missed = 0;
+      r->boxes.push_back(detections[d]);
+      r->carried.push_back(0);
+      r->track_id.push_back(tb.id);
+      next_.push_back(tb);
+    }
+  }
+
+  /// An unmatched track is carried at its predicted box, grown by grow_px_per_frame, until it has been
+  /// missed max_missed_frames times or leaves the image.
+  void carry_missed_tracks(int width, int height, BoxTrackerResult<T>* r) {
+    for (std::size_t t = 0; t < tracks_.size(); ++t) {
+      if (track_used_[t]) continue;
+      TrackedBox<T> tb = tracks_[t];
+      ++tb.missed;
+      const Box<T> moved = predicted_[t].padded(options_.grow_px_per_frame);
+      const bool outside = moved.x1 < T(0) || moved.y1 < T(0) || moved.x0 > T(width - 1) || moved.y0 > T(height - 1);
+      if (tb.missed > options_.max_missed_frames || outside || !moved.valid()) {
+        ++r->num_dropped;
+        continue;
+      }
+      // The unclipped box is kept for the next prediction; the output is clipped to the image.
+      tb.detection.box = moved;
+      Detection<T> out = tb.detection;
+      out.box = moved.clipped(width, height);
+      r->boxes.push_back(out);
+      r->carried.push_back(1);
+      r->track_id.push_back(tb.id);
+      ++r->num_carried;
+      next_.push_back(tb);
+    }
+  }
+
   struct Pair {
     T iou;
     std::size_t det, track;
