@@ -379,142 +379,24 @@ class Culler {
     std::string why;
     Status s = check_frame(f, n, &why);
     if (s != Status::Ok) return refuse_frame(s, why, n);
-
-    // A descriptor width other than the keyframe's cannot be matched to it: this frame starts anew.
-    std::string dropped;
-    if (have_keyframe_ && f.keyframe_match == nullptr && f.descriptors.data != nullptr && keyframe_desc_rows_ > 0 &&
-        f.descriptors.row_bytes != keyframe_row_bytes_) {
-      dropped = "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) + " bytes where the keyframe's have " +
-                std::to_string(keyframe_row_bytes_) + ": not matched, this frame becomes the keyframe";
-      forget_keyframe();
-      r.frames_since_keyframe = 0;
-    }
-
-    // Positions the geometry reads: undistorted when given. A point non-finite in either is culled.
-    const PointsView& geo = f.undistorted_keypoints.given ? f.undistorted_keypoints : f.keypoints;
-    const T nan = std::numeric_limits<T>::quiet_NaN();
-    cur_px_.resize(n);
-    non_finite_.assign(n, 0);
-    std::size_t bad[2] = {0, 0}, first_bad[2] = {0, 0};
-    for (std::size_t i = 0; i < n; ++i) {
-      // Read in T: a double beyond float's range is an infinity to Culler<float>.
-      const Vec2<T> raw(static_cast<T>(f.keypoints.x(i)), static_cast<T>(f.keypoints.y(i)));
-      const Vec2<T> p = &geo == &f.keypoints ? raw : Vec2<T>(static_cast<T>(geo.x(i)), static_cast<T>(geo.y(i)));
-      const bool raw_ok = std::isfinite(raw.x()) && std::isfinite(raw.y());
-      const bool geo_ok = std::isfinite(p.x()) && std::isfinite(p.y());
-      cur_px_[i] = raw_ok && geo_ok ? p : Vec2<T>(nan, nan);
-      if (raw_ok && geo_ok) continue;
-      non_finite_[i] = 1;
-      const int which = raw_ok ? 1 : 0;  // named by the argument that holds the NaN or Inf
-      if (bad[which]++ == 0) first_bad[which] = i;
-    }
-
-    const CullerInputs need = inputs();
+    const std::string dropped = drop_keyframe_of_another_width(f, &r);
+    NonFinite bad;
+    read_positions(f, n, &bad);
     const bool have_depth = !f.depth_m.empty() || !f.depth_raw.empty();
     const bool have_pose = f.cam_from_world != nullptr;
-    r.missing.depth = need.depth && !have_depth;
-    r.missing.detections = need.detections && f.detections == nullptr;
-    // A frame without keypoints has no descriptor rows to give: nothing is missing.
-    r.missing.descriptors = need.descriptors && n > 0 && f.descriptors.data == nullptr && f.keyframe_match == nullptr;
-    r.missing.pose = need.pose && !have_pose;
+    note_missing(f, n, have_depth, have_pose, &r);
     const Rigid3<T> pose = have_pose ? *f.cam_from_world : (have_keyframe_ ? keyframe_pose_ : Rigid3<T>::identity());
-
-    // Correspondences to the keyframe, and from them the evidence arrays.
-    prev_px_.assign(n, Vec2<T>(nan, nan));
-    valid_.assign(n, 0);
-    points_world_.assign(n, Vec3<T>(nan, nan, nan));
-    r.track_ids.resize(n);
-    if (have_keyframe_) {
-      if (f.keyframe_match) {
-        // check_frame copied and range-checked them into match_index_.
-      } else if (f.descriptors.data != nullptr && keyframe_desc_rows_ > 0) {
-        const Rigid3<T> cam_from_keyframe = pose * keyframe_pose_.inverse();
-        match_to_keyframe(keyframe_px_, keyframe_cam_points_,
-                          DescriptorRows(keyframe_desc_.data(), keyframe_desc_rows_, 0, keyframe_row_bytes_), cur_px_,
-                          f.descriptors, camera_, have_pose ? &cam_from_keyframe : nullptr, options_.matching,
-                          match_ws_, &match_);
-        if (match_.status == Status::InvalidInput || match_.status == Status::NonFinite)
-          return refuse_frame(match_.status, match_.reason, n);
-      } else {
-        match_.keyframe_index.assign(n, -1);
-      }
-    }
-    const std::vector<int>& m = f.keyframe_match || !have_keyframe_ ? match_index_ : match_.keyframe_index;
-    for (std::size_t i = 0; i < n; ++i) {
-      const int k = have_keyframe_ && !non_finite_[i] ? m[i] : -1;
-      if (k >= 0) {
-        const std::size_t ku = static_cast<std::size_t>(k);
-        prev_px_[i] = keyframe_px_[ku];
-        valid_[i] = 1;
-        points_world_[i] = keyframe_world_points_[ku];
-        r.track_ids[i] = keyframe_ids_[ku];
-        ++r.matched;
-      } else {
-        r.track_ids[i] = next_id_++;
-      }
-    }
-
-    // Keyframe decision before the pipeline: its multi-view store takes this frame's static features.
-    bool new_keyframe = !have_keyframe_;
-    if (have_keyframe_ && options_.keyframe_policy == KeyframePolicy::Host) new_keyframe = f.is_keyframe;
-    if (have_keyframe_ && options_.keyframe_policy == KeyframePolicy::Own) {
-      const Rigid3<T> rel = pose * keyframe_pose_.inverse();
-      const double moved = static_cast<double>(rel.t.norm());
-      const double turned = static_cast<double>(rotation_angle(rel.R)) * Constants<double>::rad_to_deg();
-      const double base = static_cast<double>(keyframe_px_.size() < n ? keyframe_px_.size() : n);
-      // A keyframe without keypoints (a front end that detects after its first frame) matches nothing and
-      // the ratio rule cannot see it: the first frame with keypoints replaces it.
-      const bool empty_keyframe = keyframe_px_.empty() && n > 0;
-      new_keyframe = empty_keyframe || moved > options_.keyframe_max_translation_m ||
-                     turned > options_.keyframe_max_rotation_deg ||
-                     static_cast<double>(r.matched) < options_.keyframe_min_matched_ratio * base;
-    }
-
-    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, float, std::vector<Vec3<T>>> pf;
-    pf.keypoints = &cur_px_;
-    if (have_keyframe_) {
-      pf.prev_keypoints = &prev_px_;
-      pf.track_valid = valid_;
-      // Without a pose the residuals of the 3-D points would be the camera's own motion.
-      if (have_pose && keyframe_has_depth_) pf.points_3d = &points_world_;
-      pf.evidence_frames = r.frames_since_keyframe;
-    }
-    pf.track_ids = &r.track_ids;
-    pf.detections = f.detections;
-    pf.camera = camera_;
-    pf.cam_from_world = have_pose ? &pose : nullptr;
-    // Only the multi-view check reads the pipeline's keyframe store; filling it otherwise costs allocations.
-    pf.is_keyframe = new_keyframe && options_.pipeline.multiview.enabled;
-    const PipelineResult<T>* pr = nullptr;
-    if (!f.depth_raw.empty()) {
-      CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t, std::vector<Vec3<T>>> pu;
-      copy_frame(pf, &pu);
-      pu.depth = f.depth_raw;
-      pr = &cull_frame(pu, options_.pipeline, &state_);
-    } else {
-      pf.depth = f.depth_m;
-      pr = &cull_frame(pf, options_.pipeline, &state_);
-    }
-    r.keep = pr->keep;
-    r.labels = pr->labels;
-    r.reasons = pr->reasons;
-    if (r.keep.size() == n) {
-      for (std::size_t i = 0; i < n; ++i) {
-        if (!non_finite_[i]) continue;  // never trusted, whatever the stages and the survivor guard said
-        r.keep[i] = 0;
-        r.labels[i] = FeatureLabel::Dynamic;
-        r.reasons[i] = CullReason::InvalidInput;
-      }
-    }
-    r.num_kept = 0;
-    for (std::uint8_t k : r.keep) r.num_kept += k != 0;
-    if (bad[0] > 0) append_non_finite("keypoints", bad[0], first_bad[0], &r.reason);
-    if (bad[1] > 0) append_non_finite("undistorted_keypoints", bad[1], first_bad[1], &r.reason);
+    if (!match_keyframe(f, n, pose, have_pose, &why, &s)) return refuse_frame(s, why, n);
+    carry_tracks(f, n, &r);
+    const bool new_keyframe = decide_keyframe(f, n, pose, r.matched);
+    const PipelineResult<T>& pr = run_pipeline(f, have_pose, pose, new_keyframe, &r);
+    take_pipeline_result(pr, n, &r);
+    if (bad.count[0] > 0) append_non_finite("keypoints", bad.count[0], bad.first[0], &r.reason);
+    if (bad.count[1] > 0) append_non_finite("undistorted_keypoints", bad.count[1], bad.first[1], &r.reason);
     if (!dropped.empty()) append(dropped, &r.reason);
     if (!r.reason.empty()) r.status = Status::MissingInput;
-    describe(*pr, have_pose, have_depth, dropped.empty(), &r);
-
-    if (new_keyframe && pr->keep.size() == n) {
+    describe(pr, have_pose, have_depth, dropped.empty(), &r);
+    if (new_keyframe && pr.keep.size() == n) {
       if (!f.depth_raw.empty())
         store_keyframe(f, f.depth_raw, pose);
       else
@@ -560,6 +442,163 @@ class Culler {
   bool has_keyframe() const { return have_keyframe_; }
 
  private:
+  /// Keypoints with a NaN or Inf coordinate: count and first index, [0] in keypoints, [1] only in the
+  /// undistorted ones.
+  struct NonFinite {
+    std::size_t count[2] = {0, 0}, first[2] = {0, 0};
+  };
+
+  /// A descriptor width other than the keyframe's cannot be matched to it: the keyframe is forgotten and
+  /// this frame starts anew. Returns the reason, or empty.
+  std::string drop_keyframe_of_another_width(const CullerFrame<T>& f, CullerResult* r) {
+    if (!have_keyframe_ || f.keyframe_match != nullptr || f.descriptors.data == nullptr || keyframe_desc_rows_ == 0 ||
+        f.descriptors.row_bytes == keyframe_row_bytes_)
+      return std::string();
+    forget_keyframe();
+    r->frames_since_keyframe = 0;
+    return "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) + " bytes where the keyframe's have " +
+           std::to_string(keyframe_row_bytes_) + ": not matched, this frame becomes the keyframe";
+  }
+
+  /// The positions the geometry reads (cur_px_): undistorted when given; a point non-finite in either
+  /// form is NaN there, flagged in non_finite_ and culled at the end.
+  void read_positions(const CullerFrame<T>& f, std::size_t n, NonFinite* bad) {
+    const PointsView& geo = f.undistorted_keypoints.given ? f.undistorted_keypoints : f.keypoints;
+    const T nan = std::numeric_limits<T>::quiet_NaN();
+    cur_px_.resize(n);
+    non_finite_.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      // Read in T: a double beyond float's range is an infinity to Culler<float>.
+      const Vec2<T> raw(static_cast<T>(f.keypoints.x(i)), static_cast<T>(f.keypoints.y(i)));
+      const Vec2<T> p = &geo == &f.keypoints ? raw : Vec2<T>(static_cast<T>(geo.x(i)), static_cast<T>(geo.y(i)));
+      const bool raw_ok = std::isfinite(raw.x()) && std::isfinite(raw.y());
+      const bool geo_ok = std::isfinite(p.x()) && std::isfinite(p.y());
+      cur_px_[i] = raw_ok && geo_ok ? p : Vec2<T>(nan, nan);
+      if (raw_ok && geo_ok) continue;
+      non_finite_[i] = 1;
+      const int which = raw_ok ? 1 : 0;  // named by the argument that holds the NaN or Inf
+      if (bad->count[which]++ == 0) bad->first[which] = i;
+    }
+  }
+
+  /// The inputs the configuration reads that this frame lacks.
+  void note_missing(const CullerFrame<T>& f, std::size_t n, bool have_depth, bool have_pose, CullerResult* r) const {
+    const CullerInputs need = inputs();
+    r->missing.depth = need.depth && !have_depth;
+    r->missing.detections = need.detections && f.detections == nullptr;
+    // A frame without keypoints has no descriptor rows to give: nothing is missing.
+    r->missing.descriptors = need.descriptors && n > 0 && f.descriptors.data == nullptr && f.keyframe_match == nullptr;
+    r->missing.pose = need.pose && !have_pose;
+  }
+
+  /// The correspondences to the keyframe: the host's (check_frame copied them into match_index_) or the
+  /// culler's own matching of the descriptors. False (status and reason set) when the matcher refuses.
+  bool match_keyframe(const CullerFrame<T>& f, std::size_t n, const Rigid3<T>& pose, bool have_pose,
+                      std::string* why, Status* status) {
+    if (!have_keyframe_ || f.keyframe_match) return true;
+    if (f.descriptors.data == nullptr || keyframe_desc_rows_ == 0) {
+      match_.keyframe_index.assign(n, -1);
+      return true;
+    }
+    const Rigid3<T> cam_from_keyframe = pose * keyframe_pose_.inverse();
+    match_to_keyframe(keyframe_px_, keyframe_cam_points_,
+                      DescriptorRows(keyframe_desc_.data(), keyframe_desc_rows_, 0, keyframe_row_bytes_), cur_px_,
+                      f.descriptors, camera_, have_pose ? &cam_from_keyframe : nullptr, options_.matching, match_ws_,
+                      &match_);
+    if (match_.status != Status::InvalidInput && match_.status != Status::NonFinite) return true;
+    *status = match_.status;
+    *why = match_.reason;
+    return false;
+  }
+
+  /// The evidence arrays from the correspondences: a matched keypoint carries its keyframe point's
+  /// pixel, 3-D point and track id; any other gets a new id.
+  void carry_tracks(const CullerFrame<T>& f, std::size_t n, CullerResult* r) {
+    const T nan = std::numeric_limits<T>::quiet_NaN();
+    prev_px_.assign(n, Vec2<T>(nan, nan));
+    valid_.assign(n, 0);
+    points_world_.assign(n, Vec3<T>(nan, nan, nan));
+    r->track_ids.resize(n);
+    const std::vector<int>& m = f.keyframe_match || !have_keyframe_ ? match_index_ : match_.keyframe_index;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int k = have_keyframe_ && !non_finite_[i] ? m[i] : -1;
+      if (k >= 0) {
+        const std::size_t ku = static_cast<std::size_t>(k);
+        prev_px_[i] = keyframe_px_[ku];
+        valid_[i] = 1;
+        points_world_[i] = keyframe_world_points_[ku];
+        r->track_ids[i] = keyframe_ids_[ku];
+        ++r->matched;
+      } else {
+        r->track_ids[i] = next_id_++;
+      }
+    }
+  }
+
+  /// Whether this frame becomes the reference keyframe, decided before the pipeline (its multi-view store
+  /// takes this frame's static features): the host's flag, or the own policy's motion and match ratio.
+  bool decide_keyframe(const CullerFrame<T>& f, std::size_t n, const Rigid3<T>& pose, std::size_t matched) const {
+    if (!have_keyframe_) return true;
+    if (options_.keyframe_policy == KeyframePolicy::Host) return f.is_keyframe;
+    if (options_.keyframe_policy != KeyframePolicy::Own) return false;
+    const Rigid3<T> rel = pose * keyframe_pose_.inverse();
+    const double moved = static_cast<double>(rel.t.norm());
+    const double turned = static_cast<double>(rotation_angle(rel.R)) * Constants<double>::rad_to_deg();
+    const double base = static_cast<double>(keyframe_px_.size() < n ? keyframe_px_.size() : n);
+    // A keyframe without keypoints (a front end that detects after its first frame) matches nothing and
+    // the ratio rule cannot see it: the first frame with keypoints replaces it.
+    const bool empty_keyframe = keyframe_px_.empty() && n > 0;
+    return empty_keyframe || moved > options_.keyframe_max_translation_m ||
+           turned > options_.keyframe_max_rotation_deg ||
+           static_cast<double>(matched) < options_.keyframe_min_matched_ratio * base;
+  }
+
+  /// cull_frame on the evidence gathered, with the frame's float or 16-bit depth.
+  const PipelineResult<T>& run_pipeline(const CullerFrame<T>& f, bool have_pose, const Rigid3<T>& pose,
+                                        bool new_keyframe, CullerResult* r) {
+    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, float, std::vector<Vec3<T>>> pf;
+    pf.keypoints = &cur_px_;
+    if (have_keyframe_) {
+      pf.prev_keypoints = &prev_px_;
+      pf.track_valid = valid_;
+      // Without a pose the residuals of the 3-D points would be the camera's own motion.
+      if (have_pose && keyframe_has_depth_) pf.points_3d = &points_world_;
+      pf.evidence_frames = r->frames_since_keyframe;
+    }
+    pf.track_ids = &r->track_ids;
+    pf.detections = f.detections;
+    pf.camera = camera_;
+    pf.cam_from_world = have_pose ? &pose : nullptr;
+    // Only the multi-view check reads the pipeline's keyframe store; filling it otherwise costs allocations.
+    pf.is_keyframe = new_keyframe && options_.pipeline.multiview.enabled;
+    if (f.depth_raw.empty()) {
+      pf.depth = f.depth_m;
+      return cull_frame(pf, options_.pipeline, &state_);
+    }
+    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t, std::vector<Vec3<T>>> pu;
+    copy_frame(pf, &pu);
+    pu.depth = f.depth_raw;
+    return cull_frame(pu, options_.pipeline, &state_);
+  }
+
+  /// The pipeline's keep mask, labels and reasons; a non-finite keypoint is culled whatever the stages
+  /// and the survivor guard said.
+  void take_pipeline_result(const PipelineResult<T>& pr, std::size_t n, CullerResult* r) const {
+    r->keep = pr.keep;
+    r->labels = pr.labels;
+    r->reasons = pr.reasons;
+    if (r->keep.size() == n) {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!non_finite_[i]) continue;
+        r->keep[i] = 0;
+        r->labels[i] = FeatureLabel::Dynamic;
+        r->reasons[i] = CullReason::InvalidInput;
+      }
+    }
+    r->num_kept = 0;
+    for (std::uint8_t k : r->keep) r->num_kept += k != 0;
+  }
+
   /// Clears the result for a frame of n keypoints; frames_since_keyframe as the frame would see it.
   CullerResult& begin_result(std::size_t n) {
     CullerResult& r = result_;
