@@ -1,0 +1,319 @@
+#!/usr/bin/env python3
+"""Sequence side of scripts/orbslam2.sh (standard library only).
+
+  orbslam2_sequence.py prepare SEQUENCE OUT
+      OUT/orbslam2_settings.yaml (ORB-SLAM2's settings, written from SEQUENCE/camera.txt) and
+      OUT/associations.txt (rgb and depth paired as the TUM benchmark's associate.py: |dt| < 0.02 s,
+      closest pairs first, each stamp once).
+  orbslam2_sequence.py summarise SEQUENCE OUT [--vocabulary FILE] [--command TEXT] [--page FILE]
+      reads OUT/runs/VARIANT/runN/ (rgbd_tum.log, CameraTrajectory.txt, ate.json), writes
+      OUT/orbslam2_summary.csv (a row per variant and run) and prints the table; with --page, replaces
+      (or appends) the page's "## In ORB-SLAM2" section.
+
+Lost frames: ORB-SLAM2 leaves a frame out of CameraTrajectory.txt when it was lost (and every frame before
+its map exists), without a message; they are counted as association lines minus trajectory lines.
+"""
+import argparse
+import json
+import os
+import platform
+import re
+import statistics
+import struct
+import subprocess
+import sys
+
+MAX_DIFFERENCE_S = 0.02
+VARIANTS = ["stock", "box_only", "culler"]
+
+
+def read_list(path):
+    """(stamp text, file) pairs of a TUM list file."""
+    out = []
+    with open(path) as f:
+        for line in f:
+            fields = line.split()
+            if len(fields) >= 2 and not fields[0].startswith("#"):
+                out.append((fields[0], fields[1]))
+    return out
+
+
+def associate(rgb, depth):
+    """associate.py's greedy pairing: candidate pairs under the window, closest first, each stamp once."""
+    candidates = []
+    depth_stamps = [float(s) for s, _ in depth]
+    for i, (stamp, _) in enumerate(rgb):
+        t = float(stamp)
+        for j, d in enumerate(depth_stamps):
+            if abs(d - t) < MAX_DIFFERENCE_S:
+                candidates.append((abs(d - t), i, j))
+    candidates.sort()
+    used_rgb, used_depth, pairs = set(), set(), []
+    for _, i, j in candidates:
+        if i in used_rgb or j in used_depth:
+            continue
+        used_rgb.add(i)
+        used_depth.add(j)
+        pairs.append((i, j))
+    pairs.sort()
+    return [(rgb[i][0], rgb[i][1], depth[j][0], depth[j][1]) for i, j in pairs]
+
+
+def read_camera(path):
+    """camera.txt: 'key value' lines (fx, fy, cx, cy, depth_units_per_metre, optional k1 k2 p1 p2 k3)."""
+    values = {}
+    with open(path) as f:
+        for line in f:
+            fields = line.split()
+            if len(fields) >= 2 and not fields[0].startswith("#"):
+                try:
+                    values[fields[0]] = float(fields[1])
+                except ValueError:
+                    pass
+    missing = [k for k in ("fx", "fy", "cx", "cy") if k not in values]
+    if missing:
+        sys.exit("orbslam2_sequence.py: %s has no %s" % (path, ", ".join(missing)))
+    return values
+
+
+def png_size(path):
+    with open(path, "rb") as f:
+        header = f.read(24)
+    if header[:8] != b"\x89PNG\r\n\x1a\n":
+        sys.exit("orbslam2_sequence.py: %s is not a PNG" % path)
+    return struct.unpack(">II", header[16:24])
+
+
+SETTINGS = """%YAML:1.0
+# Written by scripts/orbslam2.sh from {camera}.
+Camera.fx: {fx}
+Camera.fy: {fy}
+Camera.cx: {cx}
+Camera.cy: {cy}
+Camera.k1: {k1}
+Camera.k2: {k2}
+Camera.p1: {p1}
+Camera.p2: {p2}
+Camera.k3: {k3}
+Camera.width: {width}
+Camera.height: {height}
+Camera.fps: 30.0
+# IR projector baseline times fx (about 40 for a Kinect-class sensor, as ORB-SLAM2's TUM settings).
+Camera.bf: 40.0
+Camera.RGB: 1
+ThDepth: 40.0
+DepthMapFactor: {depth_factor}
+ORBextractor.nFeatures: 1000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+Viewer.KeyFrameSize: 0.05
+Viewer.KeyFrameLineWidth: 1
+Viewer.GraphLineWidth: 0.9
+Viewer.PointSize: 2
+Viewer.CameraSize: 0.08
+Viewer.CameraLineWidth: 3
+Viewer.ViewpointX: 0
+Viewer.ViewpointY: -0.7
+Viewer.ViewpointZ: -1.8
+Viewer.ViewpointF: 500
+"""
+
+
+def prepare(sequence, out):
+    camera = read_camera(os.path.join(sequence, "camera.txt"))
+    rgb = read_list(os.path.join(sequence, "rgb.txt"))
+    depth = read_list(os.path.join(sequence, "depth.txt"))
+    if not rgb or not depth:
+        sys.exit("orbslam2_sequence.py: %s has an empty rgb.txt or depth.txt" % sequence)
+    width, height = png_size(os.path.join(sequence, rgb[0][1]))
+    settings = SETTINGS.format(
+        camera="camera.txt", width=width, height=height,
+        depth_factor=camera.get("depth_units_per_metre", 5000.0),
+        **{k: camera.get(k, 0.0) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")})
+    with open(os.path.join(out, "orbslam2_settings.yaml"), "w") as f:
+        f.write(settings)
+    pairs = associate(rgb, depth)
+    with open(os.path.join(out, "associations.txt"), "w") as f:
+        for p in pairs:
+            f.write("%s %s %s %s\n" % p)
+    print("orbslam2_sequence.py: %d rgb frames, %d with a depth partner (associations.txt), %dx%d"
+          % (len(rgb), len(pairs), width, height), file=sys.stderr)
+
+
+def count_lines(path):
+    if not os.path.exists(path):
+        return 0
+    with open(path) as f:
+        return sum(1 for line in f if line.strip() and not line.startswith("#"))
+
+
+def read_run(directory, frames):
+    row = {"ate_rmse_m": "", "ate_pairs": "", "track_ms": "", "track_median_ms": "", "cull_ms": "", "note": ""}
+    poses = count_lines(os.path.join(directory, "CameraTrajectory.txt"))
+    row["lost_frames"] = frames - poses
+    log_path = os.path.join(directory, "rgbd_tum.log")
+    text = open(log_path, errors="replace").read() if os.path.exists(log_path) else ""
+    m = re.search(r"median tracking time: ([0-9.eE+-]+)", text)
+    if m:
+        row["track_median_ms"] = "%.2f" % (1000 * float(m.group(1)))
+    m = re.search(r"mean tracking time: ([0-9.eE+-]+)", text)
+    if m:
+        row["track_ms"] = "%.2f" % (1000 * float(m.group(1)))
+    m = re.search(r"([0-9.]+) ms per frame culling", text)
+    if m:
+        row["cull_ms"] = m.group(1)
+    try:
+        with open(os.path.join(directory, "ate.json")) as f:
+            report = json.load(f)
+        if report.get("status") == "Ok":
+            row["ate_rmse_m"] = "%.5f" % report["ate"]["error_m"]["rmse"]
+            row["ate_pairs"] = report["ate"]["pairs"]
+        else:
+            row["note"] = report.get("reason", "evaluation failed")
+    except (OSError, ValueError, KeyError):
+        row["note"] = "no trajectory" if poses == 0 else "evaluation failed"
+    if not row["track_ms"]:
+        row["note"] = (row["note"] + "; " if row["note"] else "") + "rgbd_tum did not finish"
+    return row
+
+
+COLUMNS = ["variant", "run", "ate_rmse_m", "ate_pairs", "lost_frames", "frames", "track_ms", "track_median_ms",
+           "cull_ms", "note"]
+
+
+def median_range(values, scale=1.0, digits=2):
+    if not values:
+        return "n/a"
+    v = [x * scale for x in values]
+    fmt = "%%.%df" % digits
+    return (fmt + " (" + fmt + "-" + fmt + ")") % (statistics.median(v), min(v), max(v))
+
+
+def summarise(sequence, out, vocabulary, command, page):
+    frames = count_lines(os.path.join(out, "associations.txt"))
+    rows = []
+    runs_dir = os.path.join(out, "runs")
+    for variant in VARIANTS:
+        vdir = os.path.join(runs_dir, variant)
+        if not os.path.isdir(vdir):
+            continue
+        runs = sorted((int(d[3:]) for d in os.listdir(vdir) if re.fullmatch(r"run[0-9]+", d)))
+        for r in runs:
+            row = read_run(os.path.join(vdir, "run%d" % r), frames)
+            row.update(variant=variant, run=r, frames=frames)
+            rows.append(row)
+    with open(os.path.join(out, "orbslam2_summary.csv"), "w") as f:
+        f.write(",".join(COLUMNS) + "\n")
+        for row in rows:
+            f.write(",".join(str(row[c]).replace(",", ";") for c in COLUMNS) + "\n")
+    table = summary_table(rows)
+    print(table)
+    if page:
+        write_page(page, table, rows, sequence, vocabulary, command)
+
+
+def numbers(rows, variant, column):
+    return [float(r[column]) for r in rows if r["variant"] == variant and r[column] != ""]
+
+
+def summary_table(rows):
+    lines = ["| Variant | Runs | ATE RMSE, cm: median (range) | Lost frames: median (range) | Tracking ms per frame, mean: median (range) | Culling ms per frame |",
+             "|---|---|---|---|---|---|"]
+    for variant in VARIANTS:
+        mine = [r for r in rows if r["variant"] == variant]
+        if not mine:
+            continue
+        failed = sum(1 for r in mine if r["ate_rmse_m"] == "")
+        runs = "%d" % len(mine) + (" (%d without an ATE)" % failed if failed else "")
+        cull = numbers(rows, variant, "cull_ms")
+        lines.append("| %s | %s | %s | %s | %s | %s |" % (
+            variant, runs, median_range(numbers(rows, variant, "ate_rmse_m"), 100.0),
+            median_range(numbers(rows, variant, "lost_frames"), 1.0, 0),
+            median_range(numbers(rows, variant, "track_ms"), 1.0, 1),
+            "%.2f" % statistics.median(cull) if cull and variant != "stock" else "-"))
+    return "\n".join(lines)
+
+
+def ratio_line(rows):
+    stock = numbers(rows, "stock", "ate_rmse_m")
+    out = []
+    for variant in ("box_only", "culler"):
+        v = numbers(rows, variant, "ate_rmse_m")
+        if stock and v:
+            out.append("%s / stock median ATE: %.2f" % (variant, statistics.median(v) / statistics.median(stock)))
+    ts, tc = numbers(rows, "stock", "track_ms"), numbers(rows, "culler", "track_ms")
+    if ts and tc:
+        out.append("culler / stock median tracking time: %.2f" % (statistics.median(tc) / statistics.median(ts)))
+    return "; ".join(out)
+
+
+def machine():
+    cpu = ""
+    try:
+        cpu = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
+        cpu = re.search(r"Model name:\s*(.*)", cpu).group(1)
+    except (OSError, AttributeError):
+        cpu = platform.processor()
+    return "%s, %d cores" % (cpu, os.cpu_count() or 0)
+
+
+def write_page(page, table, rows, sequence, vocabulary, command):
+    name = os.path.basename(sequence.rstrip("/"))
+    voc = os.path.basename(vocabulary) if vocabulary else "?"
+    trained = "synthetic" in voc
+    section = "\n".join([
+        "## In ORB-SLAM2",
+        "",
+        "ORB-SLAM2 (raulmur/ORB_SLAM2 at f2e6f51, RGB-D, `rgbd_tum` with the viewer off) with the culler patch of",
+        "[integration.md](integration.md#orb-slam2-the-patch), on `%s`. One build; the variant is chosen at run" % name,
+        "time (`DYNCULL_MODE`): **stock** culls nothing (the culler is not called), **box_only** removes every",
+        "feature inside a person box (the YOLO forks' way), **culler** is the recommended preset. Detections are",
+        "the sequence's own `detections/` (matched by timestamp). ORB-SLAM2 is multi-threaded and not",
+        "deterministic, so every variant ran several times; ATE is against the sequence's camera ground truth",
+        "(`dyncull_eval`, SE(3) alignment, the pairs ORB-SLAM2 wrote). A lost frame is a frame missing from",
+        "ORB-SLAM2's trajectory (it leaves lost frames out without a message), counted against the %d" % rows[0]["frames"] if rows else "",
+        "associated frames. Tracking time is what `rgbd_tum` prints per run (mean over frames, culling included);",
+        "culling time is the glue's own mean per frame.",
+        "",
+        table,
+        "",
+        ratio_line(rows) + ".",
+        "",
+        "Vocabulary: `%s`%s." % (voc, ", trained by the script with ORB-SLAM2's bundled DBoW2 (k = 10, L = 5) on "
+                                       "synthetic frames of dyncull's scene (480 frames, four camera motions), "
+                                       "because the published ORBvoc.txt is not available here; no evaluated frame "
+                                       "was used to train it" if trained else ""),
+        "",
+        "Machine: %s. Command: `%s` (per-run logs, trajectories and `orbslam2_summary.csv` in its output folder)." % (machine(), command),
+        "",
+    ])
+    text = open(page).read() if os.path.exists(page) else "# Results\n"
+    m = re.search(r"^## In ORB-SLAM2\n.*?(?=^## |\Z)", text, flags=re.S | re.M)
+    if m:
+        text = text[:m.start()] + section + "\n" + text[m.end():]
+    else:
+        text = text.rstrip("\n") + "\n\n" + section
+    with open(page, "w") as f:
+        f.write(text.rstrip("\n") + "\n")
+    print("orbslam2_sequence.py: wrote the In ORB-SLAM2 section of %s" % page, file=sys.stderr)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("action", choices=["prepare", "summarise"])
+    parser.add_argument("sequence")
+    parser.add_argument("out")
+    parser.add_argument("--vocabulary", default="")
+    parser.add_argument("--command", default="scripts/orbslam2.sh")
+    parser.add_argument("--page", default="")
+    a = parser.parse_args()
+    if a.action == "prepare":
+        prepare(a.sequence, a.out)
+    else:
+        summarise(a.sequence, a.out, a.vocabulary, a.command, a.page)
+
+
+if __name__ == "__main__":
+    main()
