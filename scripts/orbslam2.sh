@@ -63,6 +63,9 @@ done
 thirdparty=$(cd "$thirdparty" && pwd)
 mkdir -p "$work"
 work=$(cd "$work" && pwd)
+absolute() { [[ -z "$1" ]] || (cd "$1" && pwd) || { echo "orbslam2.sh: no folder $1" >&2; exit 1; }; }
+dyncull_prefix=$(absolute "$dyncull_prefix")
+pangolin_prefix=$(absolute "$pangolin_prefix")
 if [[ "$mode" == run ]]; then
   [[ -n "$sequence" && -n "$out" ]] || { echo "orbslam2.sh: --sequence DIR and --out DIR are needed (or --build-only, --compile-check)" >&2; exit 2; }
   [[ -f "$sequence/rgb.txt" && -f "$sequence/camera.txt" ]] || { echo "orbslam2.sh: $sequence has no rgb.txt or camera.txt" >&2; exit 1; }
@@ -174,7 +177,9 @@ compile_check() {
   install_dyncull
   rm -rf "$tree"
   copy_orbslam2 "$tree"
-  # Pangolin's headers need its generated config header only: configure it, do not build it.
+  # g2o's and Pangolin's headers need their generated config headers only: configure them, build neither.
+  cmake -S "$tree/Thirdparty/g2o" -B "$work/compile-check/g2o-configure" -DCMAKE_BUILD_TYPE=Release \
+    >"$work/compile-check-g2o.log" 2>&1
   if [[ -n "$pangolin_prefix" ]]; then
     pangolin_includes=(-I"$pangolin_prefix/include")
   else
@@ -187,8 +192,15 @@ compile_check() {
   # ORB-SLAM2's own flags (its CMakeLists.txt): -Wall -O3 -march=native -std=c++11, Release -DNDEBUG.
   # shellcheck disable=SC2086
   g++ -Wall -O3 -march=native -std=c++11 -DNDEBUG -fPIC -c "$tree/src/Tracking.cc" -o "$work/compile-check/Tracking.o" \
-    -I"$tree" -I"$tree/include" "${pangolin_includes[@]}" -I"$dyncull_prefix/include" $cxx_flags
-  nm -C "$work/compile-check/Tracking.o" | grep -q 'U dyncull::cv_adapter::HostCuller::cull' ||
+    -I"$tree" -I"$tree/include" "${pangolin_includes[@]}" -I"$dyncull_prefix/include" $cxx_flags \
+    2>"$work/compile-check/Tracking.log" || { tail -40 "$work/compile-check/Tracking.log" >&2; exit 1; }
+  if grep -n 'include/dyncull/' "$work/compile-check/Tracking.log" >&2; then
+    echo "orbslam2.sh: the lines above are warnings in dyncull's headers under ORB-SLAM2's flags" >&2
+    exit 1
+  fi
+  local symbols
+  symbols=$(nm -C "$work/compile-check/Tracking.o")
+  grep -q 'U dyncull::cv_adapter::HostCuller::cull' <<<"$symbols" ||
     { echo "orbslam2.sh: Tracking.o does not call the culler: the patch did not apply as expected" >&2; exit 1; }
   log "compile check passed: patched src/Tracking.cc compiles with -std=c++11 -O3 against $dyncull_prefix ($(($(date +%s) - start)) s)"
 }
@@ -224,5 +236,5 @@ for variant in "${variant_list[@]}"; do
   done
 done
 python3 "$root/scripts/orbslam2_sequence.py" summarise "$sequence" "$out" --vocabulary "$vocabulary" \
-  --command "scripts/orbslam2.sh --sequence DATA/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --out DIR --runs $runs" \
+  --command "scripts/orbslam2.sh --sequence \$DYNCULL_DATA_DIR/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --out DIR --runs $runs" \
   ${page:+--page "$page"}

@@ -150,7 +150,8 @@ def count_lines(path):
 
 
 def read_run(directory, frames):
-    row = {"ate_rmse_m": "", "ate_pairs": "", "track_ms": "", "track_median_ms": "", "cull_ms": "", "note": ""}
+    row = {"ate_rmse_m": "", "ate_pairs": "", "track_ms": "", "track_median_ms": "", "cull_ms": "", "features": "",
+           "features_kept": "", "note": ""}
     poses = count_lines(os.path.join(directory, "CameraTrajectory.txt"))
     row["lost_frames"] = frames - poses
     log_path = os.path.join(directory, "rgbd_tum.log")
@@ -161,13 +162,17 @@ def read_run(directory, frames):
     m = re.search(r"mean tracking time: ([0-9.eE+-]+)", text)
     if m:
         row["track_ms"] = "%.2f" % (1000 * float(m.group(1)))
+    row["fewest_kept"] = fewest_kept(os.path.join(directory, "culler_frames.csv"))
+    m = re.search(r"features ([0-9.]+) -> ([0-9.]+) per frame", text)
+    if m:
+        row["features"], row["features_kept"] = m.group(1), m.group(2)
     m = re.search(r"([0-9.]+) ms per frame culling", text)
     if m:
         row["cull_ms"] = m.group(1)
     try:
         with open(os.path.join(directory, "ate.json")) as f:
             report = json.load(f)
-        if report.get("status") == "Ok":
+        if str(report.get("status", "")).lower() == "ok":
             row["ate_rmse_m"] = "%.5f" % report["ate"]["error_m"]["rmse"]
             row["ate_pairs"] = report["ate"]["pairs"]
         else:
@@ -179,8 +184,21 @@ def read_run(directory, frames):
     return row
 
 
+def fewest_kept(path):
+    """The fewest features kept in one frame of a run's DYNCULL_LOG, or '' without one."""
+    if not os.path.exists(path):
+        return ""
+    with open(path) as f:
+        header = f.readline().strip().split(",")
+        if "kept" not in header:
+            return ""
+        k = header.index("kept")
+        kept = [int(line.split(",")[k]) for line in f if line.count(",") >= k]
+    return min(kept) if kept else ""
+
+
 COLUMNS = ["variant", "run", "ate_rmse_m", "ate_pairs", "lost_frames", "frames", "track_ms", "track_median_ms",
-           "cull_ms", "note"]
+           "cull_ms", "features", "features_kept", "fewest_kept", "note"]
 
 
 def median_range(values, scale=1.0, digits=2):
@@ -211,7 +229,7 @@ def summarise(sequence, out, vocabulary, command, page):
     table = summary_table(rows)
     print(table)
     if page:
-        write_page(page, table, rows, sequence, vocabulary, command)
+        write_page(page, table, rows, sequence, out, vocabulary, command)
 
 
 def numbers(rows, variant, column):
@@ -219,8 +237,8 @@ def numbers(rows, variant, column):
 
 
 def summary_table(rows):
-    lines = ["| Variant | Runs | ATE RMSE, cm: median (range) | Lost frames: median (range) | Tracking ms per frame, mean: median (range) | Culling ms per frame |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| Variant | Runs | ATE RMSE, cm: median (range) | Lost frames: median (range) | Tracking ms per frame, mean: median (range) | Culling ms per frame | Features kept per frame, mean |",
+             "|---|---|---|---|---|---|---|"]
     for variant in VARIANTS:
         mine = [r for r in rows if r["variant"] == variant]
         if not mine:
@@ -228,11 +246,13 @@ def summary_table(rows):
         failed = sum(1 for r in mine if r["ate_rmse_m"] == "")
         runs = "%d" % len(mine) + (" (%d without an ATE)" % failed if failed else "")
         cull = numbers(rows, variant, "cull_ms")
-        lines.append("| %s | %s | %s | %s | %s | %s |" % (
+        kept = numbers(rows, variant, "features_kept")
+        lines.append("| %s | %s | %s | %s | %s | %s | %s |" % (
             variant, runs, median_range(numbers(rows, variant, "ate_rmse_m"), 100.0),
             median_range(numbers(rows, variant, "lost_frames"), 1.0, 0),
             median_range(numbers(rows, variant, "track_ms"), 1.0, 1),
-            "%.2f" % statistics.median(cull) if cull and variant != "stock" else "-"))
+            "%.2f" % statistics.median(cull) if cull and variant != "stock" else "-",
+            "%.0f" % statistics.median(kept) if kept else "n/a"))
     return "\n".join(lines)
 
 
@@ -243,10 +263,151 @@ def ratio_line(rows):
         v = numbers(rows, variant, "ate_rmse_m")
         if stock and v:
             out.append("%s / stock median ATE: %.2f" % (variant, statistics.median(v) / statistics.median(stock)))
+    for variant in ("box_only", "culler"):
+        fewest = numbers(rows, variant, "fewest_kept")
+        if fewest:
+            out.append("%s keeps %d features in its leanest frame (fewest over its runs)" % (variant, min(fewest)))
     ts, tc = numbers(rows, "stock", "track_ms"), numbers(rows, "culler", "track_ms")
     if ts and tc:
         out.append("culler / stock median tracking time: %.2f" % (statistics.median(tc) / statistics.median(ts)))
     return "; ".join(out)
+
+
+def timing_note(rows):
+    """How far tracking times spread within one variant, and the culler's own share of stock's time."""
+    spreads = []
+    for variant in VARIANTS:
+        t = numbers(rows, variant, "track_ms")
+        if len(t) > 1:
+            spreads.append((max(t) - min(t)) / statistics.median(t))
+    ts, cull = numbers(rows, "stock", "track_ms"), numbers(rows, "culler", "cull_ms")
+    parts = []
+    if spreads:
+        parts.append("Tracking times of one variant spread over up to %.0f %% of their median between runs here: "
+                     "the runs replay at the recorded rate beside whatever else runs on the machine, so the "
+                     "difference between the variants' tracking times is within that noise" % (100 * max(spreads)))
+    if ts and cull:
+        parts.append("the culler's own time, %.2f ms per frame (median of its runs), is %.1f %% of stock's median "
+                     "tracking time" % (statistics.median(cull), 100 * statistics.median(cull) / statistics.median(ts)))
+    return ("; ".join(parts) + ".") if parts else ""
+
+
+def read_tum(path):
+    """stamp -> (x, y, z) of a TUM trajectory file."""
+    out = {}
+    if not os.path.exists(path):
+        return out
+    with open(path) as f:
+        for line in f:
+            fields = line.split()
+            if len(fields) >= 8 and not fields[0].startswith("#"):
+                out[float(fields[0])] = tuple(float(v) for v in fields[1:4])
+    return out
+
+
+def pair_positions(truth, estimate):
+    """(truth, estimate) positions paired as associate.py: closest stamps first, each once."""
+    stamps = sorted(truth)
+    candidates = []
+    for t in estimate:
+        lo, hi = 0, len(stamps)
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if stamps[mid] < t - MAX_DIFFERENCE_S:
+                lo = mid + 1
+            else:
+                hi = mid
+        k = lo
+        while k < len(stamps) and stamps[k] < t + MAX_DIFFERENCE_S:
+            candidates.append((abs(stamps[k] - t), stamps[k], t))
+            k += 1
+    candidates.sort()
+    used_t, used_e, pairs = set(), set(), []
+    for _, g, e in candidates:
+        if g in used_t or e in used_e:
+            continue
+        used_t.add(g)
+        used_e.add(e)
+        pairs.append((e, truth[g], estimate[e]))
+    pairs.sort()
+    return [(g, e) for _, g, e in pairs]
+
+
+def horn_alignment(pairs):
+    """Rotation R and translation t with R * estimate + t closest to truth (Horn 1987, unit quaternions)."""
+    n = float(len(pairs))
+    cg = [sum(p[0][i] for p in pairs) / n for i in range(3)]
+    ce = [sum(p[1][i] for p in pairs) / n for i in range(3)]
+    S = [[sum((p[1][i] - ce[i]) * (p[0][j] - cg[j]) for p in pairs) for j in range(3)] for i in range(3)]
+    (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = S
+    N = [[xx + yy + zz, yz - zy, zx - xz, xy - yx],
+         [yz - zy, xx - yy - zz, xy + yx, zx + xz],
+         [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
+         [xy - yx, zx + xz, yz + zy, -xx - yy + zz]]
+    shift = sum(abs(v) for row in N for v in row) + 1.0  # N + shift I is positive definite: power iteration
+    q = [1.0, 0.0, 0.0, 0.0]                            # finds N's largest eigenvalue's vector
+    for _ in range(500):
+        q = [sum(N[i][j] * q[j] for j in range(4)) + shift * q[i] for i in range(4)]
+        norm = sum(v * v for v in q) ** 0.5
+        q = [v / norm for v in q]
+    w, x, y, z = q
+    R = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+    t = [cg[i] - sum(R[i][j] * ce[j] for j in range(3)) for i in range(3)]
+    return R, t
+
+
+COLOURS = {"truth": "#000000", "stock": "#d62728", "box_only": "#ff7f0e", "culler": "#1f77b4"}
+
+
+def plot_trajectories(sequence, out, rows, svg_path):
+    """Top view (the two axes of largest ground-truth extent) of the ground truth and, per variant, the
+    run with the median ATE, aligned as the ATE aligns it. Returns the runs drawn."""
+    truth = read_tum(os.path.join(sequence, "groundtruth.txt"))
+    curves, drawn = {}, []
+    for variant in VARIANTS:
+        mine = sorted((float(r["ate_rmse_m"]), r["run"]) for r in rows if r["variant"] == variant and r["ate_rmse_m"])
+        if not mine:
+            continue
+        ate, run = mine[(len(mine) - 1) // 2]
+        pairs = pair_positions(truth, read_tum(os.path.join(out, "runs", variant, "run%d" % run, "CameraTrajectory.txt")))
+        if len(pairs) < 3:
+            continue
+        R, t = horn_alignment(pairs)
+        curves[variant] = [[sum(R[i][j] * e[j] for j in range(3)) + t[i] for i in range(3)] for _, e in pairs]
+        drawn.append((variant, run, ate))
+    if not curves:
+        return drawn
+    stamps = sorted(truth)
+    gt = [truth[s] for s in stamps]
+    extent = [max(p[i] for p in gt) - min(p[i] for p in gt) for i in range(3)]
+    a, b = sorted(range(3), key=lambda i: -extent[i])[:2]
+    everything = gt + [p for c in curves.values() for p in c]
+    lo_a, hi_a = min(p[a] for p in everything), max(p[a] for p in everything)
+    lo_b, hi_b = min(p[b] for p in everything), max(p[b] for p in everything)
+    size, margin = 520.0, 40.0
+    scale = (size - 2 * margin) / max(hi_a - lo_a, hi_b - lo_b, 1e-6)
+    def xy(p):
+        return "%.1f,%.1f" % (margin + (p[a] - lo_a) * scale, size - margin - (p[b] - lo_b) * scale)
+    legend = [("ground truth", "truth")] + [("%s (run %d, ATE %.1f cm)" % (v, r, 100 * e), v) for v, r, e in drawn]
+    lines = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" font-size="12">'
+             % (size, size + 18 * len(legend)), '<rect width="100%" height="100%" fill="white"/>']
+    for name, points, width in [("truth", gt, 2.5)] + [(v, curves[v], 1.5) for v in VARIANTS if v in curves]:
+        lines.append('<polyline fill="none" stroke="%s" stroke-width="%.1f" points="%s"/>'
+                     % (COLOURS[name], width, " ".join(xy(p) for p in points)))
+    for k, (label, key) in enumerate(legend):
+        y = size + 18 * k
+        lines.append('<line x1="%d" y1="%d" x2="%d" y2="%d" stroke="%s" stroke-width="3"/>' % (margin, y, margin + 20, y, COLOURS[key]))
+        lines.append('<text x="%d" y="%d">%s</text>' % (margin + 26, y + 4, label))
+    scale_bar = 0.5 * scale
+    lines.append('<line x1="%.1f" y1="20" x2="%.1f" y2="20" stroke="black" stroke-width="2"/>' % (size - margin - scale_bar, size - margin))
+    lines.append('<text x="%.1f" y="14">0.5 m</text>' % (size - margin - scale_bar))
+    lines.append('<text x="10" y="16">top view, axes %s-%s of the ground truth</text>' % ("xyz"[a], "xyz"[b]))
+    lines.append("</svg>")
+    with open(svg_path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return drawn
 
 
 def machine():
@@ -259,10 +420,13 @@ def machine():
     return "%s, %d cores" % (cpu, os.cpu_count() or 0)
 
 
-def write_page(page, table, rows, sequence, vocabulary, command):
+def write_page(page, table, rows, sequence, out, vocabulary, command):
     name = os.path.basename(sequence.rstrip("/"))
     voc = os.path.basename(vocabulary) if vocabulary else "?"
     trained = "synthetic" in voc
+    image = "images/orbslam2_%s_trajectories.svg" % name
+    os.makedirs(os.path.join(os.path.dirname(os.path.abspath(page)), "images"), exist_ok=True)
+    drawn = plot_trajectories(sequence, out, rows, os.path.join(os.path.dirname(os.path.abspath(page)), image))
     section = "\n".join([
         "## In ORB-SLAM2",
         "",
@@ -279,7 +443,11 @@ def write_page(page, table, rows, sequence, vocabulary, command):
         "",
         table,
         "",
-        ratio_line(rows) + ".",
+        (ratio_line(rows) + ".") if ratio_line(rows) else "",
+        "",
+        timing_note(rows),
+        "",
+        ("![Ground truth and ORB-SLAM2's aligned trajectories (the median-ATE run of each variant), top view](%s)" % image) if drawn else "",
         "",
         "Vocabulary: `%s`%s." % (voc, ", trained by the script with ORB-SLAM2's bundled DBoW2 (k = 10, L = 5) on "
                                        "synthetic frames of dyncull's scene (480 frames, four camera motions), "
