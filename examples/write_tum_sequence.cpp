@@ -1,11 +1,13 @@
 // Writes a synthetic dynamic RGB-D sequence (dyncull::sim::Scene) in TUM RGB-D format, so any SLAM
 // system can run on it: rgb/*.png, depth/*.png (16-bit, 5000 per metre), rgb.txt, depth.txt,
 // associations.txt, groundtruth.txt (timestamp tx ty tz qx qy qz qw of world_from_cam), camera.txt,
-// detections/*.txt (YOLO style "class cx cy w h conf", normalised) indexed by detections.txt, and
-// the truth masks instance/*.png (16-bit ids) and moving/*.png (255 = moving surface).
+// detections/*.txt (YOLO style "class cx cy w h conf", normalised) indexed by detections.txt, the same
+// boxes in pixels as detections_json/NNNNNN.json (eval/yolo_json.hpp's schema, timestamp = the rgb stamp),
+// and the truth masks instance/*.png (16-bit ids) and moving/*.png (255 = moving surface).
 //
-// Usage: write_tum_sequence OUTDIR [--motion static|xyz|rpy|halfsphere] [--frames N] [--seed S]
-//                                  [--clean-depth]
+// Usage: write_tum_sequence OUTDIR [--family NAME] [--motion static|xyz|rpy|halfsphere] [--frames N]
+//                                  [--seed S] [--clean-depth]
+#include "dyncull/sim/families.hpp"
 #include "dyncull/sim/scene.hpp"
 
 #include <opencv2/core.hpp>
@@ -27,8 +29,8 @@ namespace {
 
 int usage(const char* why) {
   std::cerr << "write_tum_sequence: " << why << "\n"
-            << "usage: write_tum_sequence OUTDIR [--motion static|xyz|rpy|halfsphere] [--frames N] [--seed S] "
-               "[--clean-depth]\n";
+            << "usage: write_tum_sequence OUTDIR [--family NAME] [--motion static|xyz|rpy|halfsphere] [--frames N] "
+               "[--seed S] [--clean-depth]\n";
   return 2;
 }
 
@@ -57,6 +59,22 @@ std::string stamp(double t) {
   return os.str();
 }
 
+// One frame's boxes as eval/yolo_json.hpp reads them: bbox [x0, y0, x1, y1] in pixels.
+bool write_json_detections(const std::filesystem::path& path, int index, const std::string& ts,
+                           const std::string& rgb_name, const dyncull::sim::FrameData& f) {
+  std::ofstream out(path);
+  out << "{\"frame_id\": " << index << ", \"timestamp\": " << ts << ", \"image_path\": \"" << rgb_name
+      << "\", \"detections\": [";
+  out << std::setprecision(6);
+  for (std::size_t k = 0; k < f.detections.size(); ++k) {
+    const auto& d = f.detections[k];
+    out << (k ? ", " : "") << "{\"class_id\": " << d.class_id << ", \"confidence\": " << d.confidence
+        << ", \"bbox\": [" << d.box.x0 << ", " << d.box.y0 << ", " << d.box.x1 << ", " << d.box.y1 << "]}";
+  }
+  out << "]}\n";
+  return static_cast<bool>(out);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,11 +83,21 @@ int main(int argc, char** argv) {
   if (argc < 2) return usage("missing OUTDIR");
   const fs::path out = argv[1];
   SceneOptions options;
+  // --family first: it sets the scene; the other options then apply on top of it.
+  for (int k = 2; k + 1 < argc; ++k) {
+    if (std::string(argv[k]) != "--family") continue;
+    SceneFamily family;
+    std::string why;
+    if (!find_scene_family(argv[k + 1], &family, &why)) return usage(why.c_str());
+    options = family.options;
+  }
   for (int k = 2; k < argc; ++k) {
     const std::string arg = argv[k];
     const bool has_value = k + 1 < argc;
     long long value = 0;
-    if (arg == "--motion" && has_value) {
+    if (arg == "--family" && has_value) {
+      ++k;  // read above
+    } else if (arg == "--motion" && has_value) {
       if (!parse_motion(argv[++k], &options.motion)) return usage("unknown motion");
     } else if (arg == "--frames" && has_value) {
       if (!parse_int(argv[++k], 1, 1000000, &value)) return usage("--frames needs a positive integer");
@@ -87,7 +115,7 @@ int main(int argc, char** argv) {
   if (!scene.ok()) return usage(scene.reason().c_str());
 
   std::error_code ec;
-  for (const char* sub : {"rgb", "depth", "detections", "instance", "moving"}) {
+  for (const char* sub : {"rgb", "depth", "detections", "detections_json", "instance", "moving"}) {
     fs::create_directories(out / sub, ec);
     if (ec) {
       std::cerr << "write_tum_sequence: cannot create " << (out / sub) << ": " << ec.message() << "\n";
@@ -139,8 +167,11 @@ int main(int argc, char** argv) {
                          cv::imwrite((out / depth_name).string(), depth16) &&
                          cv::imwrite((out / "instance" / (ts + ".png")).string(), instance16) &&
                          cv::imwrite((out / "moving" / (ts + ".png")).string(), moving8);
+    char json_name[32];
+    std::snprintf(json_name, sizeof json_name, "%06d.json", index);
+    const bool json_written = write_json_detections(out / "detections_json" / json_name, index, ts, rgb_name, f);
     std::ofstream det(out / det_name);
-    if (!written || !det) {
+    if (!written || !json_written || !det) {
       std::cerr << "write_tum_sequence: cannot write frame " << index << " into " << out << "\n";
       return 1;
     }

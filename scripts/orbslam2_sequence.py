@@ -60,12 +60,21 @@ def associate(rgb, depth):
 
 
 def read_camera(path):
-    """camera.txt: 'key value' lines (fx, fy, cx, cy, depth_units_per_metre, optional k1 k2 p1 p2 k3)."""
+    """camera.txt: 'key value' lines (fx, fy, cx, cy, depth_units_per_metre, optional k1 k2 p1 p2 k3), or
+    one line of numbers 'fx fy cx cy [width height]' (write_tum_sequence's form, 5000 depth units per metre)."""
     values = {}
     with open(path) as f:
         for line in f:
             fields = line.split()
-            if len(fields) >= 2 and not fields[0].startswith("#"):
+            if not fields or fields[0].startswith("#"):
+                continue
+            try:
+                numbers = [float(v) for v in fields]
+            except ValueError:
+                numbers = []
+            if len(numbers) >= 4 and "fx" not in values:
+                values.update(zip(("fx", "fy", "cx", "cy"), numbers[:4]))
+            elif len(fields) >= 2:
                 try:
                     values[fields[0]] = float(fields[1])
                 except ValueError:
