@@ -9,6 +9,10 @@
 #       a vocabulary when ORBvoc.txt is absent, runs rgbd_tum (viewer off) once per variant and run in its own
 #       folder, evaluates the ATE with dyncull_eval and writes OUT/orbslam2_summary.csv; with --page, writes
 #       the page's "In ORB-SLAM2" section (default page: none).
+#   scripts/orbslam2.sh --families LIST|all --out DIR [--motions xyz,halfsphere] [--frames 300] [--runs N]
+#       the same on dyncull's scene families: each family and motion written once as a TUM-format sequence
+#       (write_tum_sequence --family, seed 1, the simulated detector's boxes in detections_json/), run, and
+#       summed up in OUT/orbslam2_families.csv (and the page's "Scene families in ORB-SLAM2" section)
 #   scripts/orbslam2.sh --build-only       builds everything, runs nothing
 #   scripts/orbslam2.sh --compile-check    applies the patches to a copy of ORB-SLAM2 and compiles the
 #       translation unit the culler patch changes (src/Tracking.cc) with ORB-SLAM2's flags against dyncull's
@@ -35,6 +39,9 @@ sequence=""
 out=""
 runs=5
 variants="stock,box_only,culler"
+families=""
+motions="xyz,halfsphere"
+frames=300
 page=""
 jobs=2
 mode=run
@@ -50,6 +57,9 @@ while (($#)); do
     --out) out=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
     --variants) variants=$2; shift 2 ;;
+    --families) families=$2; shift 2 ;;
+    --motions) motions=$2; shift 2 ;;
+    --frames) frames=$2; shift 2 ;;
     --page) page=$2; shift 2 ;;
     --jobs) jobs=$2; shift 2 ;;
     --build-only) mode=build; shift ;;
@@ -67,10 +77,14 @@ absolute() { [[ -z "$1" ]] || (cd "$1" && pwd) || { echo "orbslam2.sh: no folder
 dyncull_prefix=$(absolute "$dyncull_prefix")
 pangolin_prefix=$(absolute "$pangolin_prefix")
 if [[ "$mode" == run ]]; then
-  [[ -n "$sequence" && -n "$out" ]] || { echo "orbslam2.sh: --sequence DIR and --out DIR are needed (or --build-only, --compile-check)" >&2; exit 2; }
-  [[ -f "$sequence/rgb.txt" && -f "$sequence/camera.txt" ]] || { echo "orbslam2.sh: $sequence has no rgb.txt or camera.txt" >&2; exit 1; }
+  [[ (-n "$sequence" || -n "$families") && -n "$out" ]] ||
+    { echo "orbslam2.sh: --sequence DIR or --families LIST, and --out DIR, are needed (or --build-only, --compile-check)" >&2; exit 2; }
   [[ "$runs" =~ ^[1-9][0-9]*$ ]] || { echo "orbslam2.sh: --runs needs a positive integer, got '$runs'" >&2; exit 2; }
-  sequence=$(cd "$sequence" && pwd)
+  [[ "$frames" =~ ^[1-9][0-9]*$ ]] || { echo "orbslam2.sh: --frames needs a positive integer, got '$frames'" >&2; exit 2; }
+  if [[ -n "$sequence" ]]; then
+    [[ -f "$sequence/rgb.txt" && -f "$sequence/camera.txt" ]] || { echo "orbslam2.sh: $sequence has no rgb.txt or camera.txt" >&2; exit 1; }
+    sequence=$(cd "$sequence" && pwd)
+  fi
 fi
 [[ -z "$install_deps" ]] || "$root/scripts/install-deps.sh" --orbslam2
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$root")}"
@@ -91,6 +105,15 @@ install_dyncull() {
   cmake --install "$build" >"$work/dyncull-install.log"
 }
 
+# dyncull's example tools (write_tum_sequence), built in the same build tree as the install.
+build_dyncull_tool() {
+  local build="$work/dyncull-build"
+  [[ -f "$build/CMakeCache.txt" ]] ||
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" -DDYNCULL_BUILD_TESTS=OFF \
+      -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_DOCS=OFF -DDYNCULL_BUILD_EXAMPLES=ON >"$work/dyncull-configure.log"
+  cmake --build "$build" --target "$1" -j "$jobs" >"$work/$1-build.log"
+}
+
 # --- Pangolin (ORB-SLAM2 links it; the viewer stays off): headless, examples and tools off ---------------
 install_pangolin() {
   if [[ -n "$pangolin_prefix" ]]; then return; fi
@@ -105,7 +128,7 @@ install_pangolin() {
 }
 
 # --- ORB-SLAM2: a fresh copy with the patches applied (recopied when a patch or the source changes) -----
-patches=("$integration/debian12-build.patch" "$integration/dyncull-culler.patch" "$integration/rgbd-tum-no-viewer.patch")
+patches=("$integration/debian12-build.patch" "$integration/dyncull-culler.patch" "$integration/tum-examples-no-viewer.patch")
 copy_orbslam2() {
   local tree=$1 stamp
   stamp=$(cat "${patches[@]}" | sha256sum | cut -c1-16)-$(cd "$thirdparty/ORB_SLAM2" && git rev-parse --short HEAD 2>/dev/null || echo tree)
@@ -134,7 +157,7 @@ build_orbslam2() {
   cmake -S "$tree" -B "$tree/build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" \
     -DPangolin_DIR="$pangolin_prefix/lib/cmake/Pangolin" -Ddyncull_DIR="$dyncull_prefix/lib/cmake/dyncull" \
     >"$work/orbslam2-configure.log" 2>&1
-  cmake --build "$tree/build" --target rgbd_tum -j "$jobs" >"$work/orbslam2-build.log" 2>&1 ||
+  cmake --build "$tree/build" --target rgbd_tum mono_tum -j "$jobs" >"$work/orbslam2-build.log" 2>&1 ||
     { tail -30 "$work/orbslam2-build.log" >&2; exit 1; }
   rgbd_tum="$tree/Examples/RGB-D/rgbd_tum"
 }
@@ -154,7 +177,7 @@ find_vocabulary() {
   log "ORBvoc.txt is absent: training a vocabulary on synthetic frames (not on any evaluated sequence)"
   local vdir="$work/vocabulary" build="$work/dyncull-build" tree="$work/ORB_SLAM2" motion lists=()
   mkdir -p "$vdir"
-  cmake --build "$build" --target write_tum_sequence -j "$jobs" >"$vdir/write_tum_sequence-build.log"
+  build_dyncull_tool write_tum_sequence
   for motion in xyz rpy halfsphere static; do
     "$build/examples/write_tum_sequence" "$vdir/frames_$motion" --motion "$motion" --frames 120 --seed 11 >/dev/null
     lists+=("$vdir/frames_$motion/rgb.txt")
@@ -217,24 +240,68 @@ find_vocabulary
 [[ "$mode" == build ]] && { log "built $rgbd_tum"; exit 0; }
 
 # --- one sequence: settings, associations, runs, evaluation ---------------------------------------------
+# The boxes: detections/ of JSON files (the real sequences), else detections_json/ (write_tum_sequence).
+detections_of() {
+  if compgen -G "$1/detections/*.json" >/dev/null; then echo "$1/detections"; else echo "$1/detections_json"; fi
+}
+
+run_sequence() {
+  local seq=$1 dest=$2 variant run dir detections
+  mkdir -p "$dest"
+  python3 "$root/scripts/orbslam2_sequence.py" prepare "$seq" "$dest"
+  detections=$(detections_of "$seq")
+  for variant in "${variant_list[@]}"; do
+    for ((run = 1; run <= runs; run++)); do
+      dir="$dest/runs/$variant/run$run"
+      rm -rf "$dir"
+      mkdir -p "$dir"
+      log "$(basename "$seq"): $variant run $run of $runs"
+      (cd "$dir" && DYNCULL_MODE=$variant DYNCULL_DETECTIONS="$detections" DYNCULL_LOG="$dir/culler_frames.csv" \
+        "$rgbd_tum" "$vocabulary" "$dest/orbslam2_settings.yaml" "$seq" "$dest/associations.txt" \
+        >"$dir/rgbd_tum.log" 2>&1) || log "$variant run $run: rgbd_tum exited with status $? (see $dir/rgbd_tum.log)"
+      "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" --json \
+        >"$dir/ate.json" 2>"$dir/ate.err" || true
+    done
+  done
+}
+
+# A family's sequence, written once into --work by write_tum_sequence (seed 1).
+family_sequence() {
+  local family=$1 motion=$2 seq="$work/families/${1}_${2}_seed1_${frames}f"
+  if [[ ! -f "$seq/.complete" ]]; then
+    build_dyncull_tool write_tum_sequence
+    rm -rf "$seq"
+    "$work/dyncull-build/examples/write_tum_sequence" "$seq" --family "$family" --motion "$motion" --frames "$frames" \
+      --seed 1 >/dev/null
+    touch "$seq/.complete"
+  fi
+  echo "$seq"
+}
+
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-python3 "$root/scripts/orbslam2_sequence.py" prepare "$sequence" "$out"
 IFS=',' read -r -a variant_list <<<"$variants"
 for variant in "${variant_list[@]}"; do
   case "$variant" in stock|box_only|culler) ;; *) echo "orbslam2.sh: unknown variant '$variant'" >&2; exit 2 ;; esac
-  for ((run = 1; run <= runs; run++)); do
-    dir="$out/runs/$variant/run$run"
-    rm -rf "$dir"
-    mkdir -p "$dir"
-    log "$variant run $run of $runs"
-    (cd "$dir" && DYNCULL_MODE=$variant DYNCULL_DETECTIONS="$sequence/detections" DYNCULL_LOG="$dir/culler_frames.csv" \
-      "$rgbd_tum" "$vocabulary" "$out/orbslam2_settings.yaml" "$sequence" "$out/associations.txt" \
-      >"$dir/rgbd_tum.log" 2>&1) || log "$variant run $run: rgbd_tum exited with status $? (see $dir/rgbd_tum.log)"
-    "$dyncull_prefix/bin/dyncull_eval" "$sequence/groundtruth.txt" "$dir/CameraTrajectory.txt" --json \
-      >"$dir/ate.json" 2>"$dir/ate.err" || true
-  done
 done
-python3 "$root/scripts/orbslam2_sequence.py" summarise "$sequence" "$out" --vocabulary "$vocabulary" \
-  --command "scripts/orbslam2.sh --sequence \$DYNCULL_DATA_DIR/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --out DIR --runs $runs" \
-  ${page:+--page "$page"}
+if [[ -n "$sequence" ]]; then
+  run_sequence "$sequence" "$out"
+  python3 "$root/scripts/orbslam2_sequence.py" summarise "$sequence" "$out" --vocabulary "$vocabulary" \
+    --command "scripts/orbslam2.sh --sequence \$DYNCULL_DATA_DIR/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --out DIR --runs $runs" \
+    ${page:+--page "$page"}
+fi
+if [[ -n "$families" ]]; then
+  [[ "$families" != all ]] || families=walking,sitting,crowd,far_walker,brisk,low_texture,noisy_detector
+  IFS=',' read -r -a family_list <<<"$families"
+  IFS=',' read -r -a motion_list <<<"$motions"
+  for family in "${family_list[@]}"; do
+    for motion in "${motion_list[@]}"; do
+      seq=$(family_sequence "$family" "$motion")
+      run_sequence "$seq" "$out/families/${family}_${motion}"
+      python3 "$root/scripts/orbslam2_sequence.py" summarise "$seq" "$out/families/${family}_${motion}" >/dev/null
+    done
+  done
+  python3 "$root/scripts/orbslam2_sequence.py" families "$out" \
+    --command "scripts/orbslam2.sh --families $families --motions $motions --frames $frames --out DIR --runs $runs" \
+    ${page:+--page "$page"}
+fi
