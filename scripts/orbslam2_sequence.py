@@ -529,7 +529,8 @@ def families(out, command, page):
         "",
         text,
         "",
-        "Culler at most 0.5x stock's median ATE on %d of %d sequences; culler below box-only on %d of %d." % (
+        "Culler at most 0.5x stock's median ATE on %d of %d sequences; culler below box-only on %d of %d. Where a "
+        "variant lost frames, its ATE covers only the frames it tracked: read the two columns together." % (
             within, len(ratios), wins, len(names)),
         "",
         "Command: `%s`." % command,
