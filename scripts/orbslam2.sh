@@ -123,7 +123,7 @@ install_pangolin() {
   cmake -S "$thirdparty/Pangolin" -B "$work/pangolin-build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" \
     -DBUILD_EXAMPLES=OFF -DBUILD_TOOLS=OFF -DBUILD_PANGOLIN_PYTHON=OFF \
     -DCMAKE_INSTALL_PREFIX="$pangolin_prefix" >"$work/pangolin-configure.log"
-  cmake --build "$work/pangolin-build" -j "$jobs" >"$work/pangolin-build.log"
+  cmake --build "$work/pangolin-build" -j "$jobs" >"$work/pangolin-build.log" 2>&1
   cmake --install "$work/pangolin-build" >"$work/pangolin-install.log"
 }
 
