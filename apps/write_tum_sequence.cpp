@@ -3,8 +3,9 @@
 // associations.txt, groundtruth.txt (timestamp tx ty tz qx qy qz qw of world_from_cam), camera.txt
 // ("key value" lines: fx fy cx cy width height depth_units_per_metre, as dynamic_vo --dataset reads it),
 // detections/*.txt (YOLO style "class cx cy w h conf", normalised; one per rgb image, same stem) indexed
-// by detections.txt, and the truth masks instance/*.png (16-bit ids) and moving/*.png (255 = moving
-// surface).
+// by detections.txt, the same boxes in pixels as detections_json/NNNNNN.json (eval/yolo_json.hpp's
+// schema, timestamp = the rgb stamp), and the truth masks instance/*.png (16-bit ids) and moving/*.png
+// (255 = moving surface).
 //
 // Usage: write_tum_sequence OUTDIR [--family NAME] [--motion static|xyz|rpy|halfsphere] [--frames N]
 //                                  [--seed S] [--clean-depth]
@@ -62,6 +63,22 @@ std::string stamp(double t) {
   return os.str();
 }
 
+// One frame's boxes as eval/yolo_json.hpp reads them: bbox [x0, y0, x1, y1] in pixels.
+bool write_json_detections(const std::filesystem::path& path, int index, const std::string& ts,
+                           const std::string& rgb_name, const dyncull::sim::FrameData& f) {
+  std::ofstream out(path);
+  out << "{\"frame_id\": " << index << ", \"timestamp\": " << ts << ", \"image_path\": \"" << rgb_name
+      << "\", \"detections\": [";
+  out << std::setprecision(6);
+  for (std::size_t k = 0; k < f.detections.size(); ++k) {
+    const auto& d = f.detections[k];
+    out << (k ? ", " : "") << "{\"class_id\": " << d.class_id << ", \"confidence\": " << d.confidence
+        << ", \"bbox\": [" << d.box.x0 << ", " << d.box.y0 << ", " << d.box.x1 << ", " << d.box.y1 << "]}";
+  }
+  out << "]}\n";
+  return static_cast<bool>(out);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -102,7 +119,7 @@ int main(int argc, char** argv) {
   if (!scene.ok()) return usage(scene.reason().c_str());
 
   std::error_code ec;
-  for (const char* sub : {"rgb", "depth", "detections", "instance", "moving"}) {
+  for (const char* sub : {"rgb", "depth", "detections", "detections_json", "instance", "moving"}) {
     fs::create_directories(out / sub, ec);
     if (ec) {
       std::cerr << "write_tum_sequence: cannot create " << (out / sub) << ": " << ec.message() << "\n";
@@ -154,8 +171,11 @@ int main(int argc, char** argv) {
                          cv::imwrite((out / depth_name).string(), depth16) &&
                          cv::imwrite((out / "instance" / (ts + ".png")).string(), instance16) &&
                          cv::imwrite((out / "moving" / (ts + ".png")).string(), moving8);
+    char json_name[32];
+    std::snprintf(json_name, sizeof json_name, "%06d.json", index);
+    const bool json_written = write_json_detections(out / "detections_json" / json_name, index, ts, rgb_name, f);
     std::ofstream det(out / det_name);
-    if (!written || !det) {
+    if (!written || !json_written || !det) {
       std::cerr << "write_tum_sequence: cannot write frame " << index << " into " << out << "\n";
       return 1;
     }

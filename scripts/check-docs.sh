@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-paths=(README.md docs include examples apps tests bench scripts cmake CMakeLists.txt .ci)
+paths=(README.md docs include examples apps integrations tests bench scripts cmake CMakeLists.txt .ci)
 exts=(--include='*.md' --include='*.hpp' --include='*.h' --include='*.cpp' --include='*.cc' --include='*.sh'
       --include='*.cmake' --include='*.in' --include='*.txt' --include='*.py' --include=run)
 

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # Installs dyncull's build, test and benchmark dependencies from Debian 12 packages.
 # Idempotent: installs only what is missing, so CI and repeated runs cost a few seconds.
+#   scripts/install-deps.sh [--orbslam2]   --orbslam2: also what Pangolin needs for scripts/orbslam2.sh
 set -euo pipefail
 
 packages=(g++ clang cmake make pkg-config libeigen3-dev libopencv-dev libceres-dev doxygen graphviz
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev locales)
 # Open3D is an optional benchmark peer (ICP); set DYNCULL_WITH_OPEN3D=1 to install it.
 if [[ "${DYNCULL_WITH_OPEN3D:-0}" == 1 ]]; then packages+=(libopen3d-dev); fi
+# ORB-SLAM2 (scripts/orbslam2.sh) links Pangolin, which needs OpenGL, GLEW and EGL (headless backend).
+if [[ "${1:-}" == --orbslam2 ]]; then packages+=(libgl1-mesa-dev libglew-dev libegl-dev); fi
 
 sudo_cmd=()
 if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi

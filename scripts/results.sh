@@ -115,6 +115,8 @@ if [[ -n "$real_only" ]]; then
   args+=(--keep-suite-of "$page")
 else
   args+=(--suite "$suite" --ablation "$ablation")
+  # The ORB-SLAM2 sections come from scripts/orbslam2.sh: kept as they are.
+  [[ -f "$page" ]] && args+=(--keep-orbslam2-of "$page")
 fi
 python3 "$root/scripts/results_page.py" "${args[@]}" >"$page.new"
 mv "$page.new" "$page"

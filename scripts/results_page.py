@@ -9,7 +9,8 @@ scripts/ablation.sh --dataset; --suite holds dynamic_vo's family_summary.md / .c
 --suite), --ablation the ablation.md of scripts/ablation.sh. Each may hold the run_info.txt that
 scripts/results.sh writes, and the suite the families.txt it copies from dynamic_vo --help.
 --keep-suite-of copies the suite sections of an existing page unchanged (everything from its first
-"## What runs"), so the real sequence can be rerun alone. Called by scripts/results.sh.
+"## What runs"), so the real sequence can be rerun alone. --keep-orbslam2-of copies the sections
+scripts/orbslam2.sh wrote into an existing page. Called by scripts/results.sh.
 """
 import argparse
 import csv
@@ -302,7 +303,8 @@ with a real detector, then on synthetic scene families modelled on the TUM fr3 d
 ablation tables that are the evidence for the recommended preset. This page is generated:
 `scripts/results.sh` runs every experiment and rewrites it (about an hour on two free cores);
 `scripts/results.sh --real-only` reruns the real sequence alone; `scripts/results.sh --suite DIR
---ablation DIR` rewrites it from earlier output.
+--ablation DIR` rewrites it from earlier output. The ORB-SLAM2 sections at the end are written by
+`scripts/orbslam2.sh` and kept as they are by `scripts/results.sh`.
 """
 
 
@@ -314,6 +316,17 @@ def kept_suite(page):
     return text[at + 1:]
 
 
+def kept_orbslam2(page):
+    """The sections scripts/orbslam2.sh writes ("## In ORB-SLAM2", "## Scene families in ORB-SLAM2"), from
+    the first of them to the end of `page`, or nothing."""
+    if not page or not os.path.exists(page):
+        return ""
+    text = read(page)
+    starts = [text.find("\n" + h + "\n") for h in ("## In ORB-SLAM2", "## Scene families in ORB-SLAM2")]
+    starts = [s for s in starts if s >= 0]
+    return ("\n" + text[min(starts) + 1:]) if starts else ""
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--real", default="")
@@ -321,11 +334,12 @@ def main():
     ap.add_argument("--suite")
     ap.add_argument("--ablation")
     ap.add_argument("--keep-suite-of")
+    ap.add_argument("--keep-orbslam2-of", default="")
     a = ap.parse_args()
     if a.keep_suite_of:
         suite_text = kept_suite(a.keep_suite_of)
     elif a.suite and a.ablation:
-        suite_text = suite_sections(a.suite, a.ablation)
+        suite_text = suite_sections(a.suite, a.ablation) + kept_orbslam2(a.keep_orbslam2_of)
     else:
         sys.exit("results_page: give --suite and --ablation, or --keep-suite-of PAGE")
     print(header() + "\n" + real_section(a.real, a.real_ablation) + "\n" + suite_text, end="")

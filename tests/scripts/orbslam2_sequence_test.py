@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+"""Tests of scripts/orbslam2_sequence.py (run by ctest): rgb and depth paired as associate.py (closest
+first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
+Horn's alignment recovers a known rotation and translation; a run's lost frames are counted against the
+associations (ORB-SLAM2 leaves them out of its trajectory); the summary has a row per variant and run with
+the required columns, and a run without a trajectory is reported, not dropped."""
+import json
+import math
+import os
+import shutil
+import struct
+import sys
+import tempfile
+import unittest
+import zlib
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+import orbslam2_sequence as seq  # noqa: E402
+
+
+def write_png(path, width, height):
+    """A grey 8-bit PNG of the given size (only its header is read)."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    raw = b"".join(b"\x00" + b"\x80" * width for _ in range(height))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+class Sequence(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="dyncull_orbslam2_test_")
+        os.makedirs(os.path.join(self.dir, "rgb"))
+        write_png(os.path.join(self.dir, "rgb", "1.000000.png"), 64, 48)
+        with open(os.path.join(self.dir, "rgb.txt"), "w") as f:
+            f.write("# color images\n1.000000 rgb/1.000000.png\n1.033333 rgb/1.033333.png\n"
+                    "1.066667 rgb/1.066667.png\n1.100000 rgb/1.100000.png\n")
+        # depth 1.052 is within the window of rgb 1.033 (0.019) and rgb 1.067 (0.015): the closer one gets it,
+        # and rgb 1.033 stays without a partner; rgb 1.100 has none within 0.02 s (1.130).
+        with open(os.path.join(self.dir, "depth.txt"), "w") as f:
+            f.write("# depth maps\n1.010000 depth/a.png\n1.052000 depth/b.png\n1.130000 depth/c.png\n")
+        with open(os.path.join(self.dir, "camera.txt"), "w") as f:
+            f.write("fx 542.8\nfy 542.5\ncx 315.5\ncy 237.7\ndepth_units_per_metre 5000\n")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def test_pairs_closest_first_each_stamp_once(self):
+        pairs = seq.associate(seq.read_list(os.path.join(self.dir, "rgb.txt")),
+                              seq.read_list(os.path.join(self.dir, "depth.txt")))
+        self.assertEqual([(p[0], p[1], p[2], p[3]) for p in pairs],
+                         [("1.000000", "rgb/1.000000.png", "1.010000", "depth/a.png"),
+                          ("1.066667", "rgb/1.066667.png", "1.052000", "depth/b.png")])
+
+    def test_settings_from_camera_and_image_size(self):
+        seq.prepare(self.dir, self.dir)
+        text = open(os.path.join(self.dir, "orbslam2_settings.yaml")).read()
+        self.assertTrue(text.startswith("%YAML:1.0\n"))
+        for line in ("Camera.fx: 542.8", "Camera.cy: 237.7", "Camera.k1: 0.0", "Camera.width: 64",
+                     "Camera.height: 48", "DepthMapFactor: 5000.0", "ORBextractor.nFeatures: 1000"):
+            self.assertIn(line + "\n", text)
+        self.assertEqual(seq.count_lines(os.path.join(self.dir, "associations.txt")), 2)
+
+    def test_lost_frames_and_summary_rows(self):
+        seq.prepare(self.dir, self.dir)
+        good = os.path.join(self.dir, "runs", "culler", "run1")
+        empty = os.path.join(self.dir, "runs", "culler", "run2")
+        os.makedirs(good)
+        os.makedirs(empty)
+        with open(os.path.join(good, "CameraTrajectory.txt"), "w") as f:
+            f.write("1.000000 0 0 0 0 0 0 1\n")  # one of the two associated frames: one lost
+        with open(os.path.join(good, "rgbd_tum.log"), "w") as f:
+            f.write("median tracking time: 0.030\nmean tracking time: 0.0325\n"
+                    "dyncull: mode culler, 2 frames (0 without a detections file, 0 not Ok, 0 restarts), "
+                    "features 1000.0 -> 800.5 per frame, 1.500 ms per frame culling\n")
+        with open(os.path.join(good, "ate.json"), "w") as f:
+            json.dump({"status": "ok", "ate": {"pairs": 1, "error_m": {"rmse": 0.0123}}}, f)
+        seq.summarise(self.dir, self.dir, "", "cmd", "")
+        lines = open(os.path.join(self.dir, "orbslam2_summary.csv")).read().splitlines()
+        header = lines[0].split(",")
+        for column in ("variant", "run", "ate_rmse_m", "lost_frames", "frames", "track_ms"):
+            self.assertIn(column, header)
+        rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
+        self.assertEqual(len(rows), 2)
+        self.assertEqual((rows[0]["variant"], rows[0]["run"], rows[0]["ate_rmse_m"], rows[0]["lost_frames"],
+                          rows[0]["frames"], rows[0]["track_ms"], rows[0]["cull_ms"], rows[0]["features_kept"]),
+                         ("culler", "1", "0.01230", "1", "2", "32.50", "1.500", "800.5"))
+        self.assertEqual((rows[1]["run"], rows[1]["ate_rmse_m"], rows[1]["lost_frames"]), ("2", "", "2"))
+        self.assertIn("no trajectory", rows[1]["note"])
+
+
+class Alignment(unittest.TestCase):
+    def test_horn_recovers_a_rotation_and_translation(self):
+        angle = 0.7
+        c, s = math.cos(angle), math.sin(angle)
+        R = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+        t = [0.5, -1.0, 2.0]
+        estimate = [(0.0, 0.0, 0.0), (1.0, 0.2, 0.0), (0.3, 1.5, 0.4), (-0.7, 0.1, 1.2), (0.2, -0.9, -0.5)]
+        truth = [tuple(sum(R[i][j] * p[j] for j in range(3)) + t[i] for i in range(3)) for p in estimate]
+        R_fit, t_fit = seq.horn_alignment(list(zip(truth, estimate)))
+        for i in range(3):
+            self.assertAlmostEqual(t_fit[i], t[i], places=9)
+            for j in range(3):
+                self.assertAlmostEqual(R_fit[i][j], R[i][j], places=9)
+
+
+if __name__ == "__main__":
+    unittest.main()
