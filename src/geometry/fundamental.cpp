@@ -32,10 +32,3 @@ template void fundamental_8point(const std::vector<Vec2<double>>&, const std::ve
                                  FundamentalWorkspace<double>*, FundamentalResult<double>*);
 
 }  // namespace dyncull
-
-// The header-only form's marker (core/precompiled.hpp): defined here as well, so a program that also holds a
-// header-only translation unit fails to link instead of being silently ill-formed.
-extern "C" {
-extern const char dyncull_abi_fundamental_solvers;
-const char dyncull_abi_fundamental_solvers = 1;
-}

@@ -23,10 +23,3 @@ template void solve_pnp_ransac(const std::vector<Vec3<double>>&, const std::vect
                                PnpResult<double>*);
 
 }  // namespace dyncull
-
-// The header-only form's marker (core/precompiled.hpp): defined here as well, so a program that also holds a
-// header-only translation unit fails to link instead of being silently ill-formed.
-extern "C" {
-extern const char dyncull_abi_pnp_solvers;
-const char dyncull_abi_pnp_solvers = 1;
-}
