@@ -2,7 +2,7 @@
 // the reprojection check cannot run, so the culler decides on epipolar evidence against its own keyframe
 // and on the detector's boxes, and its status says which inputs were missing (MissingInput, the frame
 // still culled by the stages that ran). Input: the synthetic walking scene's grey frames and boxes.
-#include <dyncull/opencv/compiled_culler.hpp>
+#include <dyncull/opencv/culler.hpp>
 #include <dyncull/sim/scene.hpp>
 
 #include <opencv2/core/eigen.hpp>
@@ -17,7 +17,7 @@ int main() {
   const dyncull::sim::Scene scene(scene_options);
   cv::Mat K;
   cv::eigen2cv(scene.camera().K(), K);
-  dyncull::cv_adapter::CompiledCuller culler(K, cv::Size(640, 480));
+  dyncull::Culler culler(dyncull::cv_adapter::culler_camera(K, cv::Size(640, 480)));
   const cv::Ptr<cv::ORB> orb = cv::ORB::create(1000);
   dyncull::sim::FrameData frame;
   std::size_t detected = 0, kept = 0;
@@ -29,19 +29,19 @@ int main() {
     orb->detectAndCompute(gray, cv::noArray(), keys, descriptors);
     cv::Mat Tcw;  // a monocular system's pose is up to scale; the culler uses it only to guide matching
     cv::eigen2cv(frame.world_from_cam.inverse().matrix(), Tcw);
-    std::vector<dyncull::cv_adapter::DetectedBox> boxes;
+    std::vector<dyncull::DetectedBox> boxes;
     for (const auto& d : frame.detections)
       boxes.emplace_back(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence);
-    const std::vector<std::uint8_t>& keep = culler.cull(keys, descriptors, cv::Mat(), boxes, &Tcw);  // no depth
+    const dyncull::CullerResult& r = dyncull::cv_adapter::cull(culler, keys, descriptors, cv::Mat(), boxes, &Tcw);  // no depth
     detected += keys.size();
-    culler.compact(keep, descriptors, keys);
+    dyncull::cv_adapter::compact(r.keep, descriptors, keys);
     kept += keys.size();
   }
   const auto& result = culler.result();
   std::printf("monocular: %zu ORB features in %d frames, %zu kept; last status %s%s%s\n", detected,
-              scene_options.num_frames, kept, culler.to_string(result.status), result.reason.empty() ? "" : ": ",
+              scene_options.num_frames, kept, dyncull::to_string(result.status), result.reason.empty() ? "" : ": ",
               result.reason.c_str());
   // Without depth the status names what is missing; the frame is still culled.
-  const bool says_missing = result.status == dyncull::cv_adapter::CompiledCuller::Status::MissingInput;
+  const bool says_missing = result.status == dyncull::Status::MissingInput;
   return culler.ok() && says_missing && kept < detected ? 0 : 1;
 }

@@ -532,7 +532,7 @@ def main():
                     "precompiled unit at most half of `instantiate`'s time and peak memory.", "", cc, ""]
     if cch:
         cc_text += ["A host translation unit like an ORB-SLAM front end (`opencv2/core`, `features2d`, `Eigen/Core`; ORB",
-                    "into vectors), `g++ -std=c++14 -O2`, without dyncull and with `dyncull/opencv/compiled_culler.hpp`",
+                    "into vectors), `g++ -std=c++14 -O2`, without dyncull and with `dyncull/opencv/culler.hpp`",
                     "included and the culler called, `scripts/compile-cost-host.sh --csv FILE`. Target: at most 2x the",
                     "time and peak memory of the unit without it.", "", cch, ""]
     if not cc_text:

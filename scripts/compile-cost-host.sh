@@ -2,7 +2,8 @@
 # Compile cost the compiled culler adds to a host front end: g++ -O2 -std=c++14 (ORB-SLAM3's standard)
 # on a translation unit like an ORB-SLAM front end (opencv2/core, features2d and Eigen/Core; ORB on an
 # image, keypoints and descriptors into vectors), once without dyncull and once including
-# dyncull/opencv/compiled_culler.hpp and calling the culler, in one run. Prints user and wall time and
+# dyncull/opencv/culler.hpp (the OpenCV overloads of dyncull::Culler, compiled into dyncull::culler) and
+# calling the culler, in one run. Prints user and wall time and
 # peak RSS of each (/usr/bin/time -v) and the with/without ratios; fails when a ratio of user time or
 # peak RSS exceeds --max-ratio (default 2).
 #   scripts/compile-cost-host.sh [--csv FILE] [--max-ratio R] [--source DIR]
@@ -32,7 +33,7 @@ cat > "$tmp/front_end.cpp" <<'CPP'
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #ifdef WITH_DYNCULL
-#include <dyncull/opencv/compiled_culler.hpp>
+#include <dyncull/opencv/culler.hpp>
 #endif
 #include <cstdio>
 #include <vector>
@@ -58,11 +59,11 @@ int main() {
     f.points.push_back(Eigen::Vector3f((k.pt.x - 319.5f) * z / 525.f, (k.pt.y - 239.5f) * z / 525.f, z));
   }
 #ifdef WITH_DYNCULL
-  dyncull::cv_adapter::CompiledCuller culler(K, cv::Size(640, 480));
-  std::vector<dyncull::cv_adapter::DetectedBox> boxes(1, dyncull::cv_adapter::DetectedBox(cv::Rect2f(100, 100, 80, 200), 0));
+  dyncull::Culler culler(dyncull::cv_adapter::culler_camera(K, cv::Size(640, 480)));
+  std::vector<dyncull::DetectedBox> boxes(1, dyncull::cv_adapter::detected_box(cv::Rect2f(100, 100, 80, 200), 0));
   const cv::Mat Tcw = cv::Mat::eye(4, 4, CV_32F);
-  const std::vector<std::uint8_t> keep = culler.cull(f.keys, f.descriptors, depth, boxes, &Tcw);
-  dyncull::cv_adapter::CompiledCuller::compact(keep, f.descriptors, f.keys, f.depths, f.points);
+  const std::vector<std::uint8_t> keep = dyncull::cv_adapter::cull(culler, f.keys, f.descriptors, depth, boxes, &Tcw).keep;
+  dyncull::cv_adapter::compact(keep, f.descriptors, f.keys, f.depths, f.points);
   std::printf("%s\n", culler.result().reason.c_str());
 #endif
   std::printf("%zu features\n", f.keys.size());

@@ -117,16 +117,14 @@ class Culler {
   Culler(const StrategySpec& spec, const PinholeCamera<double>& camera)
       : spec_(spec), camera_(camera.cast<float>()) {
     if (!spec_.through_culler) return;
-    const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-    CullerOptions<float> options;
-    options.pipeline = spec_.pipeline;
+    CullerOptions options("recommended");
     // This front end keeps its tracks and adds corners only at its own keyframes, which the culler's
     // keyframe then lacks; at the culler's default 0.3 half the tracks went unmatched between its
     // keyframes and fell to the box rule (static features in boxes culled: precision 0.76 against the
     // hand-fed 0.87 on the walking sequence's still camera). 0.6 keeps its keyframe close to the tracks.
     options.keyframe_min_matched_ratio = kKeyframeMinMatchedRatio;
-    frame_culler_ = std::make_unique<cv_adapter::FrameCuller>(cv::Mat(K), cv::Size(camera.width, camera.height),
-                                                              cv::Mat(), options);
+    frame_culler_ = std::make_unique<dyncull::Culler>(
+        CullerCamera(camera.fx, camera.fy, camera.cx, camera.cy, camera.width, camera.height), options);
     // One level, descriptors only. The edge threshold is the front end's track border (border_px / 2):
     // ORB's own 31 would drop every track within 31 px of the edge; closer in, its pyramid pads the image
     // (reflected) so a descriptor there is defined, if less distinctive.
@@ -210,8 +208,11 @@ class Culler {
     without_descriptor_ = n - keys_.size();
     const cv::Matx44d Tcw = to_matx(predicted_world_from_cam.inverse());
     const cv::Mat pose(Tcw);
-    const std::vector<std::uint8_t>& k = frame_culler_->cull(keys_, descriptors_, frame.depth_m, frame.detections, &pose);
-    const CullerResult& r = frame_culler_->result();
+    boxes_.clear();
+    for (const Detection<float>& d : frame.detections)
+      boxes_.push_back(DetectedBox(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence));
+    const CullerResult& r = cv_adapter::cull(*frame_culler_, keys_, descriptors_, frame.depth_m, boxes_, &pose);
+    const std::vector<std::uint8_t>& k = r.keep;
     if (k.size() != keys_.size()) return;
     for (std::size_t j = 0; j < keys_.size(); ++j) {
       const std::size_t i = static_cast<std::size_t>(keys_[j].class_id);
@@ -284,7 +285,8 @@ class Culler {
   Rigid3<float> pose_;
   int frame_index_ = 0;
   // StrategySpec::through_culler.
-  std::unique_ptr<cv_adapter::FrameCuller> frame_culler_;
+  std::unique_ptr<dyncull::Culler> frame_culler_;
+  std::vector<DetectedBox> boxes_;
   cv::Ptr<cv::ORB> orb_;
   double descriptor_ms_ = 0;
   std::vector<cv::KeyPoint> keys_;

@@ -3,7 +3,7 @@
 // 640x480 synthetic walking scene, next to cv::ORB detectAndCompute of the same frames in the same binary.
 // Counter `vs_orb` = the culler's CPU time per frame / ORB's on the same frames (target <= 0.35);
 // `keyframes` = share of frames that became keyframes.
-#include "dyncull/culling/culler.hpp"
+#include "dyncull/culling/culler_core.hpp"
 
 #include "dyncull/sim/scene.hpp"
 
@@ -88,10 +88,10 @@ void BM_CullerPerFrame(benchmark::State& state) {
   double seconds = 0;
   std::size_t frames = 0, keyframes = 0;
   for (auto _ : state) {
-    dyncull::Culler<float> culler(s.camera);
+    dyncull::CullerCore<float> culler(s.camera);
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
       const Frame& f = s.frames[i];
-      dyncull::CullerFrame<float> in;
+      dyncull::CullerCoreFrame<float> in;
       in.keypoints = dyncull::points_view(f.keys);
       in.descriptors = dyncull::DescriptorRows(f.descriptors.data(), f.keys.size(), 32, 32);
       in.depth_m = dyncull::DepthView<float>{f.depth.data(), s.camera.width, s.camera.height, 0, 1.f, 0.4f, 8.f};

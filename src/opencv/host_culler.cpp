@@ -109,7 +109,7 @@ bool inside_any(const cv::KeyPoint& key, const std::vector<DetectedBox>& boxes, 
 struct HostCuller::Impl {
   Settings settings;
   std::vector<StampedBoxes> detections;
-  std::unique_ptr<CompiledCuller> culler;
+  std::unique_ptr<Culler> culler;
   std::vector<std::uint8_t> keep;
   std::ofstream log;
   Stats stats;
@@ -222,16 +222,14 @@ const std::vector<std::uint8_t>* HostCuller::cull(double stamp, unsigned long fr
       if (inside_any(keys[i], boxes, m.settings.box_only_classes)) m.keep[i] = 0;
   } else {
     if (!m.culler) {
-      CompiledCuller::Options options;
-      options.preset = m.settings.preset;
-      m.culler.reset(new CompiledCuller(K, image_size, distortion, options));
+      m.culler.reset(new Culler(culler_camera(K, image_size, distortion), CullerOptions(m.settings.preset)));
       if (!m.culler->ok()) fail("culler: " + m.culler->reason());
     }
     const cv::Mat* pose = predicted_Tcw.empty() ? nullptr : &predicted_Tcw;
     const std::vector<cv::KeyPoint>* undistorted = keys_un.size() == keys.size() ? &keys_un : nullptr;
-    m.keep = m.culler->cull(keys, descriptors, depth, boxes, pose, undistorted);
-    const CompiledCuller::Result& r = m.culler->result();
-    status = CompiledCuller::to_string(r.status);
+    const CullerResult& r = cv_adapter::cull(*m.culler, keys, descriptors, depth, boxes, pose, undistorted);
+    m.keep = r.keep;
+    status = dyncull::to_string(r.status);
     if (!r.ok()) {
       ++m.stats.frames_not_ok;
       reason = reason.empty() ? r.reason : reason + "; " + r.reason;

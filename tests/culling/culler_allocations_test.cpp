@@ -1,8 +1,8 @@
-// Counts the heap allocations Culler::cull makes per frame after warm-up (a counting global operator new in
+// Counts the heap allocations CullerCore::cull makes per frame after warm-up (a counting global operator new in
 // this executable only): none of its own (matching, keyframe store, evidence arrays) with a pipeline that
 // does next to nothing, and none in all with the recommended preset (its F and pose fits, depth masks and
 // stage reasons reuse buffers kept across frames).
-#include "dyncull/culling/culler.hpp"
+#include "dyncull/culling/culler_core.hpp"
 
 #include "dyncull/core/random.hpp"
 
@@ -61,13 +61,13 @@ std::vector<View> sequence(int frames) {
 }
 
 /// Allocations of each frame of the last round, after `warmup_rounds` replays of the sequence.
-std::vector<std::size_t> allocations_per_frame(const CullerOptions<float>& options, const std::vector<View>& seq,
+std::vector<std::size_t> allocations_per_frame(const CullerCoreOptions<float>& options, const std::vector<View>& seq,
                                                int warmup_rounds, Status* last_status) {
-  Culler<float> culler(PinholeCamera<float>::tum_fr3(), options);
+  CullerCore<float> culler(PinholeCamera<float>::tum_fr3(), options);
   std::vector<std::size_t> counts;
   for (int round = 0; round <= warmup_rounds; ++round) {
     for (const View& v : seq) {
-      CullerFrame<float> f;
+      CullerCoreFrame<float> f;
       f.keypoints = points_view(v.keys);
       f.descriptors = DescriptorRows(v.desc.data(), v.keys.size(), 0, 32);
       f.depth_m = DepthView<float>{v.depth.data(), 640, 480, 0, 1.f, 0.f, 1e30f};
@@ -83,7 +83,7 @@ std::vector<std::size_t> allocations_per_frame(const CullerOptions<float>& optio
 
 TEST(CullerAllocations, NoneOfItsOwnPerFrameAfterWarmUp) {
   const std::vector<View> seq = sequence(10);
-  CullerOptions<float> own_only;
+  CullerCoreOptions<float> own_only;
   own_only.pipeline = presets::none<float>();  // the pipeline does next to nothing: what is left is the culler's
   own_only.pipeline.detections.enabled = false;
   Status status = Status::Ok;
@@ -95,7 +95,7 @@ TEST(CullerAllocations, NoneOfItsOwnPerFrameAfterWarmUp) {
 TEST(CullerAllocations, RecommendedPresetNonePerFrameAfterWarmUp) {
   const std::vector<View> seq = sequence(10);
   Status status = Status::Ok;
-  const std::vector<std::size_t> counts = allocations_per_frame(CullerOptions<float>(), seq, 3, &status);
+  const std::vector<std::size_t> counts = allocations_per_frame(CullerCoreOptions<float>(), seq, 3, &status);
   std::size_t most = 0;
   for (std::size_t c : counts) most = std::max(most, c);
   std::printf("recommended through the culler: at most %zu allocations per frame after warm-up\n", most);

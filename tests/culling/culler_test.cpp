@@ -1,10 +1,11 @@
-// Tests of culling/culler.hpp on a synthetic textured wall with known camera motion: the keyframe policy
+// Tests of culling/culler_core.hpp on a synthetic textured wall with known camera motion: the keyframe policy
 // (own: by motion and by matched share; host-decided), stable track ids, the host's matches, the inputs a
 // configuration lists, missing inputs and mismatched sizes named in the status, monocular and distortion
 // statuses, and no default intrinsics.
-#include "dyncull/culling/culler.hpp"
+#include "dyncull/culling/culler_core.hpp"
 
 #include "dyncull/core/random.hpp"
+#include "support/culler_wall.hpp"
 #include "dyncull/culling/presets.hpp"
 
 #include <gtest/gtest.h>
@@ -19,70 +20,13 @@
 namespace dyncull {
 namespace {
 
-/// Textured points 2.5-4 m in front of the world origin (= first camera frame; not one plane, so the
-/// epipolar geometry is determined), seen by a camera translated by `x` metres along its x axis; every
-/// point has its own 32-byte descriptor in every view, and its depth in a 5 x 5 patch of the depth image.
-template <class T>
-struct WallView {
-  PinholeCamera<T> camera = PinholeCamera<T>::tum_fr3();
-  std::vector<Vec2<T>> keypoints;
-  std::vector<int> point_index;       // which wall point each keypoint sees
-  std::vector<std::uint8_t> descriptors;  // 32 bytes per keypoint
-  std::vector<float> depth;
-  std::vector<Detection<T>> detections;
-  Rigid3<T> cam_from_world;
-
-  CullerFrame<T> frame() const {
-    CullerFrame<T> f;
-    f.keypoints = points_view(keypoints);
-    f.descriptors = DescriptorRows(descriptors.data(), keypoints.size(), 0, 32);
-    f.depth_m = DepthView<float>{depth.data(), camera.width, camera.height, 0, 1.f, 0.f, 1e30f};
-    f.detections = &detections;
-    f.cam_from_world = &cam_from_world;
-    return f;
-  }
-};
-
-constexpr int kWallPoints = 400;
+using test::WallView;
+using test::wall_view;
+using test::kWallPoints;
 
 template <class T>
-WallView<T> wall_view(double x, std::uint64_t texture_seed = 3, bool reversed = false) {
-  WallView<T> v;
-  Random rng(11);  // the wall's points: the same in every view
-  Random tex(texture_seed);
-  v.cam_from_world.t = Vec3<T>(T(-x), T(0), T(0));
-  v.depth.assign(static_cast<std::size_t>(v.camera.width * v.camera.height), 0.f);
-  for (int j = 0; j < kWallPoints; ++j) {
-    const double wx = rng.uniform(-2.0, 2.0), wy = rng.uniform(-1.4, 1.4), wz = rng.uniform(2.5, 4.0);
-    std::uint8_t d[32];
-    for (auto& b : d) b = static_cast<std::uint8_t>(tex.next() & 0xFF);
-    const Vec3<T> pc = v.cam_from_world.apply(Vec3<T>(T(wx), T(wy), T(wz)));
-    const Vec2<T> px = v.camera.project(pc);
-    if (!v.camera.in_image(px.x(), px.y(), T(16))) continue;
-    const int u0 = static_cast<int>(std::lround(px.x())), v0 = static_cast<int>(std::lround(px.y()));
-    for (int dv = -2; dv <= 2; ++dv)
-      for (int du = -2; du <= 2; ++du)
-        v.depth[static_cast<std::size_t>((v0 + dv) * v.camera.width + u0 + du)] = static_cast<float>(pc.z());
-    v.keypoints.push_back(px);
-    v.point_index.push_back(j);
-    v.descriptors.insert(v.descriptors.end(), d, d + 32);
-  }
-  if (reversed) {  // the same points in the opposite order: ids must follow the points, not the indices
-    std::vector<Vec2<T>> k(v.keypoints.rbegin(), v.keypoints.rend());
-    std::vector<int> p(v.point_index.rbegin(), v.point_index.rend());
-    std::vector<std::uint8_t> d;
-    for (std::size_t i = v.keypoints.size(); i-- > 0;)
-      d.insert(d.end(), v.descriptors.begin() + 32 * i, v.descriptors.begin() + 32 * (i + 1));
-    v.keypoints.swap(k);
-    v.point_index.swap(p);
-    v.descriptors.swap(d);
-  }
-  return v;
-}
-
-template <class T>
-CullerOptions<T> host_keyframes() {
-  CullerOptions<T> o;
+CullerCoreOptions<T> host_keyframes() {
+  CullerCoreOptions<T> o;
   o.keyframe_policy = KeyframePolicy::Host;
   return o;
 }
@@ -96,7 +40,7 @@ TYPED_TEST(CullerTest, InvalidCameraFailsWithItsReason) {
   using T = TypeParam;
   PinholeCamera<T> camera = PinholeCamera<T>::tum_fr3();
   camera.fx = T(0);
-  Culler<T> culler(camera);
+  CullerCore<T> culler(camera);
   EXPECT_EQ(culler.status(), Status::InvalidInput);
   EXPECT_NE(culler.reason().find("camera"), std::string::npos) << culler.reason();
   const WallView<T> v = wall_view<T>(0);
@@ -109,16 +53,16 @@ TYPED_TEST(CullerTest, InvalidCameraFailsWithItsReason) {
 
 TYPED_TEST(CullerTest, InvalidOptionsNameTheField) {
   using T = TypeParam;
-  CullerOptions<T> o;
+  CullerCoreOptions<T> o;
   o.keyframe_min_matched_ratio = 2;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), o);
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), o);
   EXPECT_EQ(culler.status(), Status::InvalidInput);
   EXPECT_NE(culler.reason().find("keyframe_min_matched_ratio"), std::string::npos) << culler.reason();
 }
 
 TYPED_TEST(CullerTest, TrackIdsFollowTheKeyframePointsAcrossFrames) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   const WallView<T> v0 = wall_view<T>(0);
   const CullerResult& r0 = culler.cull(v0.frame());
   EXPECT_TRUE(r0.keyframe);
@@ -146,7 +90,7 @@ TYPED_TEST(CullerTest, TrackIdsFollowTheKeyframePointsAcrossFrames) {
 
 TYPED_TEST(CullerTest, UnmatchedKeypointsGetNewIds) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   const WallView<T> v0 = wall_view<T>(0);
   const CullerResult r0 = culler.cull(v0.frame());
   const WallView<T> v1 = wall_view<T>(0.01, 99);  // other texture: nothing matches
@@ -159,7 +103,7 @@ TYPED_TEST(CullerTest, UnmatchedKeypointsGetNewIds) {
 
 TYPED_TEST(CullerTest, OwnPolicyMakesAKeyframeWhenThePoseMovedFar) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   EXPECT_TRUE(culler.cull(wall_view<T>(0).frame()).keyframe);  // the first frame
   EXPECT_FALSE(culler.cull(wall_view<T>(0.05).frame()).keyframe);
   EXPECT_FALSE(culler.cull(wall_view<T>(0.09).frame()).keyframe);
@@ -173,7 +117,7 @@ TYPED_TEST(CullerTest, OwnPolicyMakesAKeyframeWhenThePoseMovedFar) {
 
 TYPED_TEST(CullerTest, OwnPolicyMakesAKeyframeWhenFewKeypointsMatch) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   culler.cull(wall_view<T>(0).frame());
   EXPECT_FALSE(culler.cull(wall_view<T>(0.01).frame()).keyframe);
   const CullerResult& r = culler.cull(wall_view<T>(0.02, 99).frame());
@@ -186,7 +130,7 @@ TYPED_TEST(CullerTest, OwnPolicyMakesAKeyframeWhenFewKeypointsMatch) {
 // one and every later frame would run on box evidence alone.
 TYPED_TEST(CullerTest, OwnPolicyReplacesAnEmptyKeyframe) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   WallView<T> empty = wall_view<T>(0);
   empty.keypoints.clear();
   empty.descriptors.clear();
@@ -199,11 +143,11 @@ TYPED_TEST(CullerTest, OwnPolicyReplacesAnEmptyKeyframe) {
 
 TYPED_TEST(CullerTest, HostPolicyFollowsIsKeyframe) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   EXPECT_TRUE(culler.cull(wall_view<T>(0).frame()).keyframe);  // the first frame always is one
   const WallView<T> far = wall_view<T>(0.3);
   EXPECT_FALSE(culler.cull(far.frame()).keyframe);  // the own policy would take it
-  CullerFrame<T> f = wall_view<T>(0.01).frame();
+  CullerCoreFrame<T> f = wall_view<T>(0.01).frame();
   const WallView<T> v = wall_view<T>(0.01);
   f = v.frame();
   f.is_keyframe = true;
@@ -212,7 +156,7 @@ TYPED_TEST(CullerTest, HostPolicyFollowsIsKeyframe) {
 
 TYPED_TEST(CullerTest, HostMatchesReplaceOwnMatching) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   const WallView<T> v0 = wall_view<T>(0);
   const CullerResult r0 = culler.cull(v0.frame());
   const WallView<T> v1 = wall_view<T>(0.02, 3, true);
@@ -220,7 +164,7 @@ TYPED_TEST(CullerTest, HostMatchesReplaceOwnMatching) {
   for (std::size_t i = 0; i < v1.keypoints.size(); ++i)
     for (std::size_t k = 0; k < v0.keypoints.size(); ++k)
       if (v0.point_index[k] == v1.point_index[i]) match[i] = static_cast<int>(k);
-  CullerFrame<T> f = v1.frame();
+  CullerCoreFrame<T> f = v1.frame();
   f.descriptors = DescriptorRows();  // not needed with the host's matches
   f.keyframe_match = match.data();
   const CullerResult& r = culler.cull(f);
@@ -236,15 +180,15 @@ TYPED_TEST(CullerTest, HostMatchesReplaceOwnMatching) {
 
 TYPED_TEST(CullerTest, InputsListWhatTheConfigurationReads) {
   using T = TypeParam;
-  Culler<T> recommended(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> recommended(PinholeCamera<T>::tum_fr3());
   EXPECT_EQ(recommended.inputs().names(), "keypoints, descriptors, depth, detections, pose");
-  CullerOptions<T> o;
+  CullerCoreOptions<T> o;
   o.pipeline = presets::zhu_2024<T>();
-  Culler<T> boxes_only(PinholeCamera<T>::tum_fr3(), o);
+  CullerCore<T> boxes_only(PinholeCamera<T>::tum_fr3(), o);
   EXPECT_EQ(boxes_only.inputs().names(), "keypoints, detections");
   o.pipeline = presets::dfd_slam<T>();
   o.keyframe_policy = KeyframePolicy::Host;
-  Culler<T> epipolar(PinholeCamera<T>::tum_fr3(), o);
+  CullerCore<T> epipolar(PinholeCamera<T>::tum_fr3(), o);
   EXPECT_EQ(epipolar.inputs().names(), "keypoints, descriptors, detections");
 }
 
@@ -252,19 +196,19 @@ TYPED_TEST(CullerTest, MissingInputsAreNamed) {
   using T = TypeParam;
   struct Case {
     const char* name;
-    void (*drop)(CullerFrame<T>*);
+    void (*drop)(CullerCoreFrame<T>*);
   };
   const Case cases[] = {
-      {"descriptors", [](CullerFrame<T>* f) { f->descriptors = DescriptorRows(); }},
-      {"detections", [](CullerFrame<T>* f) { f->detections = nullptr; }},
-      {"pose", [](CullerFrame<T>* f) { f->cam_from_world = nullptr; }},
-      {"depth", [](CullerFrame<T>* f) { f->depth_m = DepthView<float>{}; }},
+      {"descriptors", [](CullerCoreFrame<T>* f) { f->descriptors = DescriptorRows(); }},
+      {"detections", [](CullerCoreFrame<T>* f) { f->detections = nullptr; }},
+      {"pose", [](CullerCoreFrame<T>* f) { f->cam_from_world = nullptr; }},
+      {"depth", [](CullerCoreFrame<T>* f) { f->depth_m = DepthView<float>{}; }},
   };
   for (const Case& c : cases) {
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
     culler.cull(wall_view<T>(0).frame());
     const WallView<T> v = wall_view<T>(0.01);
-    CullerFrame<T> f = v.frame();
+    CullerCoreFrame<T> f = v.frame();
     c.drop(&f);
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::MissingInput) << c.name;
@@ -272,8 +216,8 @@ TYPED_TEST(CullerTest, MissingInputsAreNamed) {
     EXPECT_NE(r.reason.find(std::string("missing input: ") + c.name), std::string::npos) << r.reason;
     EXPECT_EQ(r.keep.size(), v.keypoints.size());
   }
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
-  CullerFrame<T> none;
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCoreFrame<T> none;
   const CullerResult& r = culler.cull(none);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_NE(r.reason.find("keypoints"), std::string::npos) << r.reason;
@@ -281,10 +225,10 @@ TYPED_TEST(CullerTest, MissingInputsAreNamed) {
 
 TYPED_TEST(CullerTest, MonocularRunsAndSaysDepthStagesDidNotRun) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   for (int k = 0; k < 3; ++k) {
     const WallView<T> v = wall_view<T>(0.01 * k);
-    CullerFrame<T> f = v.frame();
+    CullerCoreFrame<T> f = v.frame();
     f.depth_m = DepthView<float>{};
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::MissingInput);
@@ -304,8 +248,8 @@ TYPED_TEST(CullerTest, MismatchedSizesAreNamed) {
   const WallView<T> v = wall_view<T>(0);
   const std::size_t n = v.keypoints.size();
   {
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
-    CullerFrame<T> f = v.frame();
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCoreFrame<T> f = v.frame();
     f.descriptors.rows = n - 1;
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::InvalidInput);
@@ -314,24 +258,24 @@ TYPED_TEST(CullerTest, MismatchedSizesAreNamed) {
     EXPECT_FALSE(culler.has_keyframe());  // a refused frame changes no state
   }
   {
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
-    CullerFrame<T> f = v.frame();
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCoreFrame<T> f = v.frame();
     f.undistorted_keypoints = PointsView::of(static_cast<const T*>(v.keypoints[0].data()), n - 2, sizeof(Vec2<T>));
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::InvalidInput);
     EXPECT_NE(r.reason.find("undistorted_keypoints has"), std::string::npos) << r.reason;
   }
   {
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
-    CullerFrame<T> f = v.frame();
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCoreFrame<T> f = v.frame();
     f.depth_m.width = 320;
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::InvalidInput);
     EXPECT_NE(r.reason.find("depth: 320x480 for an image of 640x480"), std::string::npos) << r.reason;
   }
   {
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
-    CullerFrame<T> f = v.frame();
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCoreFrame<T> f = v.frame();
     const std::vector<std::uint16_t> raw(v.depth.size(), 15000);
     f.depth_raw = DepthView<std::uint16_t>{raw.data(), 640, 480, 0, 5000.f, 0.f, 1e30f};
     const CullerResult& r = culler.cull(f);
@@ -339,8 +283,8 @@ TYPED_TEST(CullerTest, MismatchedSizesAreNamed) {
     EXPECT_NE(r.reason.find("not both"), std::string::npos) << r.reason;
   }
   {
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
-    CullerFrame<T> f = v.frame();
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCoreFrame<T> f = v.frame();
     Rigid3<T> bad = v.cam_from_world;
     bad.t.x() = std::numeric_limits<T>::quiet_NaN();
     f.cam_from_world = &bad;
@@ -352,11 +296,11 @@ TYPED_TEST(CullerTest, MismatchedSizesAreNamed) {
 
 TYPED_TEST(CullerTest, DistortedCameraNeedsUndistortedKeypoints) {
   using T = TypeParam;
-  CullerOptions<T> o;
+  CullerCoreOptions<T> o;
   o.camera_has_distortion = true;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), o);
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), o);
   const WallView<T> v = wall_view<T>(0);
-  CullerFrame<T> f = v.frame();
+  CullerCoreFrame<T> f = v.frame();
   const CullerResult& r = culler.cull(f);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_NE(r.reason.find("undistorted_keypoints"), std::string::npos) << r.reason;
@@ -366,7 +310,7 @@ TYPED_TEST(CullerTest, DistortedCameraNeedsUndistortedKeypoints) {
   EXPECT_EQ(first.status, Status::MissingInput);  // no keyframe to track against yet
   EXPECT_NE(first.reason.find("first frame"), std::string::npos) << first.reason;
   const WallView<T> v1 = wall_view<T>(0.01);
-  CullerFrame<T> f1 = v1.frame();
+  CullerCoreFrame<T> f1 = v1.frame();
   f1.undistorted_keypoints = points_view(v1.keypoints);
   const CullerResult& second = culler.cull(f1);
   EXPECT_TRUE(second.ok()) << second.reason;
@@ -374,12 +318,12 @@ TYPED_TEST(CullerTest, DistortedCameraNeedsUndistortedKeypoints) {
 
 TYPED_TEST(CullerTest, Uint16DepthGivesTheSameResultAsMetres) {
   using T = TypeParam;
-  Culler<T> metres(PinholeCamera<T>::tum_fr3()), raw(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> metres(PinholeCamera<T>::tum_fr3()), raw(PinholeCamera<T>::tum_fr3());
   for (int k = 0; k < 3; ++k) {
     const WallView<T> v = wall_view<T>(0.01 * k);
     std::vector<std::uint16_t> depth(v.depth.size());  // 5000 per metre, as TUM's PNGs
     for (std::size_t i = 0; i < depth.size(); ++i) depth[i] = static_cast<std::uint16_t>(std::lround(v.depth[i] * 5000.f));
-    CullerFrame<T> f = v.frame();
+    CullerCoreFrame<T> f = v.frame();
     const CullerResult a = metres.cull(f);
     f.depth_m = DepthView<float>{};
     f.depth_raw = DepthView<std::uint16_t>{depth.data(), 640, 480, 0, 5000.f, 0.f, 1e30f};
@@ -412,8 +356,8 @@ TYPED_TEST(CullerTest, PointsViewReadsPackedAndStridedPoints) {
 // --- The frame contract under bad input -------------------------------------------------------------
 
 template <class T>
-CullerOptions<T> none_preset() {
-  CullerOptions<T> o;
+CullerCoreOptions<T> none_preset() {
+  CullerCoreOptions<T> o;
   o.pipeline = presets::none<T>();
   return o;
 }
@@ -422,7 +366,7 @@ TYPED_TEST(CullerTest, NonFiniteKeypointIsCulledAndNamedWhileTheFrameStaysUsable
   using T = TypeParam;
   for (const bool none : {false, true}) {
     SCOPED_TRACE(none ? "preset none" : "preset recommended");
-    Culler<T> culler(PinholeCamera<T>::tum_fr3(), none ? none_preset<T>() : CullerOptions<T>());
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), none ? none_preset<T>() : CullerCoreOptions<T>());
     culler.cull(wall_view<T>(0).frame());
     WallView<T> v = wall_view<T>(0.01);
     v.keypoints[5].x() = std::numeric_limits<T>::quiet_NaN();
@@ -448,12 +392,12 @@ TYPED_TEST(CullerTest, NonFiniteKeypointIsCulledAndNamedWhileTheFrameStaysUsable
 
 TYPED_TEST(CullerTest, NonFiniteUndistortedKeypointIsCulledAndNamedByItsArgument) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), none_preset<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), none_preset<T>());
   culler.cull(wall_view<T>(0).frame());
   const WallView<T> v = wall_view<T>(0.01);
   std::vector<Vec2<T>> undistorted = v.keypoints;
   undistorted[7].y() = std::numeric_limits<T>::quiet_NaN();
-  CullerFrame<T> f = v.frame();
+  CullerCoreFrame<T> f = v.frame();
   f.undistorted_keypoints = points_view(undistorted);
   const CullerResult& r = culler.cull(f);
   EXPECT_EQ(r.status, Status::MissingInput) << r.reason;
@@ -466,7 +410,7 @@ TYPED_TEST(CullerTest, NonFiniteUndistortedKeypointIsCulledAndNamedByItsArgument
 
 TYPED_TEST(CullerTest, DescriptorWidthChangeStartsANewKeyframeNamingTheDescriptors) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   culler.cull(wall_view<T>(0).frame());
   for (const std::size_t width : {std::size_t(64), std::size_t(33)}) {
     SCOPED_TRACE("rows of " + std::to_string(width) + " bytes");
@@ -474,7 +418,7 @@ TYPED_TEST(CullerTest, DescriptorWidthChangeStartsANewKeyframeNamingTheDescripto
     std::vector<std::uint8_t> wide(v.keypoints.size() * width);
     for (std::size_t i = 0; i < v.keypoints.size(); ++i)
       for (std::size_t b = 0; b < width; ++b) wide[i * width + b] = v.descriptors[i * 32 + b % 32];
-    CullerFrame<T> f = v.frame();
+    CullerCoreFrame<T> f = v.frame();
     f.descriptors = DescriptorRows(wide.data(), v.keypoints.size(), 0, width);
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::MissingInput) << r.reason;
@@ -486,7 +430,7 @@ TYPED_TEST(CullerTest, DescriptorWidthChangeStartsANewKeyframeNamingTheDescripto
     EXPECT_EQ(r.keep.size(), v.keypoints.size());
     // The next frame of the same width matches the new keyframe.
     const WallView<T> v2 = wall_view<T>(0.02);
-    CullerFrame<T> f2 = v2.frame();
+    CullerCoreFrame<T> f2 = v2.frame();
     std::vector<std::uint8_t> wide2(v2.keypoints.size() * width);
     for (std::size_t i = 0; i < v2.keypoints.size(); ++i)
       for (std::size_t b = 0; b < width; ++b) wide2[i * width + b] = v2.descriptors[i * 32 + b % 32];
@@ -499,10 +443,10 @@ TYPED_TEST(CullerTest, DescriptorWidthChangeStartsANewKeyframeNamingTheDescripto
 
 TYPED_TEST(CullerTest, DescriptorRowsWiderThanTheMatcherTakesAreRefusedWithoutPoisoningLaterFrames) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   const WallView<T> v = wall_view<T>(0);
   std::vector<std::uint8_t> wide(v.keypoints.size() * 300, 7);
-  CullerFrame<T> f = v.frame();
+  CullerCoreFrame<T> f = v.frame();
   f.descriptors = DescriptorRows(wide.data(), v.keypoints.size(), 0, 300);
   const CullerResult& r = culler.cull(f);
   EXPECT_EQ(r.status, Status::InvalidInput);
@@ -516,7 +460,7 @@ TYPED_TEST(CullerTest, DescriptorRowsWiderThanTheMatcherTakesAreRefusedWithoutPo
 
 TYPED_TEST(CullerTest, ResetForgetsTheKeyframeAndTheTracks) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3(), host_keyframes<T>());
   culler.cull(wall_view<T>(0).frame());
   culler.cull(wall_view<T>(0.01).frame());
   ASSERT_TRUE(culler.has_keyframe());
@@ -543,10 +487,10 @@ TYPED_TEST(CullerTest, PredictedPoseThatIsNotRigidIsRefusedNamingThePose) {
                                                  {"shear", shear}};
   for (const auto& b : bad) {
     SCOPED_TRACE(b.first);
-    Culler<T> culler(PinholeCamera<T>::tum_fr3());
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
     Rigid3<T> pose = v.cam_from_world;
     pose.R = b.second;
-    CullerFrame<T> f = v.frame();
+    CullerCoreFrame<T> f = v.frame();
     f.cam_from_world = &pose;
     const CullerResult& r = culler.cull(f);
     EXPECT_EQ(r.status, Status::InvalidInput) << r.reason;
@@ -554,10 +498,10 @@ TYPED_TEST(CullerTest, PredictedPoseThatIsNotRigidIsRefusedNamingThePose) {
     EXPECT_EQ(r.keep, std::vector<std::uint8_t>(v.keypoints.size(), 1));
     EXPECT_FALSE(culler.has_keyframe());
   }
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   Rigid3<T> far = v.cam_from_world;
   far.t.x() = T(1e30);
-  CullerFrame<T> f = v.frame();
+  CullerCoreFrame<T> f = v.frame();
   f.cam_from_world = &far;
   const CullerResult& r = culler.cull(f);
   EXPECT_EQ(r.status, Status::InvalidInput) << r.reason;
@@ -580,7 +524,7 @@ TYPED_TEST(CullerTest, AbsurdIntrinsicsAreRefusedNamingTheField) {
   for (const auto& c : cameras) {
     SCOPED_TRACE(c.first);
     EXPECT_FALSE(c.second.valid());
-    Culler<T> culler(c.second);
+    CullerCore<T> culler(c.second);
     EXPECT_EQ(culler.status(), Status::InvalidInput);
     EXPECT_NE(culler.reason().find(std::string(c.first) + " = "), std::string::npos) << culler.reason();
   }
@@ -590,11 +534,11 @@ TYPED_TEST(CullerTest, AbsurdIntrinsicsAreRefusedNamingTheField) {
 
 TYPED_TEST(CullerTest, FrameWithoutKeypointsLacksNoDescriptors) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   culler.cull(wall_view<T>(0).frame());
   const WallView<T> v = wall_view<T>(0.01);
   const std::vector<Vec2<T>> none;
-  CullerFrame<T> f = v.frame();
+  CullerCoreFrame<T> f = v.frame();
   f.keypoints = points_view(none);
   f.descriptors = DescriptorRows{};
   const CullerResult& r = culler.cull(f);
@@ -605,9 +549,9 @@ TYPED_TEST(CullerTest, FrameWithoutKeypointsLacksNoDescriptors) {
 
 TYPED_TEST(CullerTest, PointsViewStrideBelowOnePairIsRefused) {
   using T = TypeParam;
-  Culler<T> culler(PinholeCamera<T>::tum_fr3());
+  CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
   const WallView<T> v = wall_view<T>(0);
-  CullerFrame<T> f = v.frame();
+  CullerCoreFrame<T> f = v.frame();
   f.keypoints = PointsView::of(v.keypoints[0].data(), v.keypoints.size(), sizeof(T));
   const CullerResult& r = culler.cull(f);
   EXPECT_EQ(r.status, Status::InvalidInput);
@@ -623,7 +567,7 @@ TYPED_TEST(CullerTest, PointsViewStrideBelowOnePairIsRefused) {
 // searches it around its ray, where it is; with a wrong depth, around a projection shifted by the motion.
 TEST(CullerKeyframe, KeypointBeyondTheIntRangeGetsNoDepthFromAWrappedPixel) {
   const PinholeCamera<double> camera = PinholeCamera<double>::tum_fr3();
-  Culler<double> culler(camera, host_keyframes<double>());
+  CullerCore<double> culler(camera, host_keyframes<double>());
   const double far_u = 4294967296.0 + 512.0;
   const std::vector<double> xy = {far_u, 240.0, 100.0, 100.0, 500.0, 300.0};
   std::vector<std::uint8_t> desc(3 * 32);
@@ -631,7 +575,7 @@ TEST(CullerKeyframe, KeypointBeyondTheIntRangeGetsNoDepthFromAWrappedPixel) {
   const std::vector<float> depth(640 * 480, 2.f);
   std::vector<Detection<double>> boxes;
   Rigid3<double> pose;
-  CullerFrame<double> f;
+  CullerCoreFrame<double> f;
   f.keypoints = PointsView::of(xy.data(), 3);
   f.descriptors = DescriptorRows(desc.data(), 3, 0, 32);
   f.depth_m = DepthView<float>{depth.data(), 640, 480, 0, 1.f, 0.f, 1e30f};

@@ -1,17 +1,22 @@
-// libFuzzer target: the stateful culler through its OpenCV forms, cv_adapter::FrameCuller and
-// cv_adapter::CompiledCuller, on several frames decoded from the input: random intrinsics (absurd ones
-// too) and distortion, a random preset and keyframe thresholds; per frame random or clustered keypoints
-// with NaN / Inf / huge coordinates, descriptors of random and changing widths (sometimes of another row
-// count), depth of random type and size, random boxes, poses that are rigid, noisy, sheared, scaled,
-// reflected or beyond float's range, and undistorted copies of the right or wrong length. Checks the
-// frame contract on every frame: both forms give the same keep mask, labels, status and reason; the mask
-// is parallel to the keypoints; a refused frame keeps all, a culled one keeps exactly its Static features
-// and never a non-finite keypoint; a non-Ok status has a printable reason.
-#include "dyncull/opencv/compiled_culler.hpp"
+// libFuzzer target: the public culler (dyncull::Culler, culling/culler.hpp) through its OpenCV overload
+// (opencv/culler.hpp, cv_adapter::cull) and through its plain views, and the templated CullerCore<float>
+// it runs (core_options<float> of the same CullerOptions), on several frames decoded from the input:
+// random intrinsics (absurd ones too) and distortion, a random preset and keyframe thresholds; per frame
+// random or clustered keypoints with NaN / Inf / huge coordinates, descriptors of random and changing
+// widths (sometimes of another row count or type), depth of random type and size, random boxes, poses
+// that are rigid, noisy, sheared, scaled, reflected or beyond float's range, and undistorted copies of the
+// right or wrong length. Checks the frame contract on every frame: the OpenCV overload and the plain
+// views give the same keep mask, labels, status and reason, and so does the core whenever it can hold
+// the frame (a float pose; containers the plain views express); the mask is parallel to the keypoints; a
+// refused frame keeps all, a culled one keeps exactly its Static features and never a non-finite
+// keypoint; a non-Ok status has a printable reason.
+#include "dyncull/culling/culler.hpp"
+#include "dyncull/culling/culler_core.hpp"
 #include "dyncull/opencv/culler.hpp"
 
 #include "fuzz_input.hpp"
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
 #include <cmath>
@@ -23,23 +28,8 @@
 namespace {
 
 using namespace dyncull;
-using cv_adapter::CompiledCuller;
-using cv_adapter::DetectedBox;
-using cv_adapter::FrameCuller;
 
 const char* const kPresets[] = {"recommended", "none", "dld_slam", "rtd_slam", "zhu_2024", "dfd_slam", "zhang_2023"};
-
-PipelineOptions<float> preset_options(int k) {
-  switch (k) {
-    case 1: return presets::none<float>();
-    case 2: return presets::dld_slam<float>();
-    case 3: return presets::rtd_slam<float>();
-    case 4: return presets::zhu_2024<float>();
-    case 5: return presets::dfd_slam<float>();
-    case 6: return presets::zhang_2023<float>();
-    default: return presets::recommended<float>();
-  }
-}
 
 bool printable(const std::string& s) {
   for (char c : s)
@@ -79,36 +69,45 @@ cv::Mat random_pose(fuzz::Input& in) {
   return T;
 }
 
-void check_frame(const std::vector<cv::KeyPoint>& keys, const CullerResult& a, const CompiledCuller::Result& b,
-                 bool comparable) {
+/// The frame contract on the OpenCV overload's result `a`, and `b` (another form's) equal to it.
+void check_frame(const std::vector<cv::KeyPoint>& keys, const CullerResult& a, const CullerResult* b) {
   const std::size_t n = keys.size();
-  DYNCULL_FUZZ_CHECK(b.keep.size() == n && b.labels.size() == n && b.reasons.size() == n && b.track_ids.size() == n);
-  DYNCULL_FUZZ_CHECK(b.status == CompiledCuller::Status::Ok || !b.reason.empty());
-  DYNCULL_FUZZ_CHECK(printable(b.reason));
-  if (!comparable) {
-    for (std::uint8_t k : b.keep) DYNCULL_FUZZ_CHECK(k == 1);
-    return;
+  DYNCULL_FUZZ_CHECK(a.keep.size() == n && a.labels.size() == n && a.reasons.size() == n && a.track_ids.size() == n);
+  DYNCULL_FUZZ_CHECK(a.status == Status::Ok || !a.reason.empty());
+  DYNCULL_FUZZ_CHECK(printable(a.reason));
+  if (b) {
+    DYNCULL_FUZZ_CHECK(a.status == b->status);
+    DYNCULL_FUZZ_CHECK(a.reason == b->reason);
+    DYNCULL_FUZZ_CHECK(a.keep == b->keep && a.refused == b->refused);
+    DYNCULL_FUZZ_CHECK(a.labels == b->labels && a.reasons == b->reasons);
+    DYNCULL_FUZZ_CHECK(a.track_ids == b->track_ids);
+    DYNCULL_FUZZ_CHECK(a.frames_since_keyframe == b->frames_since_keyframe && a.keyframe == b->keyframe);
+    DYNCULL_FUZZ_CHECK(a.matched == b->matched && a.num_kept == b->num_kept);
   }
-  DYNCULL_FUZZ_CHECK(static_cast<int>(a.status) == static_cast<int>(b.status));
-  DYNCULL_FUZZ_CHECK(a.reason == b.reason);
-  DYNCULL_FUZZ_CHECK(a.keep == b.keep && a.refused == b.refused);
-  DYNCULL_FUZZ_CHECK(a.track_ids == b.track_ids);
-  DYNCULL_FUZZ_CHECK(a.frames_since_keyframe == b.frames_since_keyframe && a.keyframe == b.keyframe);
-  DYNCULL_FUZZ_CHECK(a.labels.size() == n);
   std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    DYNCULL_FUZZ_CHECK(static_cast<int>(a.labels[i]) == static_cast<int>(b.labels[i]));
-    DYNCULL_FUZZ_CHECK(static_cast<int>(a.reasons[i]) == static_cast<int>(b.reasons[i]));
     kept += a.keep[i];
     if (a.refused) {
       DYNCULL_FUZZ_CHECK(a.keep[i] == 1);
       continue;
     }
-    if (a.keep.empty()) continue;
     DYNCULL_FUZZ_CHECK(a.keep[i] == (a.labels[i] == FeatureLabel::Static ? 1 : 0));
     if (!std::isfinite(keys[i].pt.x) || !std::isfinite(keys[i].pt.y)) DYNCULL_FUZZ_CHECK(a.keep[i] == 0);
   }
-  DYNCULL_FUZZ_CHECK(a.num_kept == kept && b.num_kept == kept);
+  DYNCULL_FUZZ_CHECK(a.num_kept == kept);
+}
+
+/// The keypoints through the lens model as Culler undistorts them when the host gives no copy
+/// (src/culling/culler.cpp): cv::undistortPoints in float, a non-finite keypoint left as it is.
+std::vector<cv::Point2f> undistort_as_the_culler(const std::vector<cv::KeyPoint>& keys, const CullerCamera& c) {
+  std::vector<cv::Point2f> in(keys.size()), out;
+  for (std::size_t i = 0; i < keys.size(); ++i) in[i] = keys[i].pt;
+  if (in.empty()) return in;
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
+  cv::undistortPoints(in, out, K, cv::Mat(c.distortion, true), cv::noArray(), K);
+  for (std::size_t i = 0; i < in.size(); ++i)
+    if (!std::isfinite(in[i].x) || !std::isfinite(in[i].y)) out[i] = in[i];
+  return out;
 }
 
 }  // namespace
@@ -120,22 +119,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   cv::Mat distortion;
   if (in.u8() % 4 == 0) distortion = (cv::Mat_<double>(1, 5) << in.value(-0.3, 0.3), in.value(-0.3, 0.3), 0, 0, 0);
   const int preset = in.range(0, 7);  // 7: a name no preset has, with bytes a terminal would act on
-  CompiledCuller::Options co;
-  co.preset = preset < 7 ? kPresets[preset] : std::string("\x1b[2J\0x", 6) + std::string(in.range(0, 3000), 'p');
-  co.depth_units_per_metre = in.flag() ? 5000.f : static_cast<float>(in.value(-1, 1e4));
-  co.keyframe_max_translation_m = in.flag() ? 0.1 : in.value(-1, 1);
-  co.keyframe_max_rotation_deg = in.flag() ? 15.0 : in.value(-1, 200);
-  co.keyframe_min_matched_ratio = in.flag() ? 0.3 : in.value(-0.5, 1.5);
-  CullerOptions<float> fo;
-  fo.pipeline = preset_options(preset);
-  fo.keyframe_max_translation_m = co.keyframe_max_translation_m;
-  fo.keyframe_max_rotation_deg = co.keyframe_max_rotation_deg;
-  fo.keyframe_min_matched_ratio = co.keyframe_min_matched_ratio;
-  const bool comparable = preset < 7;  // a known preset: both forms run the same options
-  FrameCuller frame_culler(K, cv::Size(W, H), distortion, fo, co.depth_units_per_metre);
-  CompiledCuller compiled(K, cv::Size(W, H), distortion, co);
-  if (comparable) DYNCULL_FUZZ_CHECK(frame_culler.ok() == compiled.ok() && frame_culler.reason() == compiled.reason());
-  DYNCULL_FUZZ_CHECK(compiled.ok() || printable(compiled.reason()));
+  CullerOptions co(preset < 7 ? kPresets[preset] : std::string("\x1b[2J\0x", 6) + std::string(in.range(0, 3000), 'p'));
+  co.depth_units_per_metre = in.flag() ? 5000.0 : in.value(-1, 1e4);
+  if (!in.flag()) co.keyframe_max_translation_m = in.value(-1, 1);
+  if (!in.flag()) co.keyframe_max_rotation_deg = in.value(-1, 200);
+  if (!in.flag()) co.keyframe_min_matched_ratio = in.value(-0.5, 1.5);
+  const CullerCamera camera = cv_adapter::culler_camera(K, cv::Size(W, H), distortion);
+  Culler by_cv(camera, co), by_views(camera, co);
+  DYNCULL_FUZZ_CHECK(by_cv.status() == by_views.status() && by_cv.reason() == by_views.reason());
+  DYNCULL_FUZZ_CHECK(by_cv.ok() || printable(by_cv.reason()));
+  // The core the public culler runs: compared only when the public one is ok (it then must be too; a bad
+  // setting the core does not have, e.g. depth_units_per_metre, leaves it nothing to compare).
+  CullerCoreOptions<float> core_opts = core_options<float>(co);
+  core_opts.camera_has_distortion = camera.has_distortion();
+  const PinholeCamera<float> pinhole{static_cast<float>(camera.fx), static_cast<float>(camera.fy),
+                                     static_cast<float>(camera.cx), static_cast<float>(camera.cy), camera.width,
+                                     camera.height};
+  CullerCore<float> core(pinhole, core_opts);
+  bool core_in_step = by_cv.ok();
+  if (core_in_step) DYNCULL_FUZZ_CHECK(core.status() == Status::Ok);
 
   std::vector<cv::KeyPoint> keys, undistorted;
   std::vector<Detection<float>> boxes;
@@ -205,12 +207,93 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     const cv::Mat* Tcw = has_pose ? &pose : nullptr;
     if (in.u8() == 0) {
-      frame_culler.reset();
-      compiled.reset();
+      by_cv.reset();
+      by_views.reset();
+      core.reset();
     }
-    frame_culler.cull(keys, descriptors, depth, boxes, Tcw, und);
-    compiled.cull(keys, descriptors, depth, dboxes, Tcw, und);
-    check_frame(keys, frame_culler.result(), compiled.result(), comparable);
+    const CullerResult& a = cv_adapter::cull(by_cv, keys, descriptors, depth, dboxes, Tcw, und);
+
+    // What the OpenCV overload refuses before the culler sees the frame: containers the plain views
+    // cannot express. A refusal leaves the culler's state as it was, so the other forms skip the frame.
+    const bool bad_descriptors = !descriptors.empty() && descriptors.type() != CV_8UC1;
+    const bool bad_depth = !depth.empty() && depth.type() != CV_32FC1 && depth.type() != CV_16UC1;
+    const bool bad_last_row = has_pose && !(pose.at<double>(3, 0) == 0.0 && pose.at<double>(3, 1) == 0.0 &&
+                                            pose.at<double>(3, 2) == 0.0 && pose.at<double>(3, 3) == 1.0);
+    if (by_cv.ok() && (bad_descriptors || bad_depth || bad_last_row)) {
+      DYNCULL_FUZZ_CHECK(a.refused && a.status == Status::InvalidInput);
+      check_frame(keys, a, nullptr);
+      continue;
+    }
+
+    CullerFrame pf;
+    pf.keypoints = points_view(keys);
+    if (und) pf.undistorted_keypoints = points_view(*und);
+    if (!descriptors.empty())
+      pf.descriptors = DescriptorRows(descriptors.ptr<std::uint8_t>(0), static_cast<std::size_t>(descriptors.rows),
+                                      descriptors.step[0], static_cast<std::size_t>(descriptors.cols));
+    if (depth.type() == CV_32FC1 && !depth.empty()) {
+      pf.depth_m.data = depth.ptr<float>(0);
+      pf.depth_m.width = depth.cols;
+      pf.depth_m.height = depth.rows;
+      pf.depth_m.stride = static_cast<std::ptrdiff_t>(depth.step[0] / sizeof(float));
+    } else if (!depth.empty()) {
+      pf.depth_raw.data = depth.ptr<std::uint16_t>(0);
+      pf.depth_raw.width = depth.cols;
+      pf.depth_raw.height = depth.rows;
+      pf.depth_raw.stride = static_cast<std::ptrdiff_t>(depth.step[0] / sizeof(std::uint16_t));
+      pf.depth_raw.units_per_metre = static_cast<float>(co.depth_units_per_metre);
+    }
+    pf.detections = &dboxes;
+    double Rt[12];
+    if (has_pose) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) Rt[4 * r + c] = pose.at<double>(r, c);
+      pf.cam_from_world = Rt;
+    }
+    const CullerResult& b = by_views.cull(pf);
+    check_frame(keys, a, &b);
+    if (!core_in_step) continue;
+
+    // The core: the same views, the boxes as Detection<float>, the pose in float, the keypoints
+    // undistorted here when the public culler undistorts them itself.
+    CullerCoreFrame<float> cf;
+    cf.keypoints = pf.keypoints;
+    cf.undistorted_keypoints = pf.undistorted_keypoints;
+    cf.descriptors = pf.descriptors;
+    cf.depth_m = pf.depth_m;
+    cf.depth_raw = pf.depth_raw;
+    cf.detections = &boxes;
+    std::vector<cv::Point2f> own_undistorted;
+    if (!und && camera.has_distortion()) {
+      own_undistorted = undistort_as_the_culler(keys, camera);
+      cf.undistorted_keypoints = points_view(own_undistorted);
+    }
+    Rigid3<float> pose_f;
+    if (has_pose) {
+      double R[9], t[3];
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) R[3 * r + c] = Rt[4 * r + c];
+        t[r] = Rt[4 * r + 3];
+      }
+      std::string why;
+      // A pose the public culler refuses in double is not given to the core (a float may not hold it).
+      if (culler_checks::check_pose(R, t, "cam_from_world", &why) != Status::Ok) {
+        DYNCULL_FUZZ_CHECK(a.refused);
+        continue;
+      }
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) pose_f.R(r, c) = static_cast<float>(R[3 * r + c]);
+        pose_f.t(r) = static_cast<float>(t[r]);
+      }
+      // Rounded to float, a rotation at the edge of the tolerance may fail the core's check: from there
+      // on the core is no longer in step with the public culler.
+      if (culler_checks::check_pose(pose_f, "cam_from_world", &why) != Status::Ok) {
+        core_in_step = false;
+        continue;
+      }
+      cf.cam_from_world = &pose_f;
+    }
+    check_frame(keys, a, &core.cull(cf));
   }
   return 0;
 }

@@ -1,13 +1,16 @@
-// Tests of opencv/compiled_culler.hpp (library dyncull::culler): on the synthetic walking scene its
-// cv::KeyPoint, cv::Point2f and float-pair overloads give exactly the header-only FrameCuller's keep mask,
-// labels, reasons, track ids and status; bad calibration, options and inputs are refused with the input
-// named; compact() shrinks the descriptors with the parallel vectors; after warm-up a frame costs no heap
-// allocation beyond the header-only culler's. The C++11 / C++14 host compile is checked by
+// Tests of the compiled public culler (dyncull::Culler of culling/culler.hpp, library dyncull::culler) and
+// its OpenCV overloads (opencv/culler.hpp): on the synthetic walking scene, cv_adapter::cull with
+// cv::KeyPoint and with cv::Point2f keypoints and the plain views (float pairs with a stride) give exactly
+// the keep mask, labels, reasons, track ids and status of the templated CullerCore<float> it runs, set up
+// with core_options<float>(CullerOptions("recommended")); bad calibration, options and inputs are refused
+// with the input named; cv_adapter::compact() shrinks the descriptors with the parallel vectors; after
+// warm-up a frame costs no heap allocation beyond the core's. The C++11 / C++14 host compile is checked by
 // compiled_culler_host.cpp (built twice, -Werror).
-#include "dyncull/opencv/compiled_culler.hpp"
+#include "dyncull/culling/culler.hpp"
 
 #include "support/counting_allocator.hpp"
 
+#include "dyncull/culling/culler_core.hpp"
 #include "dyncull/opencv/culler.hpp"
 #include "dyncull/sim/families.hpp"
 #include "dyncull/sim/scene.hpp"
@@ -19,6 +22,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <utility>
@@ -27,10 +31,6 @@
 namespace dyncull {
 namespace {
 
-using cv_adapter::CompiledCuller;
-using cv_adapter::DetectedBox;
-using cv_adapter::FrameCuller;
-
 std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
   std::vector<DetectedBox> out;
   for (const Detection<float>& d : detections)
@@ -38,18 +38,29 @@ std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detection
   return out;
 }
 
-/// The compiled result equals the header-only one, element by element.
-void expect_same(const CullerResult& expected, const CompiledCuller::Result& got, int step, const char* overload) {
-  SCOPED_TRACE(std::string(overload) + " overload, step " + std::to_string(step));
-  EXPECT_EQ(static_cast<int>(got.status), static_cast<int>(expected.status));
+DescriptorRows rows_of(const cv::Mat& d) {
+  return DescriptorRows(d.ptr<std::uint8_t>(0), static_cast<std::size_t>(d.rows), d.step[0],
+                        static_cast<std::size_t>(d.cols));
+}
+
+DepthView<float> depth_of(const cv::Mat& d) {
+  DepthView<float> v;
+  v.data = d.ptr<float>(0);
+  v.width = d.cols;
+  v.height = d.rows;
+  v.stride = static_cast<std::ptrdiff_t>(d.step[0] / sizeof(float));
+  return v;
+}
+
+/// The public culler's result equals the core's, element by element.
+void expect_same(const CullerResult& expected, const CullerResult& got, int step, const char* form) {
+  SCOPED_TRACE(std::string(form) + ", step " + std::to_string(step));
+  EXPECT_EQ(got.status, expected.status);
   EXPECT_EQ(got.reason, expected.reason);
+  EXPECT_EQ(got.refused, expected.refused);
   EXPECT_EQ(got.keep, expected.keep);
-  ASSERT_EQ(got.labels.size(), expected.labels.size());
-  ASSERT_EQ(got.reasons.size(), expected.reasons.size());
-  for (std::size_t i = 0; i < got.labels.size(); ++i) {
-    EXPECT_EQ(static_cast<int>(got.labels[i]), static_cast<int>(expected.labels[i])) << "feature " << i;
-    EXPECT_EQ(static_cast<int>(got.reasons[i]), static_cast<int>(expected.reasons[i])) << "feature " << i;
-  }
+  EXPECT_EQ(got.labels, expected.labels);
+  EXPECT_EQ(got.reasons, expected.reasons);
   EXPECT_EQ(got.track_ids, expected.track_ids);
   EXPECT_EQ(got.num_kept, expected.num_kept);
   EXPECT_EQ(got.matched, expected.matched);
@@ -57,7 +68,7 @@ void expect_same(const CullerResult& expected, const CompiledCuller::Result& got
   EXPECT_EQ(got.keyframe, expected.keyframe);
 }
 
-TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypointTypeWithoutExtraAllocations) {
+TEST(CompiledCuller, GivesTheCoresLabelsOnTheWalkingSceneForEveryKeypointTypeWithoutExtraAllocations) {
   sim::SceneFamily family;
   ASSERT_TRUE(sim::find_scene_family("walking", &family));
   sim::SceneOptions scene_options = family.options;
@@ -67,16 +78,17 @@ TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypoint
   cv::Mat K;
   cv::eigen2cv(scene.camera().K(), K);
   const cv::Size size(scene_options.width, scene_options.height);
-  FrameCuller header_only(K, size);
-  CompiledCuller with_keypoints(K, size), with_points(K, size), with_floats(K, size);
-  ASSERT_TRUE(header_only.ok()) << header_only.reason();
+  const CullerCamera camera = cv_adapter::culler_camera(K, size);
+  const CullerOptions options("recommended");
+  CullerCore<float> core(scene.camera().cast<float>(), core_options<float>(options));
+  Culler with_keypoints(camera, options), with_points(camera, options), with_views(camera, options);
+  ASSERT_EQ(core.status(), Status::Ok) << core.reason();
   ASSERT_TRUE(with_keypoints.ok()) << with_keypoints.reason();
   const cv::Ptr<cv::ORB> orb = cv::ORB::create(1000);
   std::size_t dynamic = 0, keyframes = 0;
-  // Heap allocations of each call summed over the second pass through the frames: the header-only
-  // culler's, and the compiled overloads' beyond them (their result copies and point buffers reuse the
-  // capacity the first pass grew them to).
-  std::size_t header_only_allocations = 0, extra_keypoints = 0, extra_points = 0, extra_floats = 0;
+  // Heap allocations of each call summed over the second pass through the frames: the core's, and the
+  // public forms' beyond them (their box and pose conversions reuse the capacity the first pass grew).
+  std::size_t core_allocations = 0, extra_keypoints = 0, extra_points = 0, extra_views = 0;
   sim::FrameData frame;
   for (int step = 0; step < 2 * scene_options.num_frames; ++step) {
     const int i = step % scene_options.num_frames;
@@ -87,47 +99,63 @@ TEST(CompiledCuller, GivesTheFrameCullersLabelsOnTheWalkingSceneForEveryKeypoint
     std::vector<cv::KeyPoint> keys;
     cv::Mat descriptors;
     orb->detectAndCompute(gray, cv::noArray(), keys, descriptors);
+    const Rigid3<double> pose = frame.world_from_cam.inverse();
     cv::Mat Tcw;
-    cv::eigen2cv(frame.world_from_cam.inverse().matrix(), Tcw);
+    cv::eigen2cv(pose.matrix(), Tcw);
+    const Rigid3<float> pose_f = pose.cast<float>();
+    double Rt[12];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) Rt[4 * r + c] = Tcw.at<double>(r, c);
     const std::vector<DetectedBox> boxes = boxes_of(frame.detections);
     std::vector<cv::Point2f> points;
     cv::KeyPoint::convert(keys, points);
+    CullerCoreFrame<float> cf;
+    cf.keypoints = points_view(keys);
+    if (!descriptors.empty()) cf.descriptors = rows_of(descriptors);
+    cf.depth_m = depth_of(depth);
+    cf.detections = &frame.detections;
+    cf.cam_from_world = &pose_f;
+    CullerFrame pf;  // float pairs with the stride of cv::Point2f, as a host's own point array
+    pf.keypoints = PointsView::of(points.empty() ? nullptr : &points[0].x, points.size(), sizeof(cv::Point2f));
+    pf.descriptors = cf.descriptors;
+    pf.depth_m = cf.depth_m;
+    pf.detections = &boxes;
+    pf.cam_from_world = Rt;
 
     std::size_t before = test::allocations();
-    header_only.cull(keys, descriptors, depth, frame.detections, &Tcw);
+    core.cull(cf);
     const std::size_t reference = test::allocations() - before;
     before = test::allocations();
-    with_keypoints.cull(keys, descriptors, depth, boxes, &Tcw);
+    cv_adapter::cull(with_keypoints, keys, descriptors, depth, boxes, &Tcw);
     const std::size_t by_keypoints = test::allocations() - before;
     before = test::allocations();
-    with_points.cull(points, descriptors, depth, boxes, &Tcw);
+    cv_adapter::cull(with_points, points, descriptors, depth, boxes, &Tcw);
     const std::size_t by_points = test::allocations() - before;
     before = test::allocations();
-    with_floats.cull(points.empty() ? nullptr : &points[0].x, points.size(), sizeof(cv::Point2f), descriptors, depth,
-                     boxes, &Tcw);
-    const std::size_t by_floats = test::allocations() - before;
+    with_views.cull(pf);
+    const std::size_t by_views = test::allocations() - before;
     if (second_pass) {
-      header_only_allocations += reference;
+      core_allocations += reference;
       extra_keypoints += by_keypoints > reference ? by_keypoints - reference : 0;
       extra_points += by_points > reference ? by_points - reference : 0;
-      extra_floats += by_floats > reference ? by_floats - reference : 0;
+      extra_views += by_views > reference ? by_views - reference : 0;
     }
-    const CullerResult& expected = header_only.result();
-    expect_same(expected, with_keypoints.result(), step, "cv::KeyPoint");
-    expect_same(expected, with_points.result(), step, "cv::Point2f");
-    expect_same(expected, with_floats.result(), step, "float pairs");
+    const CullerResult& expected = core.result();
+    expect_same(expected, with_keypoints.result(), step, "OpenCV overload, cv::KeyPoint");
+    expect_same(expected, with_points.result(), step, "OpenCV overload, cv::Point2f");
+    expect_same(expected, with_views.result(), step, "plain views, float pairs");
     for (FeatureLabel l : expected.labels) dynamic += l == FeatureLabel::Dynamic;
     keyframes += expected.keyframe;
   }
   // The comparison means something only when the scene made the culler cull and change keyframes.
   EXPECT_GT(dynamic, 100u);
   EXPECT_GT(keyframes, 1u);
-  std::printf("allocations in the second pass: header-only %zu; beyond it: cv::KeyPoint %zu, cv::Point2f %zu, "
-              "floats %zu\n",
-              header_only_allocations, extra_keypoints, extra_points, extra_floats);
+  std::printf("allocations in the second pass: CullerCore<float> %zu; beyond it: cv::KeyPoint %zu, cv::Point2f %zu, "
+              "plain views %zu\n",
+              core_allocations, extra_keypoints, extra_points, extra_views);
   EXPECT_EQ(extra_keypoints, 0u);
   EXPECT_EQ(extra_points, 0u);
-  EXPECT_EQ(extra_floats, 0u);
+  EXPECT_EQ(extra_views, 0u);
 }
 
 struct BadInputFixture {
@@ -140,14 +168,17 @@ struct BadInputFixture {
   BadInputFixture() {
     for (std::size_t i = 0; i < keys.size(); ++i) keys[i].pt = cv::Point2f(20.f + 10.f * float(i), 100.f);
   }
+  CullerCamera camera() const { return cv_adapter::culler_camera(K, cv::Size(640, 480)); }
 };
 
 TEST(CompiledCuller, MismatchedDescriptorRowsAreRefusedNamingTheDescriptors) {
   BadInputFixture in;
-  CompiledCuller culler(in.K, cv::Size(640, 480));
+  Culler culler(in.camera());
   ASSERT_TRUE(culler.ok()) << culler.reason();
-  const std::vector<std::uint8_t>& keep = culler.cull(in.keys, in.descriptors.rowRange(0, 39), in.depth, in.boxes, &in.Tcw);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::InvalidInput);
+  const std::vector<std::uint8_t>& keep =
+      cv_adapter::cull(culler, in.keys, in.descriptors.rowRange(0, 39), in.depth, in.boxes, &in.Tcw).keep;
+  EXPECT_EQ(culler.result().status, Status::InvalidInput);
+  EXPECT_TRUE(culler.result().refused);
   EXPECT_NE(culler.result().reason.find("descriptors has 39 rows for 40 keypoints"), std::string::npos)
       << culler.result().reason;
   EXPECT_EQ(keep, std::vector<std::uint8_t>(40, 1));
@@ -156,47 +187,47 @@ TEST(CompiledCuller, MismatchedDescriptorRowsAreRefusedNamingTheDescriptors) {
 
 TEST(CompiledCuller, EmptyOrBadCalibrationIsNamedAndEveryCullKeepsAll) {
   BadInputFixture in;
-  CompiledCuller empty_K(cv::Mat(), cv::Size(640, 480));
+  // An empty K gives a camera without intrinsics: refused, naming the camera.
+  Culler empty_K(cv_adapter::culler_camera(cv::Mat(), cv::Size(640, 480)));
   EXPECT_FALSE(empty_K.ok());
-  EXPECT_EQ(empty_K.status(), CompiledCuller::Status::InvalidInput);
-  EXPECT_NE(empty_K.reason().find("K must be a 3x3"), std::string::npos) << empty_K.reason();
-  EXPECT_EQ(empty_K.cull(in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw), std::vector<std::uint8_t>(40, 1));
-  EXPECT_EQ(empty_K.result().status, CompiledCuller::Status::InvalidInput);
+  EXPECT_EQ(empty_K.status(), Status::InvalidInput);
+  EXPECT_NE(empty_K.reason().find("camera: focal lengths"), std::string::npos) << empty_K.reason();
+  EXPECT_EQ(cv_adapter::cull(empty_K, in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw).keep,
+            std::vector<std::uint8_t>(40, 1));
+  EXPECT_EQ(empty_K.result().status, Status::InvalidInput);
   EXPECT_EQ(empty_K.result().reason, empty_K.reason());
 
-  CompiledCuller no_size(in.K, cv::Size(0, 480));
-  EXPECT_NE(no_size.reason().find("image_size"), std::string::npos) << no_size.reason();
+  Culler no_size(cv_adapter::culler_camera(in.K, cv::Size(0, 480)));
+  EXPECT_NE(no_size.reason().find("image size"), std::string::npos) << no_size.reason();
 
-  CompiledCuller::Options options;
-  options.preset = "fastest";
-  CompiledCuller unknown_preset(in.K, cv::Size(640, 480), cv::Mat(), options);
-  EXPECT_EQ(unknown_preset.status(), CompiledCuller::Status::InvalidInput);
+  Culler unknown_preset(in.camera(), CullerOptions("fastest"));
+  EXPECT_EQ(unknown_preset.status(), Status::InvalidInput);
   EXPECT_NE(unknown_preset.reason().find("preset 'fastest'"), std::string::npos) << unknown_preset.reason();
 
-  CompiledCuller::Options bad_threshold;
+  CullerOptions bad_threshold;
   bad_threshold.keyframe_max_rotation_deg = -1;
-  CompiledCuller negative(in.K, cv::Size(640, 480), cv::Mat(), bad_threshold);
+  Culler negative(in.camera(), bad_threshold);
   EXPECT_NE(negative.reason().find("keyframe_max_rotation_deg"), std::string::npos) << negative.reason();
 
-  CompiledCuller::Options bad_scale;
-  bad_scale.depth_units_per_metre = 0.f;
-  CompiledCuller zero_scale(in.K, cv::Size(640, 480), cv::Mat(), bad_scale);
+  CullerOptions bad_scale;
+  bad_scale.depth_units_per_metre = 0;
+  Culler zero_scale(in.camera(), bad_scale);
   EXPECT_NE(zero_scale.reason().find("depth_units_per_metre"), std::string::npos) << zero_scale.reason();
   // A scale the depth view refuses is refused at construction, not on every frame.
-  bad_scale.depth_units_per_metre = 2e6f;
-  CompiledCuller huge_scale(in.K, cv::Size(640, 480), cv::Mat(), bad_scale);
+  bad_scale.depth_units_per_metre = 2e6;
+  Culler huge_scale(in.camera(), bad_scale);
   EXPECT_NE(huge_scale.reason().find("depth_units_per_metre"), std::string::npos) << huge_scale.reason();
 }
 
 TEST(CompiledCuller, NonFiniteKeypointIsCulledNamingItsIndexOnEveryOverload) {
   BadInputFixture in;
-  CompiledCuller culler(in.K, cv::Size(640, 480));
+  Culler culler(in.camera());
   in.keys[3].pt.y = std::numeric_limits<float>::quiet_NaN();
-  const std::vector<std::uint8_t>& keep = culler.cull(in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw);
+  const std::vector<std::uint8_t>& keep = cv_adapter::cull(culler, in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw).keep;
   ASSERT_EQ(keep.size(), 40u);
   EXPECT_EQ(keep[3], 0);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::MissingInput);
-  EXPECT_EQ(culler.result().reasons[3], CompiledCuller::Reason::InvalidInput);
+  EXPECT_EQ(culler.result().status, Status::MissingInput);
+  EXPECT_EQ(culler.result().reasons[3], CullReason::InvalidInput);
   EXPECT_NE(culler.result().reason.find("keypoints[3] has a NaN or Inf coordinate: culled"), std::string::npos)
       << culler.result().reason;
 
@@ -204,34 +235,52 @@ TEST(CompiledCuller, NonFiniteKeypointIsCulledNamingItsIndexOnEveryOverload) {
   cv::KeyPoint::convert(in.keys, points);
   points[3].y = 100.f;
   points[7].x = std::numeric_limits<float>::infinity();
-  culler.cull(points, in.descriptors, in.depth, in.boxes, &in.Tcw);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::MissingInput);
+  cv_adapter::cull(culler, points, in.descriptors, in.depth, in.boxes, &in.Tcw);
+  EXPECT_EQ(culler.result().status, Status::MissingInput);
   EXPECT_NE(culler.result().reason.find("keypoints[7]"), std::string::npos) << culler.result().reason;
   EXPECT_EQ(culler.result().keep[7], 0);
   EXPECT_EQ(culler.result().keep[3], 1);
 
-  culler.cull(&points[0].x, points.size(), 0, in.descriptors, in.depth, in.boxes, &in.Tcw);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::MissingInput);
+  // The plain views: packed float pairs, a null pointer with a count, a stride shorter than a pair.
+  CullerFrame f;
+  f.descriptors = rows_of(in.descriptors);
+  f.depth_m = depth_of(in.depth);
+  f.detections = &in.boxes;
+  double Rt[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  f.cam_from_world = Rt;
+  f.keypoints = PointsView::of(&points[0].x, points.size());
+  culler.cull(f);
+  EXPECT_EQ(culler.result().status, Status::MissingInput);
   EXPECT_NE(culler.result().reason.find("keypoints[7]"), std::string::npos) << culler.result().reason;
 
-  culler.cull(nullptr, 5, 0, cv::Mat(), in.depth, in.boxes, &in.Tcw);
-  EXPECT_EQ(culler.result().status, CompiledCuller::Status::InvalidInput);
+  CullerFrame null_points = f;
+  null_points.keypoints = PointsView::of(static_cast<const float*>(nullptr), 5);
+  null_points.descriptors = DescriptorRows();
+  culler.cull(null_points);
+  EXPECT_EQ(culler.result().status, Status::InvalidInput);
   EXPECT_NE(culler.result().reason.find("keypoints: null data with a count of 5"), std::string::npos)
       << culler.result().reason;
   EXPECT_EQ(culler.result().keep, std::vector<std::uint8_t>(5, 1));
 
-  culler.cull(&points[0].x, points.size(), 4, in.descriptors, in.depth, in.boxes, &in.Tcw);
+  f.keypoints = PointsView::of(&points[0].x, points.size(), 4);
+  culler.cull(f);
   EXPECT_NE(culler.result().reason.find("stride_bytes 4"), std::string::npos) << culler.result().reason;
 }
 
 TEST(CompiledCuller, MovedFromCullerRefusesInsteadOfCrashing) {
   BadInputFixture in;
-  CompiledCuller a(in.K, cv::Size(640, 480));
-  CompiledCuller b(std::move(a));
+  Culler a(in.camera());
+  Culler b(std::move(a));
   EXPECT_TRUE(b.ok());
   EXPECT_FALSE(a.ok());  // NOLINT(bugprone-use-after-move): the moved-from state is what is tested
   EXPECT_NE(a.reason().find("moved from"), std::string::npos);
-  EXPECT_EQ(a.cull(in.keys, in.descriptors, in.depth, in.boxes), std::vector<std::uint8_t>(40, 1));
+  EXPECT_EQ(cv_adapter::cull(a, in.keys, in.descriptors, in.depth, in.boxes).keep, std::vector<std::uint8_t>(40, 1));
+  // Move assignment hands the culler on as well.
+  Culler c(CullerCamera{});
+  EXPECT_FALSE(c.ok());
+  c = std::move(b);
+  EXPECT_TRUE(c.ok()) << c.reason();
+  EXPECT_FALSE(cv_adapter::cull(c, in.keys, in.descriptors, in.depth, in.boxes, &in.Tcw).refused);
 }
 
 TEST(CompiledCuller, CompactShrinksDescriptorsWithEveryParallelVector) {
@@ -241,7 +290,7 @@ TEST(CompiledCuller, CompactShrinksDescriptorsWithEveryParallelVector) {
   std::vector<cv::KeyPoint> keys(5);
   std::vector<float> depths = {0.f, 1.f, 2.f, 3.f, 4.f};
   for (int i = 0; i < 5; ++i) keys[static_cast<std::size_t>(i)].pt = cv::Point2f(float(i), 0.f);
-  EXPECT_EQ(CompiledCuller::compact(keep, descriptors, keys, depths), 3);
+  EXPECT_EQ(cv_adapter::compact(keep, descriptors, keys, depths), 3);
   EXPECT_EQ(descriptors.rows, 3);
   EXPECT_EQ(descriptors.at<std::uint8_t>(1, 31), 2);
   EXPECT_EQ(descriptors.at<std::uint8_t>(2, 0), 4);
@@ -250,21 +299,25 @@ TEST(CompiledCuller, CompactShrinksDescriptorsWithEveryParallelVector) {
   EXPECT_EQ(depths, (std::vector<float>{0.f, 2.f, 4.f}));
 
   std::vector<float> short_vector(2);
-  EXPECT_EQ(CompiledCuller::compact(std::vector<std::uint8_t>(3, 0), descriptors, keys, short_vector), -1);
+  EXPECT_EQ(cv_adapter::compact(std::vector<std::uint8_t>(3, 0), descriptors, keys, short_vector), -1);
   EXPECT_EQ(descriptors.rows, 3);  // untouched
   EXPECT_EQ(keys.size(), 3u);
+  // A matrix of another row count is refused the same way.
+  cv::Mat two_rows(2, 32, CV_8UC1, cv::Scalar(1));
+  EXPECT_EQ(cv_adapter::compact(std::vector<std::uint8_t>(3, 1), two_rows, keys), -1);
+  EXPECT_EQ(two_rows.rows, 2);
 }
 
 TEST(CompiledCuller, DetectedBoxFromARectSpansItsWidthAndHeight) {
-  const DetectedBox b(cv::Rect2f(10.f, 20.f, 30.f, 40.f), 0, 0.9f);
+  const DetectedBox b = cv_adapter::detected_box(cv::Rect2f(10.f, 20.f, 30.f, 40.f), 0, 0.9f);
   EXPECT_EQ(b.x0, 10.f);
   EXPECT_EQ(b.y0, 20.f);
   EXPECT_EQ(b.x1, 40.f);
   EXPECT_EQ(b.y1, 60.f);
   EXPECT_EQ(b.class_id, 0);
   EXPECT_EQ(b.confidence, 0.9f);
-  EXPECT_STREQ(CompiledCuller::to_string(CompiledCuller::Status::MissingInput), "missing input");
-  EXPECT_STREQ(CompiledCuller::to_string(CompiledCuller::Label::Dynamic), "dynamic");
+  EXPECT_STREQ(to_string(Status::MissingInput), "missing input");
+  EXPECT_STREQ(to_string(FeatureLabel::Dynamic), "dynamic");
 }
 
 }  // namespace

@@ -1,10 +1,13 @@
-// One frame contract for the three culler forms: Culler<float> (plain views), cv_adapter::FrameCuller
-// (OpenCV containers, header-only) and cv_adapter::CompiledCuller (dyncull::culler) get the same frames,
-// good and bad (NaN / Inf keypoints, descriptor width changes, bad poses, absurd intrinsics, empty frames,
-// mismatched sizes, bad strides), and give the same keep mask, labels, reasons, status and reason. Also the
-// OpenCV forms' own findings: a CV_64F pose beyond float's range, a moved-from CompiledCuller, a quoted
-// preset name, and a refused frame that keeps frames_since_keyframe.
-#include "dyncull/opencv/compiled_culler.hpp"
+// One frame contract for the culler's forms: the public dyncull::Culler (culling/culler.hpp, compiled into
+// dyncull::culler) through its plain views and through its OpenCV overload (opencv/culler.hpp,
+// cv_adapter::cull), and the templated CullerCore<float> it runs, set up with
+// core_options<float>(CullerOptions()), get the same frames, good and bad (NaN / Inf keypoints, descriptor
+// width changes, bad poses, absurd intrinsics, empty frames, mismatched sizes, bad strides), and give the
+// same keep mask, labels, reasons, status and reason. Also the public forms' own findings: a double pose
+// beyond float's range, a moved-from Culler, a quoted preset name, and a refused frame that keeps
+// frames_since_keyframe.
+#include "dyncull/culling/culler.hpp"
+#include "dyncull/culling/culler_core.hpp"
 #include "dyncull/opencv/culler.hpp"
 
 #include <gtest/gtest.h>
@@ -21,10 +24,6 @@
 namespace dyncull {
 namespace {
 
-using cv_adapter::CompiledCuller;
-using cv_adapter::DetectedBox;
-using cv_adapter::FrameCuller;
-
 const cv::Mat kK = (cv::Mat_<double>(3, 3) << 525, 0, 319.5, 0, 525, 239.5, 0, 0, 1);
 const cv::Size kSize(640, 480);
 
@@ -32,12 +31,12 @@ const cv::Size kSize(640, 480);
 struct Frame {
   std::vector<cv::KeyPoint> keys;
   cv::Mat descriptors;  // CV_8U rows, or empty
-  cv::Mat depth;        // CV_32F metres, or empty
+  cv::Mat depth;        // CV_32F metres, or empty (the OpenCV form also takes other types, to refuse them)
   std::vector<Detection<float>> boxes;
   cv::Mat Tcw;  // 4x4 CV_64F, or empty: no pose
   std::vector<cv::KeyPoint> undistorted;
   bool has_undistorted = false;
-  std::size_t stride_bytes = 0;  // for the plain view and the compiled float-pair overload (0: as the keys)
+  std::size_t stride_bytes = 0;  // for the plain views (0: as the keys); the OpenCV form has no stride
 };
 
 /// A static scene seen from the same pose: 60 keypoints, each with its own descriptor, depth 2 m, a person
@@ -67,73 +66,38 @@ struct Outcome {
   std::vector<std::int64_t> track_ids;
   int frames_since_keyframe = 0;
   bool keyframe = false;
+  bool refused = false;
   std::size_t matched = 0;
 };
 
-template <class R>
-Outcome outcome_of(const R& r) {
+Outcome outcome_of(const CullerResult& r) {
   Outcome o;
   o.status = static_cast<int>(r.status);
   o.reason = r.reason;
   o.keep = r.keep;
-  for (auto l : r.labels) o.labels.push_back(static_cast<int>(l));
-  for (auto c : r.reasons) o.reasons.push_back(static_cast<int>(c));
+  for (FeatureLabel l : r.labels) o.labels.push_back(static_cast<int>(l));
+  for (CullReason c : r.reasons) o.reasons.push_back(static_cast<int>(c));
   o.track_ids = r.track_ids;
   o.frames_since_keyframe = r.frames_since_keyframe;
   o.keyframe = r.keyframe;
+  o.refused = r.refused;
   o.matched = r.matched;
   return o;
 }
 
-/// The plain culler on the frame's data, read in place. Its pose argument is cam_from_world; the OpenCV
-/// forms name it predicted_Tcw: the reason is compared with that name.
-class PlainForm {
- public:
-  explicit PlainForm(const cv::Mat& K, const CullerOptions<float>& o = CullerOptions<float>())
-      : culler_(camera_of(K), o) {}
-  Outcome cull(const Frame& in) {
-    CullerFrame<float> f;
-    f.keypoints = points_view(in.keys);
-    if (in.stride_bytes != 0) f.keypoints.stride_bytes = in.stride_bytes;
-    if (in.has_undistorted) f.undistorted_keypoints = points_view(in.undistorted);
-    if (!in.descriptors.empty())
-      f.descriptors = DescriptorRows(in.descriptors.ptr<std::uint8_t>(0), static_cast<std::size_t>(in.descriptors.rows),
-                                     in.descriptors.step[0], in.descriptors.cols * in.descriptors.elemSize());
-    if (!in.depth.empty()) f.depth_m = cv_adapter::depth_view_f32(in.depth);
-    f.detections = &in.boxes;
-    if (!in.Tcw.empty()) {
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) pose_.R(r, c) = static_cast<float>(in.Tcw.at<double>(r, c));
-        pose_.t(r) = static_cast<float>(in.Tcw.at<double>(r, 3));
-      }
-      f.cam_from_world = &pose_;
-    }
-    Outcome o = outcome_of(culler_.cull(f));
-    for (std::size_t at = o.reason.find("cam_from_world"); at != std::string::npos; at = o.reason.find("cam_from_world"))
-      o.reason.replace(at, 14, "predicted_Tcw");
-    return o;
-  }
+DescriptorRows rows_of(const cv::Mat& d) {
+  return DescriptorRows(d.ptr<std::uint8_t>(0), static_cast<std::size_t>(d.rows), d.step[0],
+                        static_cast<std::size_t>(d.cols));
+}
 
- private:
-  static PinholeCamera<float> camera_of(const cv::Mat& K) {
-    return PinholeCamera<float>{static_cast<float>(K.at<double>(0, 0)), static_cast<float>(K.at<double>(1, 1)),
-                                static_cast<float>(K.at<double>(0, 2)), static_cast<float>(K.at<double>(1, 2)),
-                                kSize.width, kSize.height};
-  }
-  Culler<float> culler_;
-  Rigid3<float> pose_;
-};
-
-class FrameForm {
- public:
-  explicit FrameForm(const cv::Mat& K) : culler_(K, kSize) {}
-  Outcome cull(const Frame& in) {
-    culler_.cull(in.keys, in.descriptors, in.depth, in.boxes, in.Tcw.empty() ? nullptr : &in.Tcw,
-                 in.has_undistorted ? &in.undistorted : nullptr);
-    return outcome_of(culler_.result());
-  }
-  FrameCuller culler_;
-};
+DepthView<float> depth_of(const cv::Mat& d) {
+  DepthView<float> v;
+  v.data = d.ptr<float>(0);
+  v.width = d.cols;
+  v.height = d.rows;
+  v.stride = static_cast<std::ptrdiff_t>(d.step[0] / sizeof(float));
+  return v;
+}
 
 std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
   std::vector<DetectedBox> out;
@@ -142,24 +106,83 @@ std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detection
   return out;
 }
 
-class CompiledForm {
+/// The public culler on the frame's data, read in place through plain views; the pose as 12 doubles.
+class PlainForm {
  public:
-  explicit CompiledForm(const cv::Mat& K) : culler_(K, kSize) {}
+  explicit PlainForm(const cv::Mat& K, const CullerOptions& o = CullerOptions())
+      : culler_(cv_adapter::culler_camera(K, kSize), o) {}
   Outcome cull(const Frame& in) {
-    const std::vector<DetectedBox> boxes = boxes_of(in.boxes);
-    const cv::Mat* pose = in.Tcw.empty() ? nullptr : &in.Tcw;
-    if (in.stride_bytes != 0) {
-      culler_.cull(in.keys.empty() ? nullptr : &in.keys[0].pt.x, in.keys.size(), in.stride_bytes, in.descriptors,
-                   in.depth, boxes, pose);
-    } else {
-      culler_.cull(in.keys, in.descriptors, in.depth, boxes, pose, in.has_undistorted ? &in.undistorted : nullptr);
+    CullerFrame f;
+    f.keypoints = points_view(in.keys);
+    if (in.stride_bytes != 0) f.keypoints.stride_bytes = in.stride_bytes;
+    if (in.has_undistorted) f.undistorted_keypoints = points_view(in.undistorted);
+    if (!in.descriptors.empty()) f.descriptors = rows_of(in.descriptors);
+    if (!in.depth.empty()) f.depth_m = depth_of(in.depth);
+    boxes_ = boxes_of(in.boxes);
+    f.detections = &boxes_;
+    if (!in.Tcw.empty()) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) Rt_[4 * r + c] = in.Tcw.at<double>(r, c);
+      f.cam_from_world = Rt_;
     }
-    return outcome_of(culler_.result());
+    return outcome_of(culler_.cull(f));
   }
-  CompiledCuller culler_;
+  Culler culler_;
+
+ private:
+  std::vector<DetectedBox> boxes_;
+  double Rt_[12];
 };
 
-void expect_same(const Outcome& a, const Outcome& b, const char* what) {
+/// The public culler through the OpenCV overload.
+class CvForm {
+ public:
+  explicit CvForm(const cv::Mat& K, const CullerOptions& o = CullerOptions())
+      : culler_(cv_adapter::culler_camera(K, kSize), o) {}
+  Outcome cull(const Frame& in) {
+    const std::vector<DetectedBox> boxes = boxes_of(in.boxes);
+    return outcome_of(cv_adapter::cull(culler_, in.keys, in.descriptors, in.depth, boxes,
+                                       in.Tcw.empty() ? nullptr : &in.Tcw,
+                                       in.has_undistorted ? &in.undistorted : nullptr));
+  }
+  Culler culler_;
+};
+
+/// The templated core the public culler runs, with the options it derives from CullerOptions. Its pose is
+/// a Rigid3<float>: a double pose beyond float's range cannot be given to it.
+class CoreForm {
+ public:
+  explicit CoreForm(const cv::Mat& K, const CullerOptions& o = CullerOptions())
+      : culler_(camera_of(K), core_options<float>(o)) {}
+  Outcome cull(const Frame& in) {
+    CullerCoreFrame<float> f;
+    f.keypoints = points_view(in.keys);
+    if (in.stride_bytes != 0) f.keypoints.stride_bytes = in.stride_bytes;
+    if (in.has_undistorted) f.undistorted_keypoints = points_view(in.undistorted);
+    if (!in.descriptors.empty()) f.descriptors = rows_of(in.descriptors);
+    if (!in.depth.empty()) f.depth_m = depth_of(in.depth);
+    f.detections = &in.boxes;
+    if (!in.Tcw.empty()) {
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) pose_.R(r, c) = static_cast<float>(in.Tcw.at<double>(r, c));
+        pose_.t(r) = static_cast<float>(in.Tcw.at<double>(r, 3));
+      }
+      f.cam_from_world = &pose_;
+    }
+    return outcome_of(culler_.cull(f));
+  }
+  CullerCore<float> culler_;
+
+ private:
+  static PinholeCamera<float> camera_of(const cv::Mat& K) {
+    return PinholeCamera<float>{static_cast<float>(K.at<double>(0, 0)), static_cast<float>(K.at<double>(1, 1)),
+                                static_cast<float>(K.at<double>(0, 2)), static_cast<float>(K.at<double>(1, 2)),
+                                kSize.width, kSize.height};
+  }
+  Rigid3<float> pose_;
+};
+
+void expect_same(const Outcome& a, const Outcome& b, const std::string& what) {
   SCOPED_TRACE(what);
   EXPECT_EQ(a.status, b.status);
   EXPECT_EQ(a.reason, b.reason);
@@ -169,24 +192,32 @@ void expect_same(const Outcome& a, const Outcome& b, const char* what) {
   EXPECT_EQ(a.track_ids, b.track_ids);
   EXPECT_EQ(a.frames_since_keyframe, b.frames_since_keyframe);
   EXPECT_EQ(a.keyframe, b.keyframe);
+  EXPECT_EQ(a.refused, b.refused);
   EXPECT_EQ(a.matched, b.matched);
 }
 
-/// Feeds the frames to all three forms (the plain one only when `plain`), each after a good first frame,
-/// compares every frame's outcome and returns the last one.
-Outcome same_in_every_form(const std::vector<Frame>& frames, bool plain = true, bool frame_form = true) {
+/// Which forms get the frames: the OpenCV overload always; the plain views and the core when they can hold
+/// the input.
+struct Forms {
+  bool plain = true, core = true;
+};
+
+/// Feeds the frames to the forms, each after a good first frame, compares every frame's outcome with the
+/// OpenCV form's (or, without plain views on it, the plain form's) and returns the last one.
+Outcome same_in_every_form(const std::vector<Frame>& frames, Forms forms = Forms(), bool cv_form = true) {
   PlainForm p(kK);
-  FrameForm f(kK);
-  CompiledForm c(kK);
+  CvForm c(kK);
+  CoreForm k(kK);
   const Frame first = good_frame();
-  Outcome last = c.cull(first);
-  if (plain) expect_same(p.cull(first), last, "first frame, plain vs compiled");
-  if (frame_form) expect_same(f.cull(first), last, "first frame, FrameCuller vs compiled");
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    const std::string step = "frame " + std::to_string(k + 1);
-    last = c.cull(frames[k]);
-    if (plain) expect_same(p.cull(frames[k]), last, (step + ", plain vs compiled").c_str());
-    if (frame_form) expect_same(f.cull(frames[k]), last, (step + ", FrameCuller vs compiled").c_str());
+  const Outcome head = cv_form ? c.cull(first) : p.cull(first);
+  if (cv_form && forms.plain) expect_same(p.cull(first), head, "first frame, plain views vs OpenCV overload");
+  if (forms.core) expect_same(k.cull(first), head, "first frame, CullerCore<float> vs public culler");
+  Outcome last = head;
+  for (std::size_t n = 0; n < frames.size(); ++n) {
+    const std::string step = "frame " + std::to_string(n + 1);
+    last = cv_form ? c.cull(frames[n]) : p.cull(frames[n]);
+    if (cv_form && forms.plain) expect_same(p.cull(frames[n]), last, step + ", plain views vs OpenCV overload");
+    if (forms.core) expect_same(k.cull(frames[n]), last, step + ", CullerCore<float> vs public culler");
   }
   return last;
 }
@@ -275,26 +306,39 @@ TEST(CullerContract, PoseThatIsNotRigidOrOutOfRangeIsRefusedAlikeInEveryForm) {
     r.second.copyTo(bad.Tcw(cv::Rect(0, 0, 3, 3)));
     const Outcome o = same_in_every_form({bad});
     EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
-    EXPECT_NE(o.reason.find("predicted_Tcw's rotation is not a rotation"), std::string::npos) << o.reason;
+    // The pose check is the culler's own, after the OpenCV overload read the matrix: it names the
+    // culler's input, cam_from_world, in every form.
+    EXPECT_NE(o.reason.find("cam_from_world's rotation is not a rotation"), std::string::npos) << o.reason;
+    EXPECT_TRUE(o.refused);
     EXPECT_EQ(o.keep, std::vector<std::uint8_t>(60, 1));
   }
   Frame far = good_frame();
-  far.Tcw.at<double>(1, 3) = 1e30;  // in float's range: all three forms read it
+  far.Tcw.at<double>(1, 3) = 1e30;  // in float's range: the core reads it too
   const Outcome o = same_in_every_form({far});
   EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
   EXPECT_NE(o.reason.find("out of the range"), std::string::npos) << o.reason;
   Frame nan = good_frame();
   nan.Tcw.at<double>(0, 0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(same_in_every_form({nan}).status, static_cast<int>(Status::NonFinite));
+  // Not [R t; 0 0 0 1]: only the OpenCV overload takes a 4x4 matrix, and it names its argument.
+  Frame last_row = good_frame();
+  last_row.Tcw.at<double>(3, 0) = 0.5;
+  Forms cv_only;
+  cv_only.plain = cv_only.core = false;
+  const Outcome lr = same_in_every_form({last_row}, cv_only);
+  EXPECT_EQ(lr.status, static_cast<int>(Status::InvalidInput));
+  EXPECT_NE(lr.reason.find("predicted_Tcw must be a 4x4"), std::string::npos) << lr.reason;
 }
 
 TEST(CullerContract, DoublePoseBeyondFloatRangeIsOutOfRangeNotNonFinite) {
   for (const cv::Point at : {cv::Point(3, 0), cv::Point(1, 1)}) {
     Frame huge = good_frame();
     huge.Tcw.at<double>(at) = 1e300;
-    const Outcome o = same_in_every_form({huge}, /*plain=*/false);  // a float pose cannot hold 1e300
+    Forms public_only;
+    public_only.core = false;  // a float pose cannot hold 1e300
+    const Outcome o = same_in_every_form({huge}, public_only);
     EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput)) << o.reason;
-    EXPECT_NE(o.reason.find("predicted_Tcw has an entry of"), std::string::npos) << o.reason;
+    EXPECT_NE(o.reason.find("cam_from_world has an entry of"), std::string::npos) << o.reason;
     EXPECT_NE(o.reason.find("out of the range"), std::string::npos) << o.reason;
     EXPECT_EQ(o.reason.find("NaN"), std::string::npos) << o.reason;
   }
@@ -306,20 +350,23 @@ TEST(CullerContract, AbsurdIntrinsicsAreRefusedInEveryForm) {
   for (const auto& k : {std::make_pair("fx", tiny_focal), std::make_pair("cx", far_centre)}) {
     SCOPED_TRACE(k.first);
     PlainForm p(k.second);
-    FrameForm f(k.second);
-    CompiledForm c(k.second);
-    EXPECT_FALSE(f.culler_.ok());
+    CvForm c(k.second);
+    CoreForm d(k.second);
+    EXPECT_FALSE(p.culler_.ok());
     EXPECT_FALSE(c.culler_.ok());
-    EXPECT_NE(c.culler_.reason().find(std::string("camera_from_K: K: ") + k.first + " = "), std::string::npos)
+    EXPECT_EQ(d.culler_.status(), Status::InvalidInput);
+    EXPECT_NE(c.culler_.reason().find(std::string("camera: ") + k.first + " = "), std::string::npos)
         << c.culler_.reason();
+    EXPECT_EQ(c.culler_.reason(), d.culler_.reason());
     const Frame in = good_frame();
-    const Outcome a = p.cull(in), b = f.cull(in), d = c.cull(in);
-    for (const Outcome* o : {&a, &b, &d}) {
+    const Outcome a = p.cull(in), b = c.cull(in), e = d.cull(in);
+    for (const Outcome* o : {&a, &b, &e}) {
       EXPECT_EQ(o->status, static_cast<int>(Status::InvalidInput));
       EXPECT_NE(o->reason.find(std::string(k.first) + " = "), std::string::npos) << o->reason;
       EXPECT_EQ(o->keep, std::vector<std::uint8_t>(60, 1));
     }
-    expect_same(b, d, "FrameCuller vs compiled");
+    expect_same(a, b, "plain views vs OpenCV overload");
+    expect_same(e, b, "CullerCore<float> vs public culler");
   }
 }
 
@@ -353,8 +400,8 @@ TEST(CullerContract, MismatchedSizesAndBadStridesAreRefusedAlikeInEveryForm) {
   EXPECT_NE(o.reason.find("depth: 320x240 for an image of 640x480"), std::string::npos) << o.reason;
 
   Frame stride = good_frame();
-  stride.stride_bytes = 4;  // FrameCuller takes cv::KeyPoint vectors only: no stride to get wrong
-  o = same_in_every_form({stride}, /*plain=*/true, /*frame_form=*/false);
+  stride.stride_bytes = 4;  // the OpenCV overload takes point vectors only: no stride to get wrong
+  o = same_in_every_form({stride}, Forms(), /*cv_form=*/false);
   EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput));
   EXPECT_NE(o.reason.find("keypoints: stride_bytes 4 is below the 8 bytes of an x, y pair"), std::string::npos)
       << o.reason;
@@ -362,67 +409,82 @@ TEST(CullerContract, MismatchedSizesAndBadStridesAreRefusedAlikeInEveryForm) {
 }
 
 TEST(CullerContract, RefusedFrameKeepsFramesSinceKeyframeInEveryForm) {
-  // Refused by the plain culler's checks, by the compiled culler's own reading of float pairs, and by
-  // FrameCuller's reading of a cv::Mat: the count goes on in each.
+  // Refused by the core's checks (descriptor rows), by its check of a plain view's stride, and by the
+  // OpenCV overload's reading of a cv::Mat (8-bit depth, through Culler::refuse): the count goes on in each.
   Frame rows = good_frame();
   rows.descriptors = rows.descriptors.rowRange(0, 59).clone();
   Frame stride = good_frame();
   stride.stride_bytes = 4;
   Frame bytes = good_frame();
   bytes.depth = cv::Mat(480, 640, CV_8UC1, cv::Scalar(2));
+  Forms all, views, cv_only;
+  cv_only.plain = cv_only.core = false;
   const struct {
     const char* what;
     Frame frame;
-    bool plain, frame_form;
-  } cases[] = {{"descriptor rows", rows, true, true}, {"stride", stride, true, false}, {"8-bit depth", bytes, false, true}};
+    Forms forms;
+    bool cv_form;
+  } cases[] = {{"descriptor rows", rows, all, true}, {"stride", stride, views, false}, {"8-bit depth", bytes, cv_only, true}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
-    const Outcome o = same_in_every_form({good_frame(), good_frame(), c.frame}, c.plain, c.frame_form);
+    const Outcome o = same_in_every_form({good_frame(), good_frame(), c.frame}, c.forms, c.cv_form);
     EXPECT_EQ(o.status, static_cast<int>(Status::InvalidInput)) << o.reason;
+    EXPECT_TRUE(o.refused);
     EXPECT_EQ(o.frames_since_keyframe, 3);
   }
 }
 
 TEST(CullerContract, ResetStartsAgainInEveryForm) {
-  FrameForm f(kK);
-  CompiledForm c(kK);
-  for (int k = 0; k < 2; ++k) {
-    f.cull(good_frame());
+  PlainForm p(kK);
+  CvForm c(kK);
+  CoreForm k(kK);
+  for (int n = 0; n < 2; ++n) {
+    p.cull(good_frame());
     c.cull(good_frame());
+    k.cull(good_frame());
   }
-  f.culler_.reset();
+  p.culler_.reset();
   c.culler_.reset();
-  const Outcome a = f.cull(good_frame()), b = c.cull(good_frame());
-  expect_same(a, b, "after reset");
+  k.culler_.reset();
+  EXPECT_EQ(c.culler_.keyframe_size(), 0u);
+  const Outcome a = p.cull(good_frame()), b = c.cull(good_frame()), d = k.cull(good_frame());
+  expect_same(a, b, "after reset, plain views vs OpenCV overload");
+  expect_same(d, b, "after reset, CullerCore<float> vs public culler");
   EXPECT_TRUE(b.keyframe);
   EXPECT_EQ(b.matched, 0u);
   EXPECT_EQ(b.track_ids.front(), 0);
+  EXPECT_EQ(c.culler_.keyframe_size(), 60u);
 }
 
-TEST(CompiledCullerContract, MovedFromCullerKeepsAllParallelToTheKeys) {
-  CompiledCuller a(kK, kSize);
-  CompiledCuller b(std::move(a));
+TEST(PublicCullerContract, MovedFromCullerKeepsAllParallelToTheKeys) {
+  Culler a(cv_adapter::culler_camera(kK, kSize));
+  Culler b(std::move(a));
   EXPECT_TRUE(b.ok());
   const Frame in = good_frame();
   const std::vector<DetectedBox> boxes = boxes_of(in.boxes);
   // NOLINTNEXTLINE(bugprone-use-after-move): the moved-from state is what is tested
-  const std::vector<std::uint8_t>& keep = a.cull(in.keys, in.descriptors, in.depth, boxes, &in.Tcw);
-  EXPECT_EQ(keep, std::vector<std::uint8_t>(60, 1));
-  EXPECT_EQ(a.result().status, CompiledCuller::Status::InvalidInput);
-  EXPECT_NE(a.result().reason.find("moved from"), std::string::npos) << a.result().reason;
-  EXPECT_EQ(a.result().labels.size(), 60u);
+  const CullerResult& r = cv_adapter::cull(a, in.keys, in.descriptors, in.depth, boxes, &in.Tcw);
+  EXPECT_EQ(r.keep, std::vector<std::uint8_t>(60, 1));
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_TRUE(r.refused);
+  EXPECT_NE(r.reason.find("moved from"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.labels.size(), 60u);
   std::vector<cv::Point2f> points;
   cv::KeyPoint::convert(in.keys, points);
-  EXPECT_EQ(a.cull(points, in.descriptors, in.depth, boxes), std::vector<std::uint8_t>(60, 1));
-  EXPECT_EQ(a.cull(&points[0].x, 7, 0, cv::Mat(), in.depth, boxes), std::vector<std::uint8_t>(7, 1));
+  EXPECT_EQ(cv_adapter::cull(a, points, in.descriptors, in.depth, boxes).keep, std::vector<std::uint8_t>(60, 1));
+  CullerFrame seven;
+  seven.keypoints = PointsView::of(&points[0].x, 7);
+  seven.depth_m = depth_of(in.depth);
+  seven.detections = &boxes;
+  EXPECT_EQ(a.cull(seven).keep, std::vector<std::uint8_t>(7, 1));
+  EXPECT_EQ(a.result().status, Status::InvalidInput);
   EXPECT_FALSE(a.ok());
 }
 
-TEST(CompiledCullerContract, PresetNameIsQuotedInTheReason) {
-  CompiledCuller::Options options;
-  options.preset = "\x1b[31mred" + std::string(5000, 'k') + std::string(1, '\0') + "after";
-  CompiledCuller culler(kK, kSize, cv::Mat(), options);
-  EXPECT_EQ(culler.status(), CompiledCuller::Status::InvalidInput);
+TEST(PublicCullerContract, PresetNameIsQuotedInTheReason) {
+  const CullerOptions options("\x1b[31mred" + std::string(5000, 'k') + std::string(1, '\0') + "after");
+  Culler culler(cv_adapter::culler_camera(kK, kSize), options);
+  EXPECT_EQ(culler.status(), Status::InvalidInput);
   const std::string& why = culler.reason();
   EXPECT_EQ(why.find('\x1b'), std::string::npos) << why;
   EXPECT_EQ(why.find('\0'), std::string::npos);

@@ -1,7 +1,9 @@
-// Tests of opencv/culler.hpp: the README's loop (ORB keypoints, descriptor Mat, depth, boxes through one
-// FrameCuller) labels the moving features of the synthetic walking scene as well as the recommended
+// Tests of opencv/culler.hpp, the OpenCV overloads of the public culler (dyncull::Culler, compiled into
+// dyncull::culler): the README's loop (ORB keypoints, descriptor Mat, depth, boxes through
+// cv_adapter::cull) labels the moving features of the synthetic walking scene as well as the recommended
 // pipeline hand-fed with LK tracks into its keyframes; bad K, descriptor type, depth size and pose
-// matrix are named; a distorted camera's keypoints are undistorted inside; uint16 depth reads with its scale.
+// matrix are named; a distorted camera's keypoints are undistorted inside (as a host's own
+// cv::undistortPoints copy would be); uint16 depth reads with its scale.
 #include "dyncull/opencv/culler.hpp"
 
 #include "dyncull/culling/pipeline.hpp"
@@ -11,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -24,7 +27,12 @@
 namespace dyncull {
 namespace {
 
-using cv_adapter::FrameCuller;
+std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
+  std::vector<DetectedBox> out;
+  for (const Detection<float>& d : detections)
+    out.push_back(DetectedBox(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence));
+  return out;
+}
 
 /// Dynamic-label counts against the scene's per-pixel motion truth.
 struct Score {
@@ -148,7 +156,8 @@ void expect_labels_like_the_hand_fed_pipeline(const char* family) {
   scene_options.num_frames = 90;
   const sim::Scene scene(scene_options);
   ASSERT_TRUE(scene.ok()) << scene.reason();
-  FrameCuller culler(camera_K(scene), cv::Size(scene_options.width, scene_options.height));
+  Culler culler(cv_adapter::culler_camera(camera_K(scene), cv::Size(scene_options.width, scene_options.height)),
+                CullerOptions("recommended"));
   ASSERT_TRUE(culler.ok()) << culler.reason();
   HandFed hand_fed(scene.camera().cast<float>());
   const cv::Ptr<cv::ORB> orb = cv::ORB::create(1000);
@@ -165,8 +174,9 @@ void expect_labels_like_the_hand_fed_pipeline(const char* family) {
     const Rigid3<float> pose = frame.world_from_cam.inverse().cast<float>();
     cv::Mat Tcw;
     cv::eigen2cv(pose.matrix(), Tcw);
-    const std::vector<std::uint8_t> keep = culler.cull(keys, descriptors, depth, frame.detections, &Tcw);
-    const CullerResult& r = culler.result();
+    const CullerResult& r = cv_adapter::cull(culler, keys, descriptors, depth, boxes_of(frame.detections), &Tcw);
+    const std::vector<std::uint8_t> keep = r.keep;
+    EXPECT_EQ(&r, &culler.result());
     if (i > 0) {
       EXPECT_TRUE(r.ok()) << "frame " << i << ": " << r.reason;
     }
@@ -203,33 +213,35 @@ TEST(OpenCvCuller, BadCalibrationAndInputsAreNamed) {
   for (std::size_t i = 0; i < keys.size(); ++i) keys[i].pt = cv::Point2f(20.f + 10.f * float(i), 100.f);
   const cv::Mat descriptors(40, 32, CV_8UC1, cv::Scalar(7));
   const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(2.f));
-  const std::vector<Detection<float>> boxes;
+  const std::vector<DetectedBox> boxes;
+  using cv_adapter::cull;
 
-  FrameCuller no_focal(bad_K, cv::Size(640, 480));
+  Culler no_focal(cv_adapter::culler_camera(bad_K, cv::Size(640, 480)));
   EXPECT_FALSE(no_focal.ok());
   EXPECT_NE(no_focal.reason().find("focal"), std::string::npos) << no_focal.reason();
-  EXPECT_EQ(no_focal.cull(keys, descriptors, depth, boxes), std::vector<std::uint8_t>(40, 1));
+  EXPECT_EQ(cull(no_focal, keys, descriptors, depth, boxes).keep, std::vector<std::uint8_t>(40, 1));
   EXPECT_EQ(no_focal.result().status, Status::InvalidInput);
+  EXPECT_TRUE(no_focal.result().refused);
 
-  FrameCuller culler(K, cv::Size(640, 480));
+  Culler culler(cv_adapter::culler_camera(K, cv::Size(640, 480)));
   ASSERT_TRUE(culler.ok()) << culler.reason();
   const cv::Mat float_desc(40, 8, CV_32FC1, cv::Scalar(0.f));
-  culler.cull(keys, float_desc, depth, boxes);
+  cull(culler, keys, float_desc, depth, boxes);
   EXPECT_EQ(culler.result().status, Status::InvalidInput);
   EXPECT_NE(culler.result().reason.find("CV_8U"), std::string::npos) << culler.result().reason;
 
-  culler.cull(keys, descriptors.rowRange(0, 39), depth, boxes);
+  cull(culler, keys, descriptors.rowRange(0, 39), depth, boxes);
   EXPECT_NE(culler.result().reason.find("descriptors has 39 rows for 40 keypoints"), std::string::npos)
       << culler.result().reason;
 
-  culler.cull(keys, descriptors, cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.f)), boxes);
+  cull(culler, keys, descriptors, cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.f)), boxes);
   EXPECT_NE(culler.result().reason.find("depth"), std::string::npos) << culler.result().reason;
 
   const cv::Mat Tcw3 = cv::Mat::eye(3, 4, CV_64F);
-  culler.cull(keys, descriptors, depth, boxes, &Tcw3);
+  cull(culler, keys, descriptors, depth, boxes, &Tcw3);
   EXPECT_NE(culler.result().reason.find("predicted_Tcw"), std::string::npos) << culler.result().reason;
 
-  culler.cull(keys, descriptors, cv::Mat(), boxes);
+  cull(culler, keys, descriptors, cv::Mat(), boxes);
   EXPECT_EQ(culler.result().status, Status::MissingInput);
   EXPECT_NE(culler.result().reason.find("monocular"), std::string::npos) << culler.result().reason;
 }
@@ -237,10 +249,12 @@ TEST(OpenCvCuller, BadCalibrationAndInputsAreNamed) {
 TEST(OpenCvCuller, DistortedCameraUndistortsTheKeypointsItself) {
   const cv::Mat K = (cv::Mat_<double>(3, 3) << 517.3, 0, 318.6, 0, 516.5, 255.3, 0, 0, 1);
   const cv::Mat dist = (cv::Mat_<double>(1, 5) << 0.2624, -0.9531, -0.0054, 0.0026, 1.1633);  // TUM fr1
-  FrameCuller culler(K, cv::Size(640, 480), dist);
+  Culler culler(cv_adapter::culler_camera(K, cv::Size(640, 480), dist));
   ASSERT_TRUE(culler.ok()) << culler.reason();
-  EXPECT_TRUE(culler.camera().has_distortion);
-  EXPECT_TRUE(culler.culler().options().camera_has_distortion);
+  EXPECT_TRUE(culler.camera().has_distortion());
+  EXPECT_EQ(culler.camera().distortion.size(), 5u);
+  // The same frames with the host's own undistorted copy (ORB-SLAM's mvKeysUn): the same outcome.
+  Culler given(cv_adapter::culler_camera(K, cv::Size(640, 480), dist));
   std::vector<cv::KeyPoint> keys(60);
   for (std::size_t i = 0; i < keys.size(); ++i)
     keys[i].pt = cv::Point2f(30.f + 9.f * float(i), 60.f + 5.f * float(i % 7));
@@ -248,10 +262,22 @@ TEST(OpenCvCuller, DistortedCameraUndistortsTheKeypointsItself) {
   cv::randu(descriptors, 0, 256);
   const cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(10000));  // 2 m at TUM's 5000 per metre
   const cv::Mat Tcw = cv::Mat::eye(4, 4, CV_64F);
-  const std::vector<Detection<float>> boxes;
-  culler.cull(keys, descriptors, depth, boxes, &Tcw);
-  culler.cull(keys, descriptors, depth, boxes, &Tcw);
-  EXPECT_NE(culler.result().status, Status::InvalidInput) << culler.result().reason;
+  const std::vector<DetectedBox> boxes;
+  std::vector<cv::Point2f> raw, und;
+  cv::KeyPoint::convert(keys, raw);
+  cv::undistortPoints(raw, und, K, dist, cv::noArray(), K);
+  std::vector<cv::KeyPoint> keys_un = keys;
+  for (std::size_t i = 0; i < keys.size(); ++i) keys_un[i].pt = und[i];
+  for (int frame = 0; frame < 2; ++frame) {
+    const CullerResult& r = cv_adapter::cull(culler, keys, descriptors, depth, boxes, &Tcw);
+    const CullerResult& g = cv_adapter::cull(given, keys, descriptors, depth, boxes, &Tcw, &keys_un);
+    EXPECT_NE(r.status, Status::InvalidInput) << r.reason;
+    EXPECT_EQ(r.status, g.status) << "frame " << frame;
+    EXPECT_EQ(r.reason, g.reason);
+    EXPECT_EQ(r.keep, g.keep);
+    EXPECT_EQ(r.reasons, g.reasons);
+    EXPECT_EQ(r.matched, g.matched);
+  }
   EXPECT_EQ(culler.result().matched, keys.size());  // the same keypoints match themselves
 }
 

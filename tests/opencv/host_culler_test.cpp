@@ -144,7 +144,7 @@ TEST(HostCullerDetections, BoxesAreFoundByStampWithinTheTolerance) {
   TempDir dir("stamps");
   write_two_frames(dir);
   HostCuller culler(settings_for(HostCuller::Mode::BoxOnly, dir));
-  std::vector<cv_adapter::DetectedBox> boxes;
+  std::vector<DetectedBox> boxes;  // dyncull::DetectedBox (culling/culler.hpp)
   ASSERT_TRUE(culler.detections_for(kStamp0 + 0.004, &boxes));
   ASSERT_EQ(boxes.size(), 2u);
   EXPECT_EQ(boxes[0].class_id, 0);

@@ -109,7 +109,14 @@ bool depth_step_near(const DepthView<Raw>& depth, int u, int v, int radius, doub
 /// TUM convention: uint16, 5000 units per metre, 0 = no measurement.
 inline DepthView<std::uint16_t> tum_depth_view(const std::uint16_t* data, int width, int height,
                                                float min_m = 0.f, float max_m = 1e30f) {
-  return DepthView<std::uint16_t>{data, width, height, 0, 5000.f, min_m, max_m};
+  DepthView<std::uint16_t> v;  // member by member: with its initialisers it is no aggregate in C++11
+  v.data = data;
+  v.width = width;
+  v.height = height;
+  v.units_per_metre = 5000.f;
+  v.min_m = min_m;
+  v.max_m = max_m;
+  return v;
 }
 
 }  // namespace dyncull

@@ -3,6 +3,13 @@
 /// Status plus a human-readable reason; bad input is reported here, never by crashing or throwing.
 #pragma once
 
+/// constexpr where C++14 allows a switch in it; inline in the C++11 headers' users (culling/culler.hpp).
+#if __cplusplus >= 201402L
+#define DYNCULL_CONSTEXPR14 constexpr
+#else
+#define DYNCULL_CONSTEXPR14 inline
+#endif
+
 namespace dyncull {
 
 /// Outcome of a call. Ok is the only success value; the others name the first reason found.
@@ -20,7 +27,7 @@ enum class Status {
 };
 
 /// Stable lower-case name of a status, for logs and reasons.
-constexpr const char* to_string(Status status) noexcept {
+DYNCULL_CONSTEXPR14 const char* to_string(Status status) noexcept {
   switch (status) {
     case Status::Ok: return "ok";
     case Status::TooFewPoints: return "too few points";

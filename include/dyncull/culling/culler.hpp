@@ -1,225 +1,55 @@
 /// @file culler.hpp
-/// A stateful culler that owns the evidence the culling pipeline (pipeline.hpp) reads against a reference
-/// keyframe: correspondences of each frame's keypoints to the keyframe's by guided descriptor matching
-/// (keyframe_matcher.hpp; Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-B), the keyframe's 3-D points
-/// back-projected from its depth (pinhole, x = z K^-1 u), stable track ids, frames since the keyframe and
-/// a keyframe policy. The host gives plain views per frame (keypoints, descriptors, depth, boxes, pose)
-/// and gets a keep mask, labels, reasons and a status naming any input the configuration lacked. The
-/// OpenCV forms (opencv/culler.hpp, opencv/compiled_culler.hpp) run this culler and its frame checks
-/// (culler_checks), so the same frame gets the same answer in every form (docs/design.md, input contract).
+/// The culler: one object per camera stream that takes a frame's keypoints, descriptors, depth, detector
+/// boxes and predicted pose and returns which keypoints lie on moving objects. It matches each frame to
+/// a reference keyframe (Mur-Artal, Montiel & Tardos 2015, ORB-SLAM §V-B) and runs a preset of the
+/// culling pipeline against it (culling/pipeline.hpp: Zhang et al. 2023 box levels, Zhu et al. 2024 depth
+/// masks, DLD-SLAM 2024 probability, DFD-SLAM 2024 sub-boxes, RTD-SLAM multi-view). Compiled once into
+/// dyncull::culler; this header is C++11 and includes the standard library only.
 ///
 /// API:
 /// @code
-///   Culler<float> culler(camera);                        // PinholeCamera, no default intrinsics
-///   CullerFrame<float> f;  f.keypoints = points_view(keys);  f.descriptors = ...;  f.depth_m = ...;
-///   f.detections = &boxes;  f.cam_from_world = &predicted;  // each optional, see Culler::inputs()
-///   const CullerResult& r = culler.cull(f);               // r.keep[i]: 1 = static, parallel to keys
+///   dyncull::CullerCamera camera(fx, fy, cx, cy, 640, 480);        // plus distortion when the lens has it
+///   dyncull::Culler culler(camera, dyncull::CullerOptions("recommended"));   // culler.ok(), culler.reason()
+///   dyncull::CullerFrame f;
+///   f.keypoints = dyncull::points_view(keys);  f.descriptors = ...;  f.depth_m = ...;  // each optional:
+///   f.detections = &boxes;  f.cam_from_world = Tcw;                  // culler.inputs() says what it reads
+///   const dyncull::CullerResult& r = culler.cull(f);                 // r.keep[i]: 1 = static
+///   dyncull::compact(r.keep, keys, depths);                          // the host's parallel arrays
 /// @endcode
+/// OpenCV containers: opencv/culler.hpp. The expert entry for hosts that feed their own tracks, 3-D points
+/// and ids is cull_frame (culling/pipeline.hpp).
 #pragma once
 
-#include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
-#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
-#include "dyncull/core/traits.hpp"
-#include "dyncull/core/types.hpp"
-#include "dyncull/culling/keyframe_matcher.hpp"
-#include "dyncull/culling/pipeline.hpp"
-#include "dyncull/culling/presets.hpp"
+#include "dyncull/core/views.hpp"
+#include "dyncull/culling/labels.hpp"
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
-#include <limits>
+#include <memory>
 #include <string>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 namespace dyncull {
 
-/// Read-only (u, v) pixel positions: point i's x at data + i * stride_bytes, its y right after it, both
-/// float or double. Built by points_view() from a contiguous container (cv::KeyPoint, cv::Point2f/d, Eigen
-/// 2-vectors, any struct with float/double x, y) or by hand from a pointer and a count. `given` tells an
-/// absent input from an empty one.
-struct PointsView {
-  const void* data = nullptr;
-  std::size_t count = 0;
-  std::size_t stride_bytes = 0;  ///< 0 means two packed scalars
-  bool is_double = false;
-  bool given = false;
+/// Pinhole intrinsics of the image the keypoints were detected in, in pixels, and the lens distortion in
+/// OpenCV's order (k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx, ty]]]]): 4, 5, 8, 12 or 14 values, or
+/// none. There are no default intrinsics: a zero focal length is refused.
+struct CullerCamera {
+  double fx, fy, cx, cy;
+  int width, height;
+  std::vector<double> distortion;
 
-  static PointsView of(const float* xy, std::size_t n, std::size_t stride_bytes_ = 0) {
-    return PointsView{xy, n, stride_bytes_, false, true};
-  }
-  static PointsView of(const double* xy, std::size_t n, std::size_t stride_bytes_ = 0) {
-    return PointsView{xy, n, stride_bytes_, true, true};
-  }
-  std::size_t stride() const { return stride_bytes ? stride_bytes : (is_double ? 2 * sizeof(double) : 2 * sizeof(float)); }
-  double x(std::size_t i) const { return read(i, 0); }
-  double y(std::size_t i) const { return read(i, 1); }
-
- private:
-  double read(std::size_t i, std::size_t k) const {
-    const unsigned char* p = static_cast<const unsigned char*>(data) + i * stride();
-    if (is_double) {
-      double v;
-      std::memcpy(&v, p + k * sizeof(double), sizeof v);
-      return v;
-    }
-    float v;
-    std::memcpy(&v, p + k * sizeof(float), sizeof v);
-    return static_cast<double>(v);
-  }
-};
-
-namespace detail {
-template <class P, class = void> struct culler_xy_address;
-template <class P>
-struct culler_xy_address<P, std::enable_if_t<has_pt_member<P>::value && !has_xy_members<P>::value>> {
-  static const auto* x(const P& p) { return &p.pt.x; }
-  static const auto* y(const P& p) { return &p.pt.y; }
-};
-template <class P>
-struct culler_xy_address<P, std::enable_if_t<has_xy_members<P>::value && !is_eigen_vec2<P>::value>> {
-  static const auto* x(const P& p) { return &p.x; }
-  static const auto* y(const P& p) { return &p.y; }
-};
-template <class P>
-struct culler_xy_address<P, std::enable_if_t<is_eigen_vec2<P>::value>> {
-  static const auto* x(const P& p) { return p.data(); }
-  static const auto* y(const P& p) { return p.data() + 1; }
-};
-}  // namespace detail
-
-/// PointsView over a contiguous container (std::vector, std::array) of points whose x and y are adjacent
-/// float or double members (cv::KeyPoint's pt, cv::Point2f/d, Eigen 2-vectors). The container must outlive
-/// the view and not be resized while the view is used.
-template <class Container>
-PointsView points_view(const Container& points) {
-  using P = std::decay_t<decltype(*points.data())>;
-  using A = detail::culler_xy_address<P>;
-  using S = std::remove_cv_t<std::remove_pointer_t<decltype(A::x(std::declval<const P&>()))>>;
-  static_assert(std::is_same<S, float>::value || std::is_same<S, double>::value,
-                "dyncull::points_view: point coordinates must be float or double");
-  PointsView v;
-  v.given = true;
-  v.is_double = std::is_same<S, double>::value;
-  v.count = static_cast<std::size_t>(points.size());
-  v.stride_bytes = sizeof(P);
-  if (v.count == 0) return v;
-  const P& first = points.data()[0];
-  v.data = A::x(first);
-  // x and y must be adjacent (every type above lays them out so); anything else is read as no points.
-  if (reinterpret_cast<const unsigned char*>(A::y(first)) != reinterpret_cast<const unsigned char*>(A::x(first)) + sizeof(S))
-    v.data = nullptr, v.count = 0;
-  return v;
-}
-
-/// The frame checks every culler form shares (Culler, cv_adapter::FrameCuller, cv_adapter::CompiledCuller),
-/// so that the same input gets the same status and reason whichever form the host uses.
-namespace culler_checks {
-
-/// Largest magnitude of a predicted pose's entry (metres for t): 1e8 m holds any Earth-fixed map
-/// (ECEF, UTM) and keeps every entry and its square inside float's range.
-constexpr double kMaxPoseEntry = 1e8;
-/// Largest deviation of a predicted rotation from orthonormal: max |(R^T R - I)_ij| and |det R - 1|. A
-/// float pose composed over a long motion model stays near 1e-6; a scale, shear or sum of rotations is
-/// far above.
-constexpr double kRotationTolerance = 1e-3;
-
-/// A value in a reason: three significant digits, the same text for a float and a double input.
-inline std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
-
-/// Ok, or InvalidInput naming `name`: a given view with a count needs data, and its stride must hold one
-/// (x, y) pair.
-inline Status check_points(const PointsView& v, const char* name, std::string* why) {
-  if (!v.given) return Status::Ok;
-  if (v.count > 0 && v.data == nullptr)
-    return (*why = std::string(name) + ": null data with a count of " + std::to_string(v.count), Status::InvalidInput);
-  const std::size_t pair = v.is_double ? 2 * sizeof(double) : 2 * sizeof(float);
-  if (v.stride_bytes != 0 && v.stride_bytes < pair)
-    return (*why = std::string(name) + ": stride_bytes " + std::to_string(v.stride_bytes) + " is below the " +
-                   std::to_string(pair) + " bytes of an x, y pair",
-            Status::InvalidInput);
-  return Status::Ok;
-}
-
-/// A predicted pose cam_from_world as R (row-major) and t, read in double before any conversion: NonFinite
-/// for a NaN or Inf entry; InvalidInput for an entry beyond kMaxPoseEntry or an R that is not a rotation
-/// (orthonormal with det +1 within kRotationTolerance: a zero, scaled, sheared or reflected R). The
-/// reason names `name`.
-inline Status check_pose(const double R[9], const double t[3], const char* name, std::string* why) {
-  const auto n = [name] { return std::string(name); };  // text only on failure: no allocation per frame
-  for (int k = 0; k < 12; ++k) {
-    const double v = k < 9 ? R[k] : t[k - 9];
-    if (!std::isfinite(v)) return (*why = n() + " has a NaN or Inf entry", Status::NonFinite);
-  }
-  for (int k = 0; k < 12; ++k) {
-    const double v = k < 9 ? R[k] : t[k - 9];
-    if (std::abs(v) > kMaxPoseEntry)
-      return (*why = n() + " has an entry of " + number(v) + ", out of the range [-1e8, 1e8] of a pose",
-              Status::InvalidInput);
-  }
-  double deviation = 0;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      double dot = 0;
-      for (int r = 0; r < 3; ++r) dot += R[3 * r + a] * R[3 * r + b];
-      const double d = std::abs(dot - (a == b ? 1.0 : 0.0));
-      deviation = d > deviation ? d : deviation;
-    }
-  const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
-                     R[2] * (R[3] * R[7] - R[4] * R[6]);
-  if (deviation > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance)
-    return (*why = n() + "'s rotation is not a rotation (R^T R differs from I by " + number(deviation) +
-                   ", det R = " + number(det) + "; a rigid pose has 0 and 1 within 1e-3)",
-            Status::InvalidInput);
-  return Status::Ok;
-}
-
-/// check_pose on a Rigid3.
-template <class T>
-Status check_pose(const Rigid3<T>& pose, const char* name, std::string* why) {
-  double R[9], t[3];
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R[3 * r + c] = static_cast<double>(pose.R(r, c));
-    t[r] = static_cast<double>(pose.t(r));
-  }
-  return check_pose(R, t, name, why);
-}
-
-}  // namespace culler_checks
-
-/// Which inputs a configuration reads (Culler::inputs) or a frame lacked (CullerResult::missing).
-struct CullerInputs {
-  bool keypoints = false;
-  bool descriptors = false;  ///< to match the keyframe (not needed when the host gives keyframe_match)
-  bool depth = false;
-  bool detections = false;
-  bool pose = false;         ///< predicted cam_from_world
-
-  bool any() const { return keypoints || descriptors || depth || detections || pose; }
-  /// Comma-separated names, e.g. "keypoints, descriptors, depth".
-  std::string names() const {
-    std::string s;
-    auto add = [&](bool on, const char* name) {
-      if (!on) return;
-      if (!s.empty()) s += ", ";
-      s += name;
-    };
-    add(keypoints, "keypoints");
-    add(descriptors, "descriptors");
-    add(depth, "depth");
-    add(detections, "detections");
-    add(pose, "pose");
-    return s;
+  CullerCamera() : fx(0), fy(0), cx(0), cy(0), width(0), height(0) {}
+  CullerCamera(double fx_, double fy_, double cx_, double cy_, int width_, int height_,
+               std::vector<double> distortion_ = std::vector<double>())
+      : fx(fx_), fy(fy_), cx(cx_), cy(cy_), width(width_), height(height_), distortion(distortion_) {}
+  /// A coefficient is non-zero: the geometry needs undistorted keypoints.
+  bool has_distortion() const {
+    for (std::size_t i = 0; i < distortion.size(); ++i)
+      if (distortion[i] != 0.0) return true;
+    return false;
   }
 };
 
@@ -229,585 +59,243 @@ enum class KeyframePolicy : std::uint8_t {
   Host,     ///< the host sets CullerFrame::is_keyframe (its own keyframes); the first frame always is one
 };
 
-template <class T>
-struct CullerOptions {
-  PipelineOptions<T> pipeline = presets::recommended<T>();
-  KeyframePolicy keyframe_policy = KeyframePolicy::Own;
-  /// Own policy: a new keyframe when the predicted pose is further than this from the keyframe's ...
-  /// (the demo front end's 0.1 m: shorter baselines lowered its ATE on translating sequences)
-  double keyframe_max_translation_m = 0.1;
-  double keyframe_max_rotation_deg = 15.0;   ///< ... or turned more than this ...
-  /// ... or fewer than this share of the keypoints matched the keyframe's. Lower than the demo's 0.5 of
-  /// its LK tracks: a detector that re-detects every frame matches about half of its keypoints one frame
-  /// later (repeatability, and movers the pose-guided search does not find), so at 0.5 nearly every
-  /// frame would be a keyframe and the evidence a one-frame baseline, on which the recommended preset
-  /// leaves the decision to the box rule (subbox.min_evidence_frames). A host that keeps its tracks
-  /// between its own keyframes (new corners only there) matches fewer of them to the culler's keyframe:
-  /// about 0.6 suits it (the dynamic_vo demo's culler strategy).
-  double keyframe_min_matched_ratio = 0.3;
-  KeyframeMatchOptions matching{};
-  /// Keyframe depth used for its 3-D points: the TUM sensor's reliable range, and no point within
-  /// depth_edge_radius_px of a depth step above max_depth_step_ratio (it back-projects half on the object,
-  /// half behind it). Radius 0 switches the edge test off.
-  float min_depth_m = 0.4f;
-  float max_depth_m = 8.f;
-  int depth_edge_radius_px = 1;
-  double max_depth_step_ratio = 0.05;
-  /// The camera has lens distortion: every frame must carry CullerFrame::undistorted_keypoints, which the
-  /// geometry (matching, epipolar and reprojection checks, back-projection) uses.
-  bool camera_has_distortion = false;
+/// What the culler does, as a preset plus the settings a host tunes. `CullerOptions(name)` fills every
+/// setting with the preset's value; change the ones you need. Everything else is fixed by the preset
+/// (docs/algorithms.md lists the presets and the evidence for their constants). Distances are in pixels
+/// of the undistorted image or metres; each setting says its range.
+class CullerOptions {
+ public:
+  /// recommended, dld_slam, rtd_slam, zhu_2024, dfd_slam, zhang_2023 or none. An unknown name keeps the
+  /// recommended values and validate() says so.
+  explicit CullerOptions(const std::string& preset = "recommended");
+  const std::string& preset() const { return preset_; }
 
-  /// Ok, or InvalidInput with the reason naming the field ("pipeline." / "matching." for nested ones).
-  Status validate(std::string* reason = nullptr) const {
-    auto bad = [&](const std::string& why) {
-      if (reason) *reason = "CullerOptions: " + why;
-      return Status::InvalidInput;
-    };
-    std::string why;
-    if (pipeline.validate(&why) != Status::Ok) return bad("pipeline." + why);
-    if (matching.validate(&why) != Status::Ok) return bad("matching: " + why);
-    if (static_cast<int>(keyframe_policy) > 1) return bad("keyframe_policy must be Own or Host");
-    if (!(keyframe_max_translation_m > 0) || !std::isfinite(keyframe_max_translation_m))
-      return bad("keyframe_max_translation_m must be positive and finite");
-    if (!(keyframe_max_rotation_deg > 0 && keyframe_max_rotation_deg <= 180))
-      return bad("keyframe_max_rotation_deg must be in (0, 180]");
-    if (!(keyframe_min_matched_ratio >= 0 && keyframe_min_matched_ratio <= 1))
-      return bad("keyframe_min_matched_ratio must be in [0, 1]");
-    if (!(min_depth_m >= 0.f) || !std::isfinite(min_depth_m) || !(max_depth_m > min_depth_m))
-      return bad("min_depth_m must be finite and >= 0, max_depth_m above it");
-    if (depth_edge_radius_px < 0 || depth_edge_radius_px > 64) return bad("depth_edge_radius_px must be in [0, 64]");
-    if (!(max_depth_step_ratio >= 0) || !std::isfinite(max_depth_step_ratio))
-      return bad("max_depth_step_ratio must be finite and >= 0");
-    if (reason) reason->clear();
-    return Status::Ok;
-  }
+  // --- keyframe: the baseline the evidence is measured over ---
+  KeyframePolicy keyframe_policy;
+  /// Own policy: a new keyframe when the predicted pose moved more than this from the keyframe's, in
+  /// (0, 1e4] m. Longer baselines show slow movers, shorter ones keep more keypoints matched.
+  double keyframe_max_translation_m;
+  double keyframe_max_rotation_deg;  ///< ... or turned more than this, in (0, 180]
+  /// ... or fewer than this share of the keypoints matched the keyframe's, in [0, 1]. A detector that
+  /// re-detects every frame matches about half of them a frame later; a host that keeps tracks between
+  /// its own keyframes matches fewer of the culler's keyframe: about 0.6 suits it.
+  double keyframe_min_matched_ratio;
+
+  // --- depth ---
+  /// Raw units per metre of 16-bit depth images the OpenCV overload reads (TUM 5000, most sensors 1000),
+  /// in [1e-3, 1e6]. A plain DepthView carries its own.
+  double depth_units_per_metre;
+  /// The depth sensor's reliable range for the keyframe's 3-D points, in metres (min >= 0, max above it).
+  double min_depth_m, max_depth_m;
+
+  // --- matching to the keyframe (binary descriptors) ---
+  /// Search radius around a keypoint's predicted position, in (0, 4096] px: the prediction's error plus
+  /// keypoint noise (ORB-SLAM2 searches 15 px).
+  double match_radius_px;
+  /// Largest Hamming distance of a match, in bits, in [0, 2048] (at most the descriptor's bits).
+  int match_max_hamming;
+
+  // --- detector boxes ---
+  double box_padding_px;         ///< grown on each side: detectors cut limbs; in [0, 1e4] px
+  double min_box_confidence;     ///< boxes scoring lower are dropped, in [0, 1]
+  double min_person_confidence;  ///< the same for class 0 (people are the movers that matter), in [0, 1]
+  /// Class ids (COCO-80 by default) by how they move (Zhang et al. 2023): high-level boxes are culled,
+  /// medium-level ones only on evidence of their own motion, low-level ones shelter their features from
+  /// the other boxes. A class in no list is ignored.
+  std::vector<int> high_level_classes, medium_level_classes, low_level_classes;
+  /// Frames a box the detector missed is carried forward at its velocity, in [0, 1000].
+  int box_memory_frames;
+
+  // --- geometric evidence ---
+  /// Epipolar distance above which a track is moving (DS-SLAM's 1 px), outside boxes and inside them,
+  /// in (0, 1e4] px.
+  double max_epipolar_distance_px, max_epipolar_distance_in_boxes_px;
+  /// Reprojection residual of a keyframe point at the PnP pose above which it moved, outside boxes and
+  /// inside them, in (0, 1e4] px.
+  double max_reprojection_px, max_reprojection_in_boxes_px;
+  /// Depth residual, in multiples of the sensor's axial noise at that depth, above which a point moved
+  /// along the ray; 0 turns the depth test off; in [0, 1e4].
+  double max_depth_residual_sigmas;
+  /// Depth band of an object behind its box's nearest surface (Zhu et al. 2024's epsilon), in [0, 1e4] m.
+  double object_depth_band_m;
+  /// A sub-box is dynamic when at least this share of its evidence is (DFD-SLAM's sigma1), in [0, 1].
+  double subbox_dynamic_ratio;
+  /// More dynamic sub-boxes than this make the whole box dynamic (DFD-SLAM's sigma2), in [0, 64].
+  int whole_box_min_dynamic_cells;
+  /// A track static this many frames, with a residual below max_residual, is kept against a region's
+  /// cull; frames in [1, 1e6], residual in [0, 1e4] px.
+  int static_history_min_frames;
+  double static_history_max_residual_px;
+  /// RTD-SLAM's multi-view check: depth difference that marks a point dynamic, in (0, 1e4] m, and the
+  /// largest viewing-angle difference checked, in (0, 180] degrees.
+  double multiview_depth_threshold_m, multiview_max_parallax_deg;
+  /// DLD-SLAM's dynamic probability above which a feature is culled, in [0, 1].
+  double probability_threshold;
+
+  // --- survivor guard: never leave the tracker too little ---
+  /// When culling would leave fewer than max(min_survivors, min_survivor_fraction * n) features, the
+  /// softest culls are undone (ORB-SLAM loses tracking below about 30 inliers).
+  std::size_t min_survivors;
+  double min_survivor_fraction;  ///< in [0, 1]
+
+  /// Ok, or InvalidInput with the reason naming the setting.
+  Status validate(std::string* reason = nullptr) const;
+
+ private:
+  std::string preset_;
 };
 
-/// One frame as the host has it: views it keeps valid during Culler::cull. All per-keypoint inputs are
-/// parallel to `keypoints`.
-template <class T>
+/// One detector box after NMS: corners in pixels of the image as detected, [x0, x1] x [y0, y1] with pixel
+/// centres at integers, a class id (COCO-80 by default) and a score in [0, 1].
+struct DetectedBox {
+  float x0, y0, x1, y1;
+  int class_id;
+  float confidence;
+
+  DetectedBox() : x0(0.f), y0(0.f), x1(0.f), y1(0.f), class_id(-1), confidence(1.f) {}
+  DetectedBox(float x0_, float y0_, float x1_, float y1_, int class_id_, float confidence_ = 1.f)
+      : x0(x0_), y0(y0_), x1(x1_), y1(y1_), class_id(class_id_), confidence(confidence_) {}
+};
+
+/// One frame as the host has it: views it keeps valid during Culler::cull. Per-keypoint inputs are
+/// parallel to `keypoints`; every input but the keypoints is optional (Culler::inputs says which the
+/// options read; a frame lacking one is culled by the stages that can run, and the status says so).
 struct CullerFrame {
-  PointsView keypoints;              ///< image pixels, as detected
-  PointsView undistorted_keypoints;  ///< required when CullerOptions::camera_has_distortion
-  DescriptorRows descriptors;        ///< one row per keypoint (data null: not given)
+  PointsView keypoints;              ///< pixels as detected (where the boxes are)
+  PointsView undistorted_keypoints;  ///< the host's undistorted copy (ORB-SLAM's mvKeysUn); absent: undistorted here
+  DescriptorRows descriptors;        ///< one binary row per keypoint (data null: not given)
   DepthView<float> depth_m;          ///< depth in metres, or ...
-  DepthView<std::uint16_t> depth_raw;  ///< ... raw uint16 with units_per_metre (TUM: 5000); neither: monocular
-  const std::vector<Detection<T>>* detections = nullptr;  ///< pixel boxes after NMS (empty: none seen)
-  const Rigid3<T>* cam_from_world = nullptr;  ///< predicted pose (a motion model is enough)
-  /// Host's correspondences: per keypoint the index of its match among the keypoints of the culler's
+  DepthView<std::uint16_t> depth_raw;  ///< ... raw 16-bit with its units_per_metre; neither: monocular
+  const std::vector<DetectedBox>* detections;  ///< boxes after NMS (empty: none seen; null: no detector)
+  /// Predicted cam_from_world as 12 doubles, row-major [R | t] (a motion model is enough); null: none.
+  const double* cam_from_world;
+  /// The host's correspondences: per keypoint the index of its match among the keypoints of the culler's
   /// keyframe (the frame CullerResult::keyframe last reported), -1 for none. Given: no own matching.
-  const int* keyframe_match = nullptr;
-  bool is_keyframe = false;  ///< KeyframePolicy::Host: this frame becomes the reference after culling
+  const int* keyframe_match;
+  bool is_keyframe;  ///< KeyframePolicy::Host: this frame becomes the reference after culling
+
+  CullerFrame() : detections(nullptr), cam_from_world(nullptr), keyframe_match(nullptr), is_keyframe(false) {}
+};
+
+/// Which inputs the options read (Culler::inputs) or a frame lacked (CullerResult::missing).
+struct CullerInputs {
+  bool keypoints, descriptors, depth, detections, pose;
+
+  CullerInputs() : keypoints(false), descriptors(false), depth(false), detections(false), pose(false) {}
+  bool any() const { return keypoints || descriptors || depth || detections || pose; }
+  /// Comma-separated names, e.g. "keypoints, descriptors, depth".
+  std::string names() const {
+    std::string s;
+    const bool on[] = {keypoints, descriptors, depth, detections, pose};
+    const char* name[] = {"keypoints", "descriptors", "depth", "detections", "pose"};
+    for (int k = 0; k < 5; ++k) {
+      if (!on[k]) continue;
+      if (!s.empty()) s += ", ";
+      s += name[k];
+    }
+    return s;
+  }
 };
 
 /// Outcome of one frame; vectors parallel to the frame's keypoints.
 struct CullerResult {
-  /// Ok: every enabled stage did its job. MissingInput: the labels are usable, but part of the input was
-  /// missing or unusable, named in `reason`: an input the configuration reads (`missing`), keypoints with
-  /// a NaN or Inf coordinate (each one culled, reason InvalidInput), a descriptor width other than the
-  /// keyframe's (this frame becomes the keyframe, no tracks), or a stage that could not run (the first
-  /// frame has no keyframe to track against); the stages that could run culled. Another status from the
-  /// pipeline (a stage that could not do its job) is passed on with the labels of the stages that ran.
-  /// refused() (InvalidInput / NonFinite before the pipeline ran): an input cannot be read, the arrays
-  /// disagree in size, or the predicted pose is not rigid; nothing culled, every keep is 1.
-  Status status = Status::Ok;
+  /// Ok: every stage the options enable did its job. MissingInput: the labels are usable, but part of
+  /// the input was missing or unusable, named in `reason`: an input the options read (`missing`),
+  /// keypoints with a NaN or Inf coordinate (each culled, reason InvalidInput), a descriptor width other
+  /// than the keyframe's (this frame becomes the keyframe), or a stage that could not run (the first
+  /// frame has no keyframe); the stages that could run culled. Another status from the pipeline (a stage
+  /// that could not do its job) is passed on with the labels of the stages that ran.
+  /// refused: InvalidInput or NonFinite before culling (an input cannot be read, arrays disagree in size,
+  /// the pose is not rigid, the camera or options are bad); nothing culled, every keep is 1.
+  Status status;
   std::string reason;
   bool ok() const { return status == Status::Ok; }
-  /// The frame was refused before culling: every keep is 1, no keyframe, no track ids (-1).
-  bool refused = false;
+  bool refused;  ///< the frame was refused before culling: every keep 1, no keyframe, track ids -1
 
-  std::vector<std::uint8_t> keep;     ///< 1 = static: apply to every parallel array of the host
-  std::vector<FeatureLabel> labels;   ///< Static or Dynamic
-  std::vector<CullReason> reasons;    ///< deciding stage (None for untouched statics)
+  std::vector<std::uint8_t> keep;       ///< 1 = static: apply to every parallel array of the host (compact)
+  std::vector<FeatureLabel> labels;     ///< Static or Dynamic
+  std::vector<CullReason> reasons;      ///< deciding stage (None for untouched statics)
   std::vector<std::int64_t> track_ids;  ///< the keyframe point's id when matched, else a new id
-  std::size_t num_features = 0, num_kept = 0;
-  std::size_t matched = 0;            ///< keypoints matched to the keyframe
-  int frames_since_keyframe = 0;      ///< baseline of this frame's evidence (0: no keyframe yet)
-  bool keyframe = false;              ///< this frame became the reference keyframe
-  CullerInputs missing;               ///< inputs the configuration reads that this frame lacked
+  std::size_t num_features, num_kept;
+  std::size_t matched;        ///< keypoints matched to the keyframe
+  int frames_since_keyframe;  ///< baseline of this frame's evidence (0: no keyframe yet)
+  bool keyframe;              ///< this frame became the reference keyframe
+  CullerInputs missing;       ///< inputs the options read that this frame lacked
+
+  CullerResult()
+      : status(Status::Ok), refused(false), num_features(0), num_kept(0), matched(0), frames_since_keyframe(0),
+        keyframe(false) {}
 };
 
-/// Owns the reference keyframe and the pipeline state; one per camera stream. Not thread-safe.
-template <class T>
+/// One camera stream's culler. Not thread-safe; movable, not copyable. A bad camera or bad options make
+/// status() say why at once and every cull() refuse (keep all).
 class Culler {
  public:
-  static_assert(std::is_floating_point<T>::value, "dyncull::Culler: T is float or double");
-  /// Widest descriptor row the keyframe matcher takes (ORB 32, BRISK 64, BinBoost / LATCH up to 64).
-  static constexpr std::size_t kMaxDescriptorBytes = 256;
+  explicit Culler(const CullerCamera& camera, const CullerOptions& options = CullerOptions());
+  ~Culler();
+  Culler(Culler&& other) noexcept;
+  Culler& operator=(Culler&& other) noexcept;
+  Culler(const Culler&) = delete;
+  Culler& operator=(const Culler&) = delete;
 
-  /// `camera`: the pinhole model of the (undistorted) keypoints; an invalid camera or options make every
-  /// cull() return InvalidInput with the reason (status() says it at once).
-  explicit Culler(const PinholeCamera<T>& camera, const CullerOptions<T>& options = CullerOptions<T>())
-      : camera_(camera), options_(options) {
-    std::string why;
-    if (camera_.validate(&why) != Status::Ok) {
-      status_ = Status::InvalidInput;
-      reason_ = "camera: " + why + " (no default intrinsics)";
-    } else {
-      status_ = options_.validate(&reason_);
-    }
-  }
+  Status status() const;
+  const std::string& reason() const;
+  bool ok() const { return status() == Status::Ok; }
+  const CullerOptions& options() const;
+  const CullerCamera& camera() const;
+  /// The inputs the options read; a frame lacking one gets MissingInput naming it.
+  CullerInputs inputs() const;
 
-  Status status() const { return status_; }
-  const std::string& reason() const { return reason_; }
-  const CullerOptions<T>& options() const { return options_; }
-  const PinholeCamera<T>& camera() const { return camera_; }
-
-  /// The inputs this configuration reads; a frame lacking one gets a non-Ok status naming it.
-  CullerInputs inputs() const { return inputs_of(options_); }
-
-  static CullerInputs inputs_of(const CullerOptions<T>& o) {
-    const PipelineOptions<T>& p = o.pipeline;
-    CullerInputs in;
-    in.keypoints = true;
-    const bool tracks = p.moving_consistency.enabled || p.reprojection.enabled || p.probability.enabled ||
-                        p.subbox.enabled || p.static_history.enabled;
-    in.descriptors = tracks;
-    in.depth = p.depth_mask.enabled || p.reprojection.enabled || p.multiview.enabled || p.edge_evidence.enabled ||
-               p.depth_mask.low_override_by_depth || p.depth_mask.assign_overlaps_by_depth;
-    in.detections =
-        p.box_rule.enabled || p.depth_mask.enabled || p.probability.enabled || p.subbox.enabled || p.tracker.enabled;
-    in.pose = p.reprojection.enabled || p.multiview.enabled || (tracks && o.keyframe_policy == KeyframePolicy::Own);
-    return in;
-  }
-
-  /// Culls one frame and, when the policy says so, makes it the reference keyframe. The result is valid
-  /// until the next call.
-  const CullerResult& cull(const CullerFrame<T>& f) {
-    CullerResult& r = begin_result(f.keypoints.given ? f.keypoints.count : 0);
-    const std::size_t n = r.num_features;
-    std::string why;
-    Status s = check_frame(f, n, &why);
-    if (s != Status::Ok) return refuse_frame(s, why, n);
-    const std::string dropped = drop_keyframe_of_another_width(f, &r);
-    NonFinite bad;
-    read_positions(f, n, &bad);
-    const bool have_depth = !f.depth_m.empty() || !f.depth_raw.empty();
-    const bool have_pose = f.cam_from_world != nullptr;
-    note_missing(f, n, have_depth, have_pose, &r);
-    const Rigid3<T> pose = have_pose ? *f.cam_from_world : (have_keyframe_ ? keyframe_pose_ : Rigid3<T>::identity());
-    if (!match_keyframe(f, n, pose, have_pose, &why, &s)) return refuse_frame(s, why, n);
-    carry_tracks(f, n, &r);
-    const bool new_keyframe = decide_keyframe(f, n, pose, r.matched);
-    const PipelineResult<T>& pr = run_pipeline(f, have_pose, pose, new_keyframe, &r);
-    take_pipeline_result(pr, n, &r);
-    if (bad.count[0] > 0) append_non_finite("keypoints", bad.count[0], bad.first[0], &r.reason);
-    if (bad.count[1] > 0) append_non_finite("undistorted_keypoints", bad.count[1], bad.first[1], &r.reason);
-    if (!dropped.empty()) append(dropped, &r.reason);
-    if (!r.reason.empty()) r.status = Status::MissingInput;
-    describe(pr, have_pose, have_depth, dropped.empty(), &r);
-    if (new_keyframe && pr.keep.size() == n) {
-      if (!f.depth_raw.empty())
-        store_keyframe(f, f.depth_raw, pose);
-      else
-        store_keyframe(f, f.depth_m, pose);
-      r.keyframe = true;
-    } else if (have_keyframe_) {
-      ++frames_since_keyframe_;
-    }
-    return r;
-  }
-
-  /// Forgets the keyframe, the tracks and the pipeline's state, as if newly constructed with the same
-  /// camera and options (a new sequence, or a host that lost track). Buffers are kept.
-  void reset() {
-    forget_keyframe();
-    state_.reset();
-    next_id_ = 0;
-    begin_result(0);
-  }
-
-  /// Reports the frame of `n` keypoints as refused with `status` and `why` (every keep 1, nothing
-  /// culled, no keyframe), as cull() does for an input it cannot read. For the adapters (opencv/culler.hpp)
-  /// that read their own containers first: their refusals then match cull()'s field for field.
-  const CullerResult& refuse_frame(Status status, std::string why, std::size_t n) {
-    CullerResult& r = begin_result(n);
-    r.status = status;
-    r.reason = std::move(why);
-    r.refused = true;
-    r.keep.assign(n, 1);
-    r.labels.assign(n, FeatureLabel::Static);
-    r.reasons.assign(n, CullReason::None);
-    r.track_ids.assign(n, -1);
-    r.num_kept = n;
-    return r;
-  }
-
+  /// Culls one frame and, when the keyframe policy says so, makes it the reference keyframe. The result
+  /// is valid until the next call.
+  const CullerResult& cull(const CullerFrame& frame);
+  /// Reports a frame of `n` keypoints as refused with `status` and `why` (every keep 1, nothing culled,
+  /// no keyframe), as cull() does for an input it cannot read: for adapters that read their own
+  /// containers first (opencv/culler.hpp), so their refusals match cull()'s field for field.
+  const CullerResult& refuse(Status status, const std::string& why, std::size_t n);
   /// The last cull()'s result.
-  const CullerResult& result() const { return result_; }
-  /// The pipeline's full result of the last cull() (per-stage reports, traces).
-  const PipelineResult<T>& pipeline_result() const { return state_.result; }
-  /// Keypoints of the reference keyframe (geometry positions), in the order CullerFrame::keyframe_match indexes.
-  const std::vector<Vec2<T>>& keyframe_keypoints() const { return keyframe_px_; }
-  bool has_keyframe() const { return have_keyframe_; }
+  const CullerResult& result() const;
+  /// Forgets the keyframe, the tracks and the pipeline's state, as if newly constructed (a new sequence,
+  /// or a host that lost track or restarted its map); the camera and options stay.
+  void reset();
+  /// Keypoints in the reference keyframe, the range CullerFrame::keyframe_match indexes (0: none yet).
+  std::size_t keyframe_size() const;
 
  private:
-  /// Keypoints with a NaN or Inf coordinate: count and first index, [0] in keypoints, [1] only in the
-  /// undistorted ones.
-  struct NonFinite {
-    std::size_t count[2] = {0, 0}, first[2] = {0, 0};
-  };
-
-  /// A descriptor width other than the keyframe's cannot be matched to it: the keyframe is forgotten and
-  /// this frame starts anew. Returns the reason, or empty.
-  std::string drop_keyframe_of_another_width(const CullerFrame<T>& f, CullerResult* r) {
-    if (!have_keyframe_ || f.keyframe_match != nullptr || f.descriptors.data == nullptr || keyframe_desc_rows_ == 0 ||
-        f.descriptors.row_bytes == keyframe_row_bytes_)
-      return std::string();
-    forget_keyframe();
-    r->frames_since_keyframe = 0;
-    return "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) + " bytes where the keyframe's have " +
-           std::to_string(keyframe_row_bytes_) + ": not matched, this frame becomes the keyframe";
-  }
-
-  /// The positions the geometry reads (cur_px_): undistorted when given; a point non-finite in either
-  /// form is NaN there, flagged in non_finite_ and culled at the end.
-  void read_positions(const CullerFrame<T>& f, std::size_t n, NonFinite* bad) {
-    const PointsView& geo = f.undistorted_keypoints.given ? f.undistorted_keypoints : f.keypoints;
-    const T nan = std::numeric_limits<T>::quiet_NaN();
-    cur_px_.resize(n);
-    non_finite_.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      // Read in T: a double beyond float's range is an infinity to Culler<float>.
-      const Vec2<T> raw(static_cast<T>(f.keypoints.x(i)), static_cast<T>(f.keypoints.y(i)));
-      const Vec2<T> p = &geo == &f.keypoints ? raw : Vec2<T>(static_cast<T>(geo.x(i)), static_cast<T>(geo.y(i)));
-      const bool raw_ok = std::isfinite(raw.x()) && std::isfinite(raw.y());
-      const bool geo_ok = std::isfinite(p.x()) && std::isfinite(p.y());
-      cur_px_[i] = raw_ok && geo_ok ? p : Vec2<T>(nan, nan);
-      if (raw_ok && geo_ok) continue;
-      non_finite_[i] = 1;
-      const int which = raw_ok ? 1 : 0;  // named by the argument that holds the NaN or Inf
-      if (bad->count[which]++ == 0) bad->first[which] = i;
-    }
-  }
-
-  /// The inputs the configuration reads that this frame lacks.
-  void note_missing(const CullerFrame<T>& f, std::size_t n, bool have_depth, bool have_pose, CullerResult* r) const {
-    const CullerInputs need = inputs();
-    r->missing.depth = need.depth && !have_depth;
-    r->missing.detections = need.detections && f.detections == nullptr;
-    // A frame without keypoints has no descriptor rows to give: nothing is missing.
-    r->missing.descriptors = need.descriptors && n > 0 && f.descriptors.data == nullptr && f.keyframe_match == nullptr;
-    r->missing.pose = need.pose && !have_pose;
-  }
-
-  /// The correspondences to the keyframe: the host's (check_frame copied them into match_index_) or the
-  /// culler's own matching of the descriptors. False (status and reason set) when the matcher refuses.
-  bool match_keyframe(const CullerFrame<T>& f, std::size_t n, const Rigid3<T>& pose, bool have_pose,
-                      std::string* why, Status* status) {
-    if (!have_keyframe_ || f.keyframe_match) return true;
-    if (f.descriptors.data == nullptr || keyframe_desc_rows_ == 0) {
-      match_.keyframe_index.assign(n, -1);
-      return true;
-    }
-    const Rigid3<T> cam_from_keyframe = pose * keyframe_pose_.inverse();
-    match_to_keyframe(keyframe_px_, keyframe_cam_points_,
-                      DescriptorRows(keyframe_desc_.data(), keyframe_desc_rows_, 0, keyframe_row_bytes_), cur_px_,
-                      f.descriptors, camera_, have_pose ? &cam_from_keyframe : nullptr, options_.matching, match_ws_,
-                      &match_);
-    if (match_.status != Status::InvalidInput && match_.status != Status::NonFinite) return true;
-    *status = match_.status;
-    *why = match_.reason;
-    return false;
-  }
-
-  /// The evidence arrays from the correspondences: a matched keypoint carries its keyframe point's
-  /// pixel, 3-D point and track id; any other gets a new id.
-  void carry_tracks(const CullerFrame<T>& f, std::size_t n, CullerResult* r) {
-    const T nan = std::numeric_limits<T>::quiet_NaN();
-    prev_px_.assign(n, Vec2<T>(nan, nan));
-    valid_.assign(n, 0);
-    points_world_.assign(n, Vec3<T>(nan, nan, nan));
-    r->track_ids.resize(n);
-    const std::vector<int>& m = f.keyframe_match || !have_keyframe_ ? match_index_ : match_.keyframe_index;
-    for (std::size_t i = 0; i < n; ++i) {
-      const int k = have_keyframe_ && !non_finite_[i] ? m[i] : -1;
-      if (k >= 0) {
-        const std::size_t ku = static_cast<std::size_t>(k);
-        prev_px_[i] = keyframe_px_[ku];
-        valid_[i] = 1;
-        points_world_[i] = keyframe_world_points_[ku];
-        r->track_ids[i] = keyframe_ids_[ku];
-        ++r->matched;
-      } else {
-        r->track_ids[i] = next_id_++;
-      }
-    }
-  }
-
-  /// Whether this frame becomes the reference keyframe, decided before the pipeline (its multi-view store
-  /// takes this frame's static features): the host's flag, or the own policy's motion and match ratio.
-  bool decide_keyframe(const CullerFrame<T>& f, std::size_t n, const Rigid3<T>& pose, std::size_t matched) const {
-    if (!have_keyframe_) return true;
-    if (options_.keyframe_policy == KeyframePolicy::Host) return f.is_keyframe;
-    if (options_.keyframe_policy != KeyframePolicy::Own) return false;
-    const Rigid3<T> rel = pose * keyframe_pose_.inverse();
-    const double moved = static_cast<double>(rel.t.norm());
-    const double turned = static_cast<double>(rotation_angle(rel.R)) * Constants<double>::rad_to_deg();
-    const double base = static_cast<double>(keyframe_px_.size() < n ? keyframe_px_.size() : n);
-    // A keyframe without keypoints (a front end that detects after its first frame) matches nothing and
-    // the ratio rule cannot see it: the first frame with keypoints replaces it.
-    const bool empty_keyframe = keyframe_px_.empty() && n > 0;
-    return empty_keyframe || moved > options_.keyframe_max_translation_m ||
-           turned > options_.keyframe_max_rotation_deg ||
-           static_cast<double>(matched) < options_.keyframe_min_matched_ratio * base;
-  }
-
-  /// cull_frame on the evidence gathered, with the frame's float or 16-bit depth.
-  const PipelineResult<T>& run_pipeline(const CullerFrame<T>& f, bool have_pose, const Rigid3<T>& pose,
-                                        bool new_keyframe, CullerResult* r) {
-    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, float, std::vector<Vec3<T>>> pf;
-    pf.keypoints = &cur_px_;
-    if (have_keyframe_) {
-      pf.prev_keypoints = &prev_px_;
-      pf.track_valid = valid_;
-      // Without a pose the residuals of the 3-D points would be the camera's own motion.
-      if (have_pose && keyframe_has_depth_) pf.points_3d = &points_world_;
-      pf.evidence_frames = r->frames_since_keyframe;
-    }
-    pf.track_ids = &r->track_ids;
-    pf.detections = f.detections;
-    pf.camera = camera_;
-    pf.cam_from_world = have_pose ? &pose : nullptr;
-    // Only the multi-view check reads the pipeline's keyframe store; filling it otherwise costs allocations.
-    pf.is_keyframe = new_keyframe && options_.pipeline.multiview.enabled;
-    if (f.depth_raw.empty()) {
-      pf.depth = f.depth_m;
-      return cull_frame(pf, options_.pipeline, &state_);
-    }
-    CullingFrame<T, std::vector<Vec2<T>>, std::vector<Vec2<T>>, std::uint16_t, std::vector<Vec3<T>>> pu;
-    copy_frame(pf, &pu);
-    pu.depth = f.depth_raw;
-    return cull_frame(pu, options_.pipeline, &state_);
-  }
-
-  /// The pipeline's keep mask, labels and reasons; a non-finite keypoint is culled whatever the stages
-  /// and the survivor guard said.
-  void take_pipeline_result(const PipelineResult<T>& pr, std::size_t n, CullerResult* r) const {
-    r->keep = pr.keep;
-    r->labels = pr.labels;
-    r->reasons = pr.reasons;
-    if (r->keep.size() == n) {
-      for (std::size_t i = 0; i < n; ++i) {
-        if (!non_finite_[i]) continue;
-        r->keep[i] = 0;
-        r->labels[i] = FeatureLabel::Dynamic;
-        r->reasons[i] = CullReason::InvalidInput;
-      }
-    }
-    r->num_kept = 0;
-    for (std::uint8_t k : r->keep) r->num_kept += k != 0;
-  }
-
-  /// Clears the result for a frame of n keypoints; frames_since_keyframe as the frame would see it.
-  CullerResult& begin_result(std::size_t n) {
-    CullerResult& r = result_;
-    r.status = Status::Ok;
-    r.reason.clear();
-    r.refused = false;
-    r.missing = CullerInputs{};
-    r.num_features = n;
-    r.num_kept = 0;
-    r.matched = 0;
-    r.keyframe = false;
-    r.frames_since_keyframe = have_keyframe_ ? frames_since_keyframe_ + 1 : 0;
-    if (n == 0) {
-      r.keep.clear();
-      r.labels.clear();
-      r.reasons.clear();
-      r.track_ids.clear();
-    }
-    return r;
-  }
-
-  void forget_keyframe() {
-    have_keyframe_ = false;
-    keyframe_has_depth_ = false;
-    frames_since_keyframe_ = 0;
-    keyframe_pose_ = Rigid3<T>::identity();
-    keyframe_px_.clear();
-    keyframe_cam_points_.clear();
-    keyframe_world_points_.clear();
-    keyframe_ids_.clear();
-    keyframe_desc_rows_ = 0;
-  }
-
-  static void append(const std::string& part, std::string* s) {
-    if (!s->empty()) *s += "; ";
-    *s += part;
-  }
-
-  static void append_non_finite(const char* name, std::size_t count, std::size_t first, std::string* s) {
-    std::string part = std::string(name) + "[" + std::to_string(first) + "]";
-    if (count > 1) part += " and " + std::to_string(count - 1) + (count == 2 ? " other" : " others");
-    part += count > 1 ? " have" : " has";
-    append(part + " a NaN or Inf coordinate: culled", s);
-  }
-
-  /// InvalidInput / NonFinite with the reason naming the input, or Ok.
-  Status check_frame(const CullerFrame<T>& f, std::size_t n, std::string* why) {
-    if (status_ != Status::Ok) return (*why = reason_, status_);
-    if (!f.keypoints.given) return (*why = "missing input: keypoints", Status::InvalidInput);
-    Status s = culler_checks::check_points(f.keypoints, "keypoints", why);
-    if (s != Status::Ok) return s;
-    if (options_.camera_has_distortion && !f.undistorted_keypoints.given)
-      return (*why = "missing input: undistorted_keypoints (the camera has distortion; the geometry needs them)",
-              Status::InvalidInput);
-    if (f.undistorted_keypoints.given && f.undistorted_keypoints.count != n)
-      return (*why = "undistorted_keypoints has " + std::to_string(f.undistorted_keypoints.count) + " points for " +
-                     std::to_string(n) + " keypoints",
-              Status::InvalidInput);
-    s = culler_checks::check_points(f.undistorted_keypoints, "undistorted_keypoints", why);
-    if (s != Status::Ok) return s;
-    if (f.descriptors.data != nullptr && f.descriptors.rows != n)
-      return (*why = "descriptors has " + std::to_string(f.descriptors.rows) + " rows for " + std::to_string(n) +
-                     " keypoints",
-              Status::InvalidInput);
-    if (f.descriptors.data != nullptr && (f.descriptors.row_bytes == 0 || f.descriptors.stride() < f.descriptors.row_bytes))
-      return (*why = "descriptors: row_bytes must be positive and at most the stride", Status::InvalidInput);
-    if (f.descriptors.data != nullptr && f.descriptors.row_bytes > kMaxDescriptorBytes)
-      return (*why = "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) +
-                     " bytes; the keyframe matcher takes 1 to 256",
-              Status::InvalidInput);
-    if (f.descriptors.data != nullptr && 8 * f.descriptors.row_bytes < static_cast<std::size_t>(options_.matching.max_hamming))
-      return (*why = "descriptors: rows of " + std::to_string(f.descriptors.row_bytes) + " bytes (" +
-                     std::to_string(8 * f.descriptors.row_bytes) + " bits) are shorter than matching.max_hamming = " +
-                     std::to_string(options_.matching.max_hamming) + " bits",
-              Status::InvalidInput);
-    if (!f.depth_m.empty() && !f.depth_raw.empty())
-      return (*why = "depth: give depth_m (metres) or depth_raw (uint16), not both", Status::InvalidInput);
-    std::string d;
-    if (f.depth_m.validate(&d) != Status::Ok || f.depth_raw.validate(&d) != Status::Ok)
-      return (*why = "depth: " + d, Status::InvalidInput);
-    const int dw = !f.depth_m.empty() ? f.depth_m.width : f.depth_raw.width;
-    const int dh = !f.depth_m.empty() ? f.depth_m.height : f.depth_raw.height;
-    if ((!f.depth_m.empty() || !f.depth_raw.empty()) && (dw != camera_.width || dh != camera_.height))
-      return (*why = "depth: " + std::to_string(dw) + "x" + std::to_string(dh) + " for an image of " +
-                     std::to_string(camera_.width) + "x" + std::to_string(camera_.height),
-              Status::InvalidInput);
-    if (f.cam_from_world && (s = culler_checks::check_pose(*f.cam_from_world, "cam_from_world", why)) != Status::Ok)
-      return s;
-    if (f.keyframe_match) {
-      const std::size_t nk = have_keyframe_ ? keyframe_px_.size() : 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        const int k = f.keyframe_match[i];
-        if (k < -1 || (k >= 0 && static_cast<std::size_t>(k) >= nk))
-          return (*why = "keyframe_match[" + std::to_string(i) + "] = " + std::to_string(k) +
-                         " is not -1 or an index of the keyframe's " + std::to_string(nk) + " keypoints",
-                  Status::InvalidInput);
-      }
-      match_index_.assign(f.keyframe_match, f.keyframe_match + n);
-    }
-    why->clear();
-    return Status::Ok;
-  }
-
-  template <class A, class B>
-  static void copy_frame(const A& a, B* b) {
-    b->keypoints = a.keypoints;
-    b->prev_keypoints = a.prev_keypoints;
-    b->track_valid = a.track_valid;
-    b->track_ids = a.track_ids;
-    b->points_3d = a.points_3d;
-    b->detections = a.detections;
-    b->camera = a.camera;
-    b->cam_from_world = a.cam_from_world;
-    b->is_keyframe = a.is_keyframe;
-    b->evidence_frames = a.evidence_frames;
-  }
-
-  /// Status and reason after the frame's own (non-finite keypoints, a new descriptor width): the missing
-  /// inputs, then the pipeline's. The status is the first non-Ok one.
-  void describe(const PipelineResult<T>& pr, bool have_pose, bool have_depth, bool say_first_frame,
-                CullerResult* r) const {
-    std::string& s = r->reason;
-    if (r->missing.any()) {
-      r->status = Status::MissingInput;
-      append("missing input: " + r->missing.names(), &s);
-      if (r->missing.depth)
-        s += "; monocular (no depth): the depth mask and the reprojection check did not run, epipolar evidence only";
-      if (r->missing.descriptors) s += "; no descriptors and no keyframe_match: no tracks, box evidence only";
-      if (r->missing.pose) s += "; no predicted pose: the keyframe's pose stands in (no motion prior)";
-      if (r->missing.detections) s += "; no detections: the box stages did not run";
-    } else if (!have_pose && have_depth && options_.pipeline.reprojection.enabled) {
-      append("no predicted pose: the reprojection check did not run", &s);
-    }
-    if (!have_keyframe_ && say_first_frame) append("first frame: no keyframe yet, no track evidence", &s);
-    if (!pr.ok()) {
-      // The worst wins: a stage that could not do its job outranks a missing input.
-      if (r->status == Status::Ok || (r->status == Status::MissingInput && pr.status != Status::MissingInput))
-        r->status = pr.status;
-      append("pipeline: " + pr.reason, &s);
-    }
-  }
-
-  template <class Raw>
-  void store_keyframe(const CullerFrame<T>& f, const DepthView<Raw>& depth, const Rigid3<T>& pose) {
-    const std::size_t n = cur_px_.size();
-    keyframe_px_.swap(cur_px_);
-    keyframe_ids_.assign(result_.track_ids.begin(), result_.track_ids.end());
-    keyframe_pose_ = pose;
-    const Rigid3<T> world_from_cam = pose.inverse();
-    const T nan = std::numeric_limits<T>::quiet_NaN();
-    keyframe_cam_points_.assign(n, Vec3<T>(nan, nan, nan));
-    keyframe_world_points_.assign(n, Vec3<T>(nan, nan, nan));
-    keyframe_has_depth_ = !depth.empty();
-    if (keyframe_has_depth_) {
-      const int r = options_.depth_edge_radius_px;
-      for (std::size_t i = 0; i < n; ++i) {
-        // Depth where the keypoint is in the image (as detected), ray through its undistorted position.
-        int x = 0, y = 0;
-        if (!pixel_of(f.keypoints.x(i), f.keypoints.y(i), depth.width, depth.height, &x, &y)) continue;
-        if (x < r || y < r || x >= depth.width - r || y >= depth.height - r) continue;
-        const float z = depth.depth_m(x, y);
-        if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
-        if (r > 0 && depth_step_near(depth, x, y, r, options_.max_depth_step_ratio)) continue;
-        const Vec2<T>& p = keyframe_px_[i];
-        if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
-        keyframe_cam_points_[i] = camera_.backproject(p, static_cast<T>(z));
-        keyframe_world_points_[i] = world_from_cam.apply(keyframe_cam_points_[i]);
-      }
-    } else {
-      keyframe_cam_points_.clear();  // the matcher's "no depth at all"
-    }
-    keyframe_desc_rows_ = 0;
-    if (f.descriptors.data != nullptr) {
-      keyframe_row_bytes_ = f.descriptors.row_bytes;
-      keyframe_desc_.resize(n * keyframe_row_bytes_);
-      for (std::size_t i = 0; i < n; ++i)
-        std::memcpy(keyframe_desc_.data() + i * keyframe_row_bytes_, f.descriptors.row(i), keyframe_row_bytes_);
-      keyframe_desc_rows_ = n;
-    }
-    frames_since_keyframe_ = 0;
-    have_keyframe_ = true;
-  }
-
-  PinholeCamera<T> camera_;
-  CullerOptions<T> options_;
-  Status status_ = Status::Ok;
-  std::string reason_;
-  PipelineState<T> state_;
-  CullerResult result_;
-
-  // Reference keyframe.
-  bool have_keyframe_ = false;
-  bool keyframe_has_depth_ = false;
-  int frames_since_keyframe_ = 0;
-  Rigid3<T> keyframe_pose_;  // cam_from_world
-  std::vector<Vec2<T>> keyframe_px_;
-  std::vector<Vec3<T>> keyframe_cam_points_, keyframe_world_points_;
-  std::vector<std::int64_t> keyframe_ids_;
-  std::vector<std::uint8_t> keyframe_desc_;
-  std::size_t keyframe_desc_rows_ = 0, keyframe_row_bytes_ = 32;
-  std::int64_t next_id_ = 0;
-
-  // Per-frame buffers, reused.
-  std::vector<Vec2<T>> cur_px_, prev_px_;
-  std::vector<Vec3<T>> points_world_;
-  std::vector<std::uint8_t> valid_, non_finite_;
-  std::vector<int> match_index_;  // the host's keyframe_match, checked
-  KeyframeMatchWorkspace<T> match_ws_;
-  KeyframeMatchResult<T> match_;
+  struct Impl;
+  Impl& impl();  // a moved-from culler gets one that refuses every frame
+  std::unique_ptr<Impl> impl_;
 };
+
+/// Removes, in place and stably, the elements with keep[i] == 0 from every std::vector given (each
+/// parallel to keep). Returns the new size, or -1 and touches nothing when a vector's size differs.
+template <class... Vectors>
+long compact(const std::vector<std::uint8_t>& keep, Vectors&... vectors);
+
+namespace detail {
+template <class V>
+void compact_one(const std::vector<std::uint8_t>& keep, V& v) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < keep.size(); ++i) {
+    if (!keep[i]) continue;
+    if (kept != i) v[kept] = v[i];
+    ++kept;
+  }
+  v.erase(v.begin() + static_cast<std::ptrdiff_t>(kept), v.end());
+}
+}  // namespace detail
+
+template <class... Vectors>
+long compact(const std::vector<std::uint8_t>& keep, Vectors&... vectors) {
+  const std::size_t n = keep.size();
+  const std::size_t sizes[] = {n, static_cast<std::size_t>(vectors.size())...};
+  for (std::size_t a = 0; a < sizeof(sizes) / sizeof(sizes[0]); ++a)
+    if (sizes[a] != n) return -1;
+  const int expand[] = {0, (detail::compact_one(keep, vectors), 0)...};
+  (void)expand;
+  long kept = 0;
+  for (std::size_t i = 0; i < n; ++i) kept += keep[i] != 0;
+  return kept;
+}
 
 }  // namespace dyncull

@@ -20,6 +20,7 @@
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
+#include "dyncull/core/views.hpp"
 #include "dyncull/geometry/point_grid.hpp"
 
 #include <cmath>
@@ -32,29 +33,6 @@
 #include <vector>
 
 namespace dyncull {
-
-/// Read-only rows of binary descriptors: row i starts at data + i * stride_bytes and has row_bytes bytes
-/// (ORB: 32). A cv::Mat of descriptors is DescriptorRows(m.ptr(0), m.rows, m.step, m.cols). Anything with
-/// the members data, rows, row_bytes and stride() (culling/keep_mask.hpp's RowsView) converts.
-struct DescriptorRows {
-  const std::uint8_t* data = nullptr;
-  std::size_t rows = 0;
-  std::size_t stride_bytes = 0;  ///< 0 means row_bytes
-  std::size_t row_bytes = 32;
-
-  DescriptorRows() = default;
-  DescriptorRows(const std::uint8_t* data_, std::size_t rows_, std::size_t stride_bytes_ = 0,
-                 std::size_t row_bytes_ = 32)
-      : data(data_), rows(rows_), stride_bytes(stride_bytes_), row_bytes(row_bytes_) {}
-  template <class R, class = decltype(std::declval<const R&>().stride()),
-            class = decltype(std::declval<const R&>().row_bytes), class = decltype(std::declval<const R&>().rows),
-            class = decltype(std::declval<const R&>().data)>
-  DescriptorRows(const R& view)  // NOLINT: implicit on purpose, RowsView reads as DescriptorRows
-      : data(view.data), rows(view.rows), stride_bytes(view.stride()), row_bytes(view.row_bytes) {}
-
-  std::size_t stride() const { return stride_bytes ? stride_bytes : row_bytes; }
-  const std::uint8_t* row(std::size_t i) const { return data + i * stride(); }
-};
 
 struct KeyframeMatchOptions {
   /// Search radius (px) around a keyframe point's prediction through the pose and its depth: the pose

@@ -3,6 +3,8 @@
 /// Three-valued labels follow RTD-SLAM (Gao et al. 2024) §III.D: medium-level objects are sent to geometric verification.
 #pragma once
 
+#include "dyncull/core/status.hpp"
+
 #include <cstdint>
 
 namespace dyncull {
@@ -28,7 +30,7 @@ enum class CullReason : std::uint8_t {
   InvalidInput,       ///< non-finite coordinates: never trusted as static
 };
 
-constexpr const char* to_string(FeatureLabel label) noexcept {
+DYNCULL_CONSTEXPR14 const char* to_string(FeatureLabel label) noexcept {
   switch (label) {
     case FeatureLabel::Static: return "static";
     case FeatureLabel::Candidate: return "candidate";
@@ -37,7 +39,7 @@ constexpr const char* to_string(FeatureLabel label) noexcept {
   return "unknown";
 }
 
-constexpr const char* to_string(CullReason reason) noexcept {
+DYNCULL_CONSTEXPR14 const char* to_string(CullReason reason) noexcept {
   switch (reason) {
     case CullReason::None: return "none";
     case CullReason::HighLevelBox: return "high-level box";

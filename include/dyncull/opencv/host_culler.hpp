@@ -10,7 +10,7 @@
 ///   // or, for any host: const std::vector<std::uint8_t>* keep = culler.cull(stamp, frame_id, ...);
 #pragma once
 
-#include "dyncull/opencv/compiled_culler.hpp"
+#include "dyncull/opencv/culler.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -34,7 +34,7 @@ class HostCuller {
 
   struct Settings {
     Mode mode;
-    std::string preset;              ///< the culler's preset (CompiledCuller::Options::preset)
+    std::string preset;              ///< the culler's preset (CullerOptions)
     std::string detections_dir;      ///< NNNNNN.json per frame with `timestamp` = the image stamp
     double stamp_tolerance_s;        ///< a detections file matches an image within this many seconds
     std::string log_path;            ///< per-frame CSV log; empty: none
@@ -107,7 +107,7 @@ int cull_orb_slam_frame(HostCuller& culler, Frame& frame, cv::Size image_size, c
       culler.cull(frame.mTimeStamp, static_cast<unsigned long>(frame.mnId), K, distortion, image_size, frame.mvKeys,
                   frame.mvKeysUn, frame.mDescriptors, depth, predicted_Tcw);
   if (!keep) return frame.N;
-  const long n = CompiledCuller::compact(*keep, frame.mDescriptors, frame.mvKeys, frame.mvKeysUn, frame.mvuRight,
+  const long n = compact(*keep, frame.mDescriptors, frame.mvKeys, frame.mvKeysUn, frame.mvuRight,
                                          frame.mvDepth);
   if (n < 0) return frame.N;
   frame.N = static_cast<int>(n);
