@@ -2,6 +2,9 @@
 // the headers define the solvers inline and cull_frame is instantiated here, for keypoints held as a plain
 // xy struct (a frame type the library does not hold).
 #undef DYNCULL_PRECOMPILED
+// The mixing rule's link guard (core/precompiled.hpp) is off in this test only: comparing the two forms in
+// one binary is its purpose, and both come from the same source tree and flags.
+#define DYNCULL_UNGUARDED_MIXING
 
 #include "culling/pipeline_precompiled_runs.hpp"
 
