@@ -1,8 +1,10 @@
-// The stateful culler's whole per-frame cost (culling/culler.hpp: its own guided matching to the keyframe,
-// the keyframe's 3-D points, the recommended pipeline, the keyframe policy) on ~1000 ORB features of the
+// The stateful culler's whole per-frame cost, templated core (culling/culler_core.hpp) and compiled public
+// culler (culling/culler.hpp): its own guided matching to the keyframe, the keyframe's 3-D points, the
+// recommended pipeline, the keyframe policy, on ~1000 ORB features of the
 // 640x480 synthetic walking scene, next to cv::ORB detectAndCompute of the same frames in the same binary.
 // Counter `vs_orb` = the culler's CPU time per frame / ORB's on the same frames (target <= 0.35);
 // `keyframes` = share of frames that became keyframes.
+#include "dyncull/culling/culler.hpp"
 #include "dyncull/culling/culler_core.hpp"
 
 #include "dyncull/sim/scene.hpp"
@@ -17,6 +19,8 @@
 #include "culling/cpu_time.hpp"
 
 #include <algorithm>
+#include <array>
+#include <memory>
 #include <chrono>
 #include <cstdint>
 #include <vector>
@@ -82,23 +86,28 @@ const Sequence& sequence() {
   return seq;
 }
 
-/// One pass over the sequence with a fresh culler per iteration; the first frame (no keyframe yet) is not timed.
-void BM_CullerPerFrame(benchmark::State& state) {
-  const Sequence& s = sequence();
+/// The core's frame of sequence frame `f`.
+dyncull::CullerCoreFrame<float> core_frame(const Sequence& s, const Frame& f) {
+  dyncull::CullerCoreFrame<float> in;
+  in.keypoints = dyncull::points_view(f.keys);
+  in.descriptors = dyncull::DescriptorRows(f.descriptors.data(), f.keys.size(), 32, 32);
+  in.depth_m = dyncull::DepthView<float>{f.depth.data(), s.camera.width, s.camera.height, 0, 1.f, 0.4f, 8.f};
+  in.detections = &f.detections;
+  in.cam_from_world = &f.cam_from_world;
+  return in;
+}
+
+/// One pass over the sequence with a fresh culler per iteration (`make`), each frame culled by
+/// `cull(culler, i)`; the first frame (no keyframe yet) is not timed.
+template <class Make, class Cull>
+void time_sequence(benchmark::State& state, const Sequence& s, Make make, Cull cull) {
   double seconds = 0;
   std::size_t frames = 0, keyframes = 0;
   for (auto _ : state) {
-    dyncull::CullerCore<float> culler(s.camera);
+    auto culler = make();
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
-      const Frame& f = s.frames[i];
-      dyncull::CullerCoreFrame<float> in;
-      in.keypoints = dyncull::points_view(f.keys);
-      in.descriptors = dyncull::DescriptorRows(f.descriptors.data(), f.keys.size(), 32, 32);
-      in.depth_m = dyncull::DepthView<float>{f.depth.data(), s.camera.width, s.camera.height, 0, 1.f, 0.4f, 8.f};
-      in.detections = &f.detections;
-      in.cam_from_world = &f.cam_from_world;
       const double t0 = cpu_seconds();
-      const dyncull::CullerResult& r = culler.cull(in);
+      const dyncull::CullerResult& r = cull(*culler, i);
       const double dt = cpu_seconds() - t0;
       benchmark::DoNotOptimize(r.num_kept);
       if (i == 0) continue;
@@ -114,7 +123,49 @@ void BM_CullerPerFrame(benchmark::State& state) {
   state.counters["features"] = double(s.features) / double(s.frames.size());
   state.counters["keyframes"] = double(keyframes) / double(frames);
 }
+
+/// The templated core (culling/culler_core.hpp), header-only.
+void BM_CullerPerFrame(benchmark::State& state) {
+  const Sequence& s = sequence();
+  time_sequence(
+      state, s, [&] { return std::make_unique<dyncull::CullerCore<float>>(s.camera); },
+      [&](dyncull::CullerCore<float>& c, std::size_t i) -> const dyncull::CullerResult& {
+        return c.cull(core_frame(s, s.frames[i]));
+      });
+}
 BENCHMARK(BM_CullerPerFrame)->Unit(benchmark::kMillisecond);
+
+/// The public culler (culling/culler.hpp, compiled into dyncull::culler) on the same frames: the same core
+/// behind the C++11 header, boxes and pose converted per frame.
+void BM_PublicCullerPerFrame(benchmark::State& state) {
+  const Sequence& s = sequence();
+  std::vector<std::vector<dyncull::DetectedBox>> boxes(s.frames.size());
+  std::vector<std::array<double, 12>> poses(s.frames.size());
+  for (std::size_t i = 0; i < s.frames.size(); ++i) {
+    for (const auto& d : s.frames[i].detections)
+      boxes[i].emplace_back(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence);
+    const dyncull::Rigid3<float>& p = s.frames[i].cam_from_world;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) poses[i][std::size_t(4 * r + c)] = p.R(r, c);
+      poses[i][std::size_t(4 * r + 3)] = p.t(r);
+    }
+  }
+  const dyncull::CullerCamera camera(s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy, s.camera.width,
+                                     s.camera.height);
+  time_sequence(
+      state, s, [&] { return std::make_unique<dyncull::Culler>(camera); },
+      [&](dyncull::Culler& c, std::size_t i) -> const dyncull::CullerResult& {
+        const dyncull::CullerCoreFrame<float> core = core_frame(s, s.frames[i]);
+        dyncull::CullerFrame in;
+        in.keypoints = core.keypoints;
+        in.descriptors = core.descriptors;
+        in.depth_m = core.depth_m;
+        in.detections = &boxes[i];
+        in.cam_from_world = poses[i].data();
+        return c.cull(in);
+      });
+}
+BENCHMARK(BM_PublicCullerPerFrame)->Unit(benchmark::kMillisecond);
 
 void BM_OpenCvOrbDetectAndCompute(benchmark::State& state) {
   const Sequence& s = sequence();

@@ -4,6 +4,7 @@
 // heap allocation per frame after warm-up (a counting global operator new in this executable).
 #include "dyncull/culling/culler.hpp"
 
+#include "dyncull/core/views.hpp"
 #include "dyncull/culling/culler_core.hpp"
 #include "support/counting_allocator.hpp"
 #include "support/culler_wall.hpp"
