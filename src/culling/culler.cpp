@@ -51,6 +51,11 @@ Status check_class_lists(const CullerOptions& o, std::string* why) {
   return Status::Ok;
 }
 
+PinholeCamera<float> pinhole_of(const CullerCamera& c) {
+  return PinholeCamera<float>{static_cast<float>(c.fx), static_cast<float>(c.fy), static_cast<float>(c.cx),
+                              static_cast<float>(c.cy), c.width, c.height};
+}
+
 Status check_camera(const CullerCamera& c, std::string* why) {
   const std::size_t k = c.distortion.size();
   if (k != 0 && k != 4 && k != 5 && k != 8 && k != 12 && k != 14)
@@ -59,16 +64,9 @@ Status check_camera(const CullerCamera& c, std::string* why) {
   for (std::size_t i = 0; i < k; ++i)
     if (!std::isfinite(c.distortion[i]))
       return (*why = "camera: distortion[" + std::to_string(i) + "] is NaN or Inf", Status::InvalidInput);
-  const PinholeCamera<float> pinhole{static_cast<float>(c.fx), static_cast<float>(c.fy), static_cast<float>(c.cx),
-                                     static_cast<float>(c.cy), c.width, c.height};
   std::string w;
-  if (pinhole.validate(&w) != Status::Ok) return (*why = "camera: " + w + " (no default intrinsics)", Status::InvalidInput);
+  if (pinhole_of(c).validate(&w) != Status::Ok) return (*why = "camera: " + w + " (no default intrinsics)", Status::InvalidInput);
   return Status::Ok;
-}
-
-PinholeCamera<float> pinhole_of(const CullerCamera& c) {
-  return PinholeCamera<float>{static_cast<float>(c.fx), static_cast<float>(c.fy), static_cast<float>(c.cx),
-                              static_cast<float>(c.cy), c.width, c.height};
 }
 
 }  // namespace

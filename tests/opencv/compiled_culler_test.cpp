@@ -12,6 +12,7 @@
 
 #include "dyncull/culling/culler_core.hpp"
 #include "dyncull/opencv/culler.hpp"
+#include "dyncull/opencv/views.hpp"
 #include "dyncull/sim/families.hpp"
 #include "dyncull/sim/scene.hpp"
 
@@ -43,14 +44,6 @@ DescriptorRows rows_of(const cv::Mat& d) {
                         static_cast<std::size_t>(d.cols));
 }
 
-DepthView<float> depth_of(const cv::Mat& d) {
-  DepthView<float> v;
-  v.data = d.ptr<float>(0);
-  v.width = d.cols;
-  v.height = d.rows;
-  v.stride = static_cast<std::ptrdiff_t>(d.step[0] / sizeof(float));
-  return v;
-}
 
 /// The public culler's result equals the core's, element by element.
 void expect_same(const CullerResult& expected, const CullerResult& got, int step, const char* form) {
@@ -112,7 +105,7 @@ TEST(CompiledCuller, GivesTheCoresLabelsOnTheWalkingSceneForEveryKeypointTypeWit
     CullerCoreFrame<float> cf;
     cf.keypoints = points_view(keys);
     if (!descriptors.empty()) cf.descriptors = rows_of(descriptors);
-    cf.depth_m = depth_of(depth);
+    cf.depth_m = cv_adapter::depth_view_f32(depth);
     cf.detections = &frame.detections;
     cf.cam_from_world = &pose_f;
     CullerFrame pf;  // float pairs with the stride of cv::Point2f, as a host's own point array
@@ -244,7 +237,7 @@ TEST(CompiledCuller, NonFiniteKeypointIsCulledNamingItsIndexOnEveryOverload) {
   // The plain views: packed float pairs, a null pointer with a count, a stride shorter than a pair.
   CullerFrame f;
   f.descriptors = rows_of(in.descriptors);
-  f.depth_m = depth_of(in.depth);
+  f.depth_m = cv_adapter::depth_view_f32(in.depth);
   f.detections = &in.boxes;
   double Rt[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
   f.cam_from_world = Rt;

@@ -9,6 +9,7 @@
 #include "dyncull/culling/culler.hpp"
 #include "dyncull/culling/culler_core.hpp"
 #include "dyncull/opencv/culler.hpp"
+#include "dyncull/opencv/views.hpp"
 
 #include <gtest/gtest.h>
 
@@ -90,14 +91,6 @@ DescriptorRows rows_of(const cv::Mat& d) {
                         static_cast<std::size_t>(d.cols));
 }
 
-DepthView<float> depth_of(const cv::Mat& d) {
-  DepthView<float> v;
-  v.data = d.ptr<float>(0);
-  v.width = d.cols;
-  v.height = d.rows;
-  v.stride = static_cast<std::ptrdiff_t>(d.step[0] / sizeof(float));
-  return v;
-}
 
 std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
   std::vector<DetectedBox> out;
@@ -117,7 +110,7 @@ class PlainForm {
     if (in.stride_bytes != 0) f.keypoints.stride_bytes = in.stride_bytes;
     if (in.has_undistorted) f.undistorted_keypoints = points_view(in.undistorted);
     if (!in.descriptors.empty()) f.descriptors = rows_of(in.descriptors);
-    if (!in.depth.empty()) f.depth_m = depth_of(in.depth);
+    if (!in.depth.empty()) f.depth_m = cv_adapter::depth_view_f32(in.depth);
     boxes_ = boxes_of(in.boxes);
     f.detections = &boxes_;
     if (!in.Tcw.empty()) {
@@ -160,7 +153,7 @@ class CoreForm {
     if (in.stride_bytes != 0) f.keypoints.stride_bytes = in.stride_bytes;
     if (in.has_undistorted) f.undistorted_keypoints = points_view(in.undistorted);
     if (!in.descriptors.empty()) f.descriptors = rows_of(in.descriptors);
-    if (!in.depth.empty()) f.depth_m = depth_of(in.depth);
+    if (!in.depth.empty()) f.depth_m = cv_adapter::depth_view_f32(in.depth);
     f.detections = &in.boxes;
     if (!in.Tcw.empty()) {
       for (int r = 0; r < 3; ++r) {
@@ -474,7 +467,7 @@ TEST(PublicCullerContract, MovedFromCullerKeepsAllParallelToTheKeys) {
   EXPECT_EQ(cv_adapter::cull(a, points, in.descriptors, in.depth, boxes).keep, std::vector<std::uint8_t>(60, 1));
   CullerFrame seven;
   seven.keypoints = PointsView::of(&points[0].x, 7);
-  seven.depth_m = depth_of(in.depth);
+  seven.depth_m = cv_adapter::depth_view_f32(in.depth);
   seven.detections = &boxes;
   EXPECT_EQ(a.cull(seven).keep, std::vector<std::uint8_t>(7, 1));
   EXPECT_EQ(a.result().status, Status::InvalidInput);
