@@ -82,8 +82,8 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the add_subdirectory consumer ran but returned ${rc}")
 endif()
 
-# examples/ on its own against the install, as a user copies it: the README's front end and the monocular
-# one configure, build and run with find_package(dyncull) alone.
+# examples/ on its own against the install, as a user copies it: the README's front end, the monocular
+# one and the header-only one configure, build and run with find_package(dyncull) alone.
 if(EXPECT_CULLER)
   execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}/../../examples" -B "${SCRATCH_DIR}/build_examples"
                           -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
@@ -92,12 +92,12 @@ if(EXPECT_CULLER)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "configuring examples/ against the installed package failed (${rc})")
   endif()
-  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_examples" --target front_end monocular
+  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_examples" --target front_end monocular header_only
                   RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "building examples/ against the installed package failed (${rc})")
   endif()
-  foreach(example front_end monocular)
+  foreach(example front_end monocular header_only)
     execute_process(COMMAND "${SCRATCH_DIR}/build_examples/${example}" RESULT_VARIABLE rc)
     if(NOT rc EQUAL 0)
       message(FATAL_ERROR "examples/${example}, built against the install, returned ${rc}")
