@@ -6,6 +6,7 @@
 
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/compact.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/mask.hpp"
 #include "dyncull/core/random.hpp"

@@ -8,9 +8,6 @@
 #include <string>
 #include <vector>
 
-#ifdef DYNCULL_HAS_OPENCV
-#include <opencv2/core.hpp>
-#endif
 
 namespace {
 using namespace dyncull;
@@ -22,98 +19,6 @@ TEST(KeepMask, PoliciesDecideWhatCandidatesBecome) {
   EXPECT_EQ(make_keep_mask(kLabels), (std::vector<std::uint8_t>{1, 0, 1, 1, 0}));
   EXPECT_EQ(make_keep_mask(kLabels, KeepPolicy::DropDynamicAndCandidate), (std::vector<std::uint8_t>{1, 0, 0, 1, 0}));
   EXPECT_TRUE(make_keep_mask({}).empty());
-}
-
-struct Key {  // an ORB-SLAM-like keypoint
-  float x, y;
-  int octave;
-};
-
-TEST(KeepMask, CompactsEveryParallelArrayTogether) {
-  std::vector<Key> keys;
-  std::vector<float> depth, right_u;
-  std::vector<std::string> names;
-  // Descriptor rows of 4 used bytes in a matrix with 8-byte stride (like a cv::Mat ROI).
-  std::vector<std::uint8_t> desc(5 * 8, 0xEE);
-  for (int i = 0; i < 5; ++i) {
-    keys.push_back({float(i), float(10 * i), i % 3});
-    depth.push_back(1.f + float(i));
-    right_u.push_back(-1.f * float(i));
-    names.push_back("kp" + std::to_string(i));
-    for (int b = 0; b < 4; ++b) desc[std::size_t(i * 8 + b)] = std::uint8_t(i * 16 + b);
-  }
-  const std::vector<std::uint8_t> keep = make_keep_mask(kLabels);
-  RowsView rows{desc.data(), 4, 8, 5};
-  const CompactResult r = compact_parallel(keep, keys, rows, depth, right_u, names);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.count, 3u);
-  EXPECT_EQ(r.removed, 2u);
-  const int kept[] = {0, 2, 3};
-  ASSERT_EQ(keys.size(), 3u);
-  ASSERT_EQ(names.size(), 3u);
-  EXPECT_EQ(rows.rows, 3u);
-  for (int j = 0; j < 3; ++j) {
-    const int i = kept[j];
-    EXPECT_EQ(keys[std::size_t(j)].x, float(i));
-    EXPECT_EQ(depth[std::size_t(j)], 1.f + float(i));
-    EXPECT_EQ(right_u[std::size_t(j)], -1.f * float(i));
-    EXPECT_EQ(names[std::size_t(j)], "kp" + std::to_string(i));
-    for (int b = 0; b < 4; ++b) EXPECT_EQ(desc[std::size_t(j * 8 + b)], std::uint8_t(i * 16 + b));
-    EXPECT_EQ(desc[std::size_t(j * 8 + 5)], 0xEE);  // padding bytes untouched
-  }
-}
-
-TEST(KeepMask, MismatchedSizesTouchNothing) {
-  std::vector<int> a = {1, 2, 3, 4, 5};
-  std::vector<int> b = {1, 2, 3};  // an array left unshrunk, like ORB-SLAM3's N in forks
-  const CompactResult r = compact_parallel(make_keep_mask(kLabels), a, b);
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_FALSE(r.reason.empty());
-  EXPECT_EQ(a.size(), 5u);
-  EXPECT_EQ(b.size(), 3u);
-  // No arrays at all: just the count.
-  EXPECT_EQ(compact_parallel(make_keep_mask(kLabels)).count, 3u);
-  // Everything dropped (an all-dynamic frame) and nothing dropped.
-  std::vector<int> c = {1, 2};
-  EXPECT_EQ(compact_parallel(std::vector<std::uint8_t>{0, 0}, c).count, 0u);
-  EXPECT_TRUE(c.empty());
-}
-
-TEST(KeepMask, BadDescriptorViewsAreRefusedAndTouchNothing) {
-  const std::vector<std::uint8_t> keep = make_keep_mask(kLabels);
-  std::vector<int> ids = {0, 1, 2, 3, 4};
-  // Null data with rows: nothing to move rows through.
-  CompactResult r = compact_parallel(keep, ids, RowsView{nullptr, 32, 32, 5});
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("null"), std::string::npos) << r.reason;
-  EXPECT_EQ(ids.size(), 5u);
-  EXPECT_EQ(r.count, 5u);
-  EXPECT_EQ(r.removed, 0u);
-  // Rows longer than the stride overlap each other.
-  std::vector<std::uint8_t> desc(5 * 8, 7);
-  r = compact_parallel(keep, ids, RowsView{desc.data(), 16, 8, 5});
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("row_bytes"), std::string::npos) << r.reason;
-  EXPECT_EQ(ids.size(), 5u);
-  // Rows that would reach past the address space.
-  r = compact_parallel(keep, RowsView{desc.data(), 8, std::numeric_limits<std::size_t>::max() / 2, 5});
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  // Two views of the same rows, and the same vector twice: the second pass would read freed slots.
-  r = compact_parallel(keep, RowsView{desc.data(), 8, 8, 5}, RowsView{desc.data() + 4, 4, 8, 5});
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("overlap"), std::string::npos) << r.reason;
-  r = compact_parallel(keep, ids, ids);
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_EQ(ids, (std::vector<int>{0, 1, 2, 3, 4}));
-  EXPECT_EQ(desc, std::vector<std::uint8_t>(5 * 8, 7));
-  // Null data is fine with no rows, and an empty frame compacts nothing.
-  EXPECT_TRUE(compact_parallel(std::vector<std::uint8_t>{}, RowsView{nullptr, 32, 32, 0}).ok());
-  // Ordinary views side by side in one buffer do not overlap.
-  std::vector<std::uint8_t> two(5 * 16, 1);
-  r = compact_parallel(keep, RowsView{two.data(), 8, 16, 5}, RowsView{two.data() + 8, 8, 16, 5});
-  EXPECT_FALSE(r.ok());  // interleaved rows share the same span of memory
-  std::vector<std::uint8_t> a(5 * 8, 1), b(5 * 8, 2);
-  EXPECT_TRUE(compact_parallel(keep, RowsView{a.data(), 8, 8, 5}, RowsView{b.data(), 8, 8, 5}, ids).ok());
 }
 
 template <class T>
@@ -204,23 +109,4 @@ TEST(Rasterise, ConventionsAndObjectMasks) {
   EXPECT_EQ(rasterise_dynamic_regions(boxes, ConstMaskView{}, MaskView{}), Status::InvalidInput);
 }
 
-#ifdef DYNCULL_HAS_OPENCV
-TEST(KeepMaskOpenCV, KeyPointsAndDescriptorMat) {
-  std::vector<cv::KeyPoint> kps;
-  cv::Mat desc(5, 32, CV_8UC1);
-  for (int i = 0; i < 5; ++i) {
-    kps.emplace_back(float(i), 0.f, 7.f);
-    desc.row(i).setTo(cv::Scalar(i));
-  }
-  const CompactResult r = compact_parallel(make_keep_mask(kLabels), kps,
-                                           RowsView{desc.data, std::size_t(desc.cols) * desc.elemSize(), desc.step, 5});
-  ASSERT_TRUE(r.ok());
-  desc = desc.rowRange(0, int(r.count));
-  ASSERT_EQ(kps.size(), 3u);
-  EXPECT_EQ(kps[1].pt.x, 2.f);
-  EXPECT_EQ(desc.at<std::uint8_t>(1, 31), 2);
-  EXPECT_EQ(desc.at<std::uint8_t>(2, 0), 3);
-  EXPECT_EQ(desc.rows, 3);
-}
-#endif
 }  // namespace

@@ -7,7 +7,7 @@
 #include "dyncull/culling/keyframe_matcher.hpp"
 
 #include "dyncull/core/random.hpp"
-#include "dyncull/culling/keep_mask.hpp"
+#include "dyncull/core/compact.hpp"
 
 #include <gtest/gtest.h>
 
@@ -470,7 +470,7 @@ TEST(KeyframeMatcher, MutualCheckRejectsAKeypointAnotherPointPrefers) {
 
 TEST(KeyframeMatcher, RowsViewAndStridedRowsAreRead) {
   TwoViews<float> v(300, pose_from<float>(0, 0.02, 0, 0.01, 0, 0), 21);
-  // The same descriptors in rows of 48 bytes (a cv::Mat ROI's step), through keep_mask's RowsView.
+  // The same descriptors in rows of 48 bytes (a cv::Mat ROI's step), through compact.hpp's RowsView.
   const std::size_t n = v.cur_kp.size();
   std::vector<std::uint8_t> strided(48 * n, 0xAB);
   for (std::size_t j = 0; j < n; ++j) std::copy(&v.cur_desc[32 * j], &v.cur_desc[32 * j] + 32, &strided[48 * j]);

@@ -301,6 +301,43 @@ TEST(CompiledCuller, CompactShrinksDescriptorsWithEveryParallelVector) {
   EXPECT_EQ(two_rows.rows, 2);
 }
 
+TEST(CompiledCuller, CompactReadsAStridedRoiAndFloatDescriptors) {
+  cv::Mat wide(5, 64, CV_8UC1, cv::Scalar(255));
+  for (int r = 0; r < 5; ++r) wide(cv::Rect(0, r, 32, 1)).setTo(cv::Scalar(r));
+  cv::Mat roi = wide(cv::Rect(0, 0, 32, 5));  // step 64 bytes
+  std::vector<int> v{0, 1, 2, 3, 4};
+  ASSERT_EQ(cv_adapter::compact({0, 1, 0, 1, 1}, roi, v), 3);
+  ASSERT_EQ(roi.rows, 3);
+  EXPECT_EQ(roi.at<std::uint8_t>(0, 0), 1);
+  EXPECT_EQ(roi.at<std::uint8_t>(2, 31), 4);
+  EXPECT_EQ(wide.at<std::uint8_t>(0, 40), 255);  // the bytes beyond the ROI are not touched
+  EXPECT_EQ(v, (std::vector<int>{1, 3, 4}));
+  // Learned float descriptors (HFNet / SuperPoint): rows of 256 floats.
+  cv::Mat fdesc(3, 256, CV_32FC1);
+  for (int i = 0; i < 3; ++i) fdesc.row(i).setTo(cv::Scalar(double(i) + 0.5));
+  std::vector<double> w{1, 2, 3};
+  ASSERT_EQ(cv_adapter::compact({1, 0, 1}, fdesc, w), 2);
+  ASSERT_EQ(fdesc.rows, 2);
+  EXPECT_EQ(fdesc.at<float>(1, 255), 2.5f);
+  EXPECT_EQ(w, (std::vector<double>{1, 3}));
+}
+
+TEST(CompiledCuller, CompactRefusesMissingDescriptorsTheSameVectorTwiceAndAcceptsAnEmptyFrame) {
+  const std::vector<std::uint8_t> keep{1, 0, 1, 0};
+  std::vector<int> a{0, 1, 2, 3};
+  cv::Mat none;  // a host without descriptors for 4 features is a mismatch, not a silent skip
+  EXPECT_EQ(cv_adapter::compact(keep, none, a), -1);
+  cv::Mat desc(4, 32, CV_8UC1, cv::Scalar(9));
+  EXPECT_EQ(cv_adapter::compact(keep, desc, a, a), -1);  // it would be compacted twice
+  EXPECT_EQ(a.size(), 4u);
+  EXPECT_EQ(desc.rows, 4);
+  cv::Mat cube(std::vector<int>{4, 2, 2}, CV_8UC1, cv::Scalar(0));
+  EXPECT_EQ(cv_adapter::compact(keep, cube, a), -1);  // not one row per feature
+  cv::Mat empty;
+  std::vector<int> e;
+  EXPECT_EQ(cv_adapter::compact({}, empty, e), 0);
+}
+
 TEST(CompiledCuller, DetectedBoxFromARectSpansItsWidthAndHeight) {
   const DetectedBox b = cv_adapter::detected_box(cv::Rect2f(10.f, 20.f, 30.f, 40.f), 0, 0.9f);
   EXPECT_EQ(b.x0, 10.f);

@@ -1,6 +1,5 @@
-// Tests of opencv/frame.hpp: one-call compaction of a descriptor cv::Mat with parallel vectors (the Mat
-// shrinks; mismatched sizes touch nothing), PinholeCamera from K with its distortion reported and bad K
-// named, TUM uint16 depth, and keypoint undistortion against cv::projectPoints on TUM fr1's coefficients.
+// Tests of opencv/frame.hpp: PinholeCamera from K with its distortion reported and bad K named, TUM
+// uint16 depth, and keypoint undistortion against cv::projectPoints on TUM fr1's coefficients.
 #include "dyncull/opencv/frame.hpp"
 
 #include <gtest/gtest.h>
@@ -17,100 +16,6 @@ namespace {
 
 namespace cva = dyncull::cv_adapter;
 using dyncull::Status;
-
-/// n x 32 descriptors whose row i is filled with the byte i.
-cv::Mat numbered_rows(int n) {
-  cv::Mat m(n, 32, CV_8UC1);
-  for (int i = 0; i < n; ++i) m.row(i).setTo(cv::Scalar(i));
-  return m;
-}
-
-TEST(OpenCvFrame, CompactsDescriptorsAndEveryVectorInOneCall) {
-  cv::Mat desc = numbered_rows(6);
-  std::vector<cv::KeyPoint> kps;
-  for (int i = 0; i < 6; ++i) kps.emplace_back(cv::Point2f(float(i), 0.f), 7.f);
-  std::vector<cv::KeyPoint> kps_un = kps;
-  std::vector<float> depth{0.5f, 1.f, 1.5f, 2.f, 2.5f, 3.f};
-  std::vector<int> ids{10, 11, 12, 13, 14, 15};
-  const std::vector<std::uint8_t> keep{1, 0, 1, 1, 0, 1};
-  const auto r = cva::compact_frame(keep, desc, kps, kps_un, depth, ids);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.count, 4u);
-  EXPECT_EQ(r.removed, 2u);
-  ASSERT_EQ(desc.rows, 4);  // shrunk: a host cannot forget it
-  const int kept[] = {0, 2, 3, 5};
-  for (int j = 0; j < 4; ++j) {
-    EXPECT_EQ(desc.at<std::uint8_t>(j, 0), kept[j]);
-    EXPECT_EQ(desc.at<std::uint8_t>(j, 31), kept[j]);
-    EXPECT_EQ(kps[std::size_t(j)].pt.x, float(kept[j]));
-    EXPECT_EQ(kps_un[std::size_t(j)].pt.x, float(kept[j]));
-    EXPECT_EQ(depth[std::size_t(j)], 0.5f * float(kept[j] + 1));
-    EXPECT_EQ(ids[std::size_t(j)], 10 + kept[j]);
-  }
-  EXPECT_EQ(kps.size(), 4u);
-  EXPECT_EQ(ids.size(), 4u);
-}
-
-TEST(OpenCvFrame, CompactionReadsAStridedRoiAndFloatDescriptors) {
-  cv::Mat parent = numbered_rows(5);
-  cv::Mat wide(5, 64, CV_8UC1, cv::Scalar(255));
-  parent.copyTo(wide(cv::Rect(0, 0, 32, 5)));
-  cv::Mat roi = wide(cv::Rect(0, 0, 32, 5));  // step 64 bytes
-  std::vector<int> v{0, 1, 2, 3, 4};
-  auto r = cva::compact_frame({0, 1, 0, 1, 1}, roi, v);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  ASSERT_EQ(roi.rows, 3);
-  EXPECT_EQ(roi.at<std::uint8_t>(0, 0), 1);
-  EXPECT_EQ(roi.at<std::uint8_t>(2, 31), 4);
-  EXPECT_EQ(wide.at<std::uint8_t>(0, 40), 255);  // the bytes beyond the ROI are not touched
-  // Learned float descriptors (HFNet / SuperPoint): rows of 256 floats.
-  cv::Mat fdesc(3, 256, CV_32FC1);
-  for (int i = 0; i < 3; ++i) fdesc.row(i).setTo(cv::Scalar(double(i) + 0.5));
-  std::vector<double> w{1, 2, 3};
-  r = cva::compact_frame({1, 0, 1}, fdesc, w);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  ASSERT_EQ(fdesc.rows, 2);
-  EXPECT_EQ(fdesc.at<float>(1, 255), 2.5f);
-  EXPECT_EQ(w, (std::vector<double>{1, 3}));
-}
-
-TEST(OpenCvFrame, MismatchedSizesCompactNothingAndNameTheArgument) {
-  cv::Mat desc = numbered_rows(4);
-  std::vector<int> a{0, 1, 2, 3}, b{0, 1, 2};
-  const std::vector<std::uint8_t> keep{1, 0, 1, 0};
-  auto r = cva::compact_frame(keep, desc, a, b);
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("vector argument 2"), std::string::npos) << r.reason;
-  EXPECT_EQ(r.count, 4u);
-  EXPECT_EQ(desc.rows, 4);
-  EXPECT_EQ(a, (std::vector<int>{0, 1, 2, 3}));
-  EXPECT_EQ(desc.at<std::uint8_t>(1, 0), 1);
-
-  cv::Mat short_desc = numbered_rows(3);
-  r = cva::compact_frame(keep, short_desc, a);
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("descriptors has 3 rows"), std::string::npos) << r.reason;
-  EXPECT_EQ(short_desc.rows, 3);
-  EXPECT_EQ(a.size(), 4u);
-
-  cv::Mat none;  // a host without descriptors for 4 features is a mismatch, not a silent skip
-  r = cva::compact_frame(keep, none, a);
-  EXPECT_EQ(r.status, Status::InvalidInput);
-
-  // The same vector twice would be compacted twice.
-  r = cva::compact_frame(keep, desc, a, a);
-  EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("share memory"), std::string::npos) << r.reason;
-  EXPECT_EQ(a.size(), 4u);
-  EXPECT_EQ(desc.rows, 4);
-
-  // Empty frame: nothing to do.
-  cv::Mat empty;
-  std::vector<int> e;
-  r = cva::compact_frame({}, empty, e);
-  EXPECT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.count, 0u);
-}
 
 template <class T>
 class OpenCvFrameTyped : public ::testing::Test {};

@@ -95,7 +95,7 @@ PointsView points_view(const Container& points) {
 
 /// Read-only rows of binary descriptors: row i starts at data + i * stride_bytes and has row_bytes bytes
 /// (ORB: 32). A cv::Mat of descriptors is DescriptorRows(m.ptr(0), m.rows, m.step, m.cols). Anything with
-/// the members data, rows, row_bytes and stride() (culling/keep_mask.hpp's RowsView) converts.
+/// the members data, rows, row_bytes and stride() (core/compact.hpp's RowsView) converts.
 struct DescriptorRows {
   const std::uint8_t* data;
   std::size_t rows;

@@ -20,6 +20,7 @@
 /// and ids is cull_frame (culling/pipeline.hpp).
 #pragma once
 
+#include "dyncull/core/compact.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/views.hpp"
@@ -266,36 +267,5 @@ class Culler {
   Impl& impl();  // a moved-from culler gets one that refuses every frame
   std::unique_ptr<Impl> impl_;
 };
-
-/// Removes, in place and stably, the elements with keep[i] == 0 from every std::vector given (each
-/// parallel to keep). Returns the new size, or -1 and touches nothing when a vector's size differs.
-template <class... Vectors>
-long compact(const std::vector<std::uint8_t>& keep, Vectors&... vectors);
-
-namespace detail {
-template <class V>
-void compact_one(const std::vector<std::uint8_t>& keep, V& v) {
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    if (!keep[i]) continue;
-    if (kept != i) v[kept] = v[i];
-    ++kept;
-  }
-  v.erase(v.begin() + static_cast<std::ptrdiff_t>(kept), v.end());
-}
-}  // namespace detail
-
-template <class... Vectors>
-long compact(const std::vector<std::uint8_t>& keep, Vectors&... vectors) {
-  const std::size_t n = keep.size();
-  const std::size_t sizes[] = {n, static_cast<std::size_t>(vectors.size())...};
-  for (std::size_t a = 0; a < sizeof(sizes) / sizeof(sizes[0]); ++a)
-    if (sizes[a] != n) return -1;
-  const int expand[] = {0, (detail::compact_one(keep, vectors), 0)...};
-  (void)expand;
-  long kept = 0;
-  for (std::size_t i = 0; i < n; ++i) kept += keep[i] != 0;
-  return kept;
-}
 
 }  // namespace dyncull

@@ -1,17 +1,18 @@
 /// @file keep_mask.hpp
-/// Applying a culling decision to a host front end (ORB-SLAM style): keep-masks from labels, in-place
-/// compaction of every parallel per-keypoint array together, an "inside a dynamic region" predicate
+/// Applying a culling decision to a host front end (ORB-SLAM style): keep-masks from labels (the parallel
+/// arrays are then compacted by dyncull::compact, core/compact.hpp), an "inside a dynamic region" predicate
 /// usable per pyramid level inside an extractor, and a rasterised mask with an explicit convention.
 ///
 /// API:
 ///   std::vector<std::uint8_t> keep = make_keep_mask(labels, KeepPolicy::DropDynamic);
-///   CompactResult c = compact_parallel(keep, keypoints, RowsView{desc.data, 32, desc.step, n}, depths, right_u);
+///   long kept = compact(keep, keypoints, RowsView(desc.data, 32, desc.step, n), depths, right_u);
 ///   DynamicRegionPredicate<float> inside(boxes, object_mask, /*scale_factor*/ 1.2f, /*levels*/ 8);
 ///   inside(x_level, y_level, level) -> bool;
 ///   rasterise_dynamic_regions(boxes, object_masks, out, MaskConvention::DynamicIs255);
 #pragma once
 
 #include "dyncull/core/box.hpp"
+#include "dyncull/core/compact.hpp"
 #include "dyncull/core/mask.hpp"
 #include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
@@ -20,8 +21,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
-#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -42,134 +41,6 @@ inline std::vector<std::uint8_t> make_keep_mask(const std::vector<FeatureLabel>&
                                                                                  : FeatureLabel::Static);
   for (std::size_t i = 0; i < labels.size(); ++i) keep[i] = static_cast<std::uint8_t>(labels[i]) <= limit;
   return keep;
-}
-
-/// Rows of bytes, `row_bytes` used per row, `stride_bytes` between rows: descriptor matrices
-/// (cv::Mat: RowsView{m.data, m.cols * m.elemSize(), m.step, m.rows}). Compaction moves rows up;
-/// the host then shrinks its matrix to the returned count (cv::Mat: m = m.rowRange(0, count)).
-struct RowsView {
-  std::uint8_t* data = nullptr;
-  std::size_t row_bytes = 0;
-  std::size_t stride_bytes = 0;  ///< 0 means row_bytes
-  std::size_t rows = 0;
-  std::size_t stride() const { return stride_bytes ? stride_bytes : row_bytes; }
-};
-
-struct CompactResult {
-  Status status = Status::Ok;
-  std::string reason;
-  bool ok() const { return status == Status::Ok; }
-  std::size_t count = 0;    ///< new number of features
-  std::size_t removed = 0;
-};
-
-namespace detail {
-inline std::size_t array_size(const RowsView& r) { return r.rows; }
-template <class V> std::size_t array_size(const std::vector<V>& v) { return v.size(); }
-
-/// Memory an argument of compact_parallel writes, as addresses [begin, end): a vector by its own
-/// object (two vector objects never share elements), a RowsView by the bytes its rows span.
-struct ByteSpan {
-  std::uintptr_t begin = 0, end = 0;
-};
-template <class V> ByteSpan byte_span(const std::vector<V>& v) {
-  const auto p = reinterpret_cast<std::uintptr_t>(&v);
-  return ByteSpan{p, p + sizeof(v)};
-}
-inline ByteSpan byte_span(const RowsView& r) {
-  if (r.data == nullptr || r.rows == 0 || r.row_bytes == 0) return ByteSpan{};
-  const auto p = reinterpret_cast<std::uintptr_t>(r.data);
-  return ByteSpan{p, p + (r.rows - 1) * r.stride() + r.row_bytes};  // bounded by rows_view_ok
-}
-
-/// A RowsView compaction can trust: rows reachable (non-null data), not overlapping each other, and
-/// the whole span addressable. Vectors always are.
-template <class V> bool rows_view_ok(const std::vector<V>&, std::size_t, std::string*) { return true; }
-inline bool rows_view_ok(const RowsView& r, std::size_t arg, std::string* reason) {
-  const std::string which = "argument " + std::to_string(arg + 1) + " (RowsView): ";
-  if (r.rows == 0 || r.row_bytes == 0) return true;  // nothing is moved
-  if (r.data == nullptr) {
-    *reason = which + "data is null but rows = " + std::to_string(r.rows);
-    return false;
-  }
-  if (r.row_bytes > r.stride()) {
-    *reason = which + "row_bytes " + std::to_string(r.row_bytes) + " exceeds stride_bytes " +
-              std::to_string(r.stride()) + ": rows would overlap";
-    return false;
-  }
-  const std::uintptr_t room = UINTPTR_MAX - reinterpret_cast<std::uintptr_t>(r.data);
-  if (r.row_bytes > room || (r.rows - 1) > (room - r.row_bytes) / r.stride()) {
-    *reason = which + "rows * stride_bytes reaches past the address space";
-    return false;
-  }
-  return true;
-}
-
-inline void compact_one(const std::vector<std::uint8_t>& keep, RowsView& r, std::size_t count) {
-  const std::size_t stride = r.stride();
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    if (!keep[i]) continue;
-    if (i != j) std::memmove(r.data + j * stride, r.data + i * stride, r.row_bytes);
-    ++j;
-  }
-  r.rows = count;
-}
-template <class V>
-void compact_one(const std::vector<std::uint8_t>& keep, std::vector<V>& v, std::size_t count) {
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    if (!keep[i]) continue;
-    if (i != j) v[j] = std::move(v[i]);
-    ++j;
-  }
-  v.erase(v.begin() + static_cast<std::ptrdiff_t>(count), v.end());
-}
-}  // namespace detail
-
-/// Compacts every array (std::vector of anything, or RowsView) in place, stably, keeping element i
-/// where keep[i] != 0. All arrays must have keep.size() elements, a RowsView with rows must have
-/// non-null data, row_bytes <= stride and a span inside the address space, and no two arguments may
-/// share memory (the same vector twice, or overlapping views); otherwise nothing is touched, status is
-/// InvalidInput, count = keep.size() and removed = 0. RowsView arguments may be temporaries: their
-/// rows field is not needed back.
-template <class... Arrays>
-CompactResult compact_parallel(const std::vector<std::uint8_t>& keep, Arrays&&... arrays) {
-  CompactResult r;
-  const std::size_t n = keep.size();
-  r.count = n;
-  const bool sizes_ok = ((detail::array_size(arrays) == n) && ... && true);
-  if (!sizes_ok) {
-    r.status = Status::InvalidInput;
-    r.reason = "every parallel array must have keep.size() = " + std::to_string(n) + " elements";
-    return r;
-  }
-  constexpr std::size_t kArrays = sizeof...(Arrays);
-  if constexpr (kArrays > 0) {
-    std::size_t arg = 0;
-    const bool views_ok = (detail::rows_view_ok(arrays, arg++, &r.reason) && ...);
-    if (!views_ok) {
-      r.status = Status::InvalidInput;
-      return r;
-    }
-    const detail::ByteSpan spans[kArrays] = {detail::byte_span(arrays)...};
-    for (std::size_t a = 0; a < kArrays; ++a) {
-      for (std::size_t b = a + 1; b < kArrays; ++b) {
-        if (spans[a].begin < spans[b].end && spans[b].begin < spans[a].end) {
-          r.status = Status::InvalidInput;
-          r.reason = "arguments " + std::to_string(a + 1) + " and " + std::to_string(b + 1) +
-                     " share memory (the same array twice, or overlapping RowsViews)";
-          return r;
-        }
-      }
-    }
-  }
-  std::size_t count = 0;
-  for (std::uint8_t k : keep) count += k != 0;
-  (detail::compact_one(keep, arrays, count), ...);
-  r.count = count;
-  r.removed = n - count;
-  return r;
 }
 
 /// "Is (x, y) inside a dynamic region?" for use inside a feature extractor, before the keypoints

@@ -118,26 +118,17 @@ const CullerResult& cull(Culler& culler, const std::vector<Point>& keys, const c
 
 /// Removes, in place and stably, the features with keep[i] == 0 from the descriptor matrix (one row per
 /// feature) and from every parallel std::vector, then shrinks the matrix to the surviving rows (a
-/// bag-of-words lookup must never read a stale row). Returns the new count; when an array has another
-/// size than keep, or the matrix is not 2-D, nothing is touched and the result is -1.
+/// bag-of-words lookup must never read a stale row). Returns the new count; -1 with nothing touched when
+/// the matrix is not 2-D or an array has another size than keep (dyncull::compact, core/compact.hpp).
 template <class... Vectors>
 long compact(const std::vector<std::uint8_t>& keep, cv::Mat& descriptors, Vectors&... vectors) {
-  const std::size_t n = keep.size();
-  const std::size_t sizes[] = {n, static_cast<std::size_t>(vectors.size())...};
-  for (std::size_t a = 0; a < sizeof(sizes) / sizeof(sizes[0]); ++a)
-    if (sizes[a] != n) return -1;
-  if (descriptors.dims > 2 || static_cast<std::size_t>(descriptors.rows) != n) return -1;
-  std::size_t kept = 0;
-  const std::size_t row_bytes = static_cast<std::size_t>(descriptors.cols) * descriptors.elemSize();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!keep[i]) continue;
-    if (kept != i && row_bytes > 0)
-      std::memmove(descriptors.ptr(static_cast<int>(kept)), descriptors.ptr(static_cast<int>(i)), row_bytes);
-    ++kept;
-  }
-  dyncull::compact(keep, vectors...);
-  if (n > 0) descriptors = descriptors.rowRange(0, static_cast<int>(kept));
-  return static_cast<long>(kept);
+  if (descriptors.dims > 2) return -1;
+  const std::size_t rows = static_cast<std::size_t>(descriptors.rows);
+  RowsView view(rows > 0 ? descriptors.ptr(0) : nullptr, static_cast<std::size_t>(descriptors.cols) * descriptors.elemSize(),
+                rows > 0 ? static_cast<std::size_t>(descriptors.step[0]) : 0, rows);
+  const long kept = dyncull::compact(keep, view, vectors...);
+  if (kept >= 0 && rows > 0) descriptors = descriptors.rowRange(0, static_cast<int>(kept));
+  return kept;
 }
 
 }  // namespace cv_adapter

@@ -1,11 +1,9 @@
 /// @file frame.hpp
-/// OpenCV adapter for a host front end's per-frame arrays (no paper equation): one-call compaction of a
-/// descriptor cv::Mat and any number of parallel vectors with a keep mask, a validated PinholeCamera from
-/// a K matrix with its distortion reported, TUM's uint16 depth (5000 per metre), and keypoint undistortion
+/// OpenCV adapter for a host front end's per-frame inputs (no paper equation): a validated PinholeCamera
+/// from a K matrix with its distortion reported, TUM's uint16 depth (5000 per metre), and keypoint undistortion
 /// to pixels through cv::undistortPoints (Brown-Conrady model, OpenCV's coefficient order).
 ///
 /// API:
-///   CompactResult c = cv_adapter::compact_frame(keep, descriptors, keypoints, keypoints_un, depths);
 ///   CameraFromK<float> cam = cv_adapter::camera_from_K<float>(K, cv::Size(640, 480), dist_coeffs);
 ///   DepthView<std::uint16_t> depth = cv_adapter::tum_depth_view(depth_png);
 ///   cv_adapter::undistort_keypoints(keypoints, K, dist_coeffs, &keypoints_un);
@@ -13,7 +11,6 @@
 
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/status.hpp"
-#include "dyncull/culling/keep_mask.hpp"
 #include "dyncull/opencv/views.hpp"
 
 #include <opencv2/calib3d.hpp>
@@ -28,53 +25,6 @@
 
 namespace dyncull {
 namespace cv_adapter {
-
-// ------------------------------------------------------------------------------------------------
-// Compaction
-// ------------------------------------------------------------------------------------------------
-
-/// Removes, in place and stably, the features with keep[i] == 0 from the descriptor matrix (one row per
-/// feature, any type) and from every parallel std::vector, then shrinks the matrix to the surviving rows
-/// so that a bag-of-words lookup never reads a stale row. Returns the new count in `count`.
-/// Every array must have keep.size() entries (descriptors: rows); otherwise nothing is touched, status
-/// is InvalidInput and the reason names the argument. The matrix's data is compacted where it lies:
-/// other cv::Mat headers sharing it see the moved rows.
-template <class... Vectors>
-CompactResult compact_frame(const std::vector<std::uint8_t>& keep, cv::Mat& descriptors, Vectors&... vectors) {
-  CompactResult r;
-  r.count = keep.size();
-  const std::size_t n = keep.size();
-  if (descriptors.dims > 2) {
-    r.status = Status::InvalidInput;
-    r.reason = "compact_frame: descriptors must be a 2-D matrix, one row per feature";
-    return r;
-  }
-  if (static_cast<std::size_t>(descriptors.rows) != n) {
-    r.status = Status::InvalidInput;
-    r.reason = "compact_frame: descriptors has " + std::to_string(descriptors.rows) + " rows for keep.size() = " +
-               std::to_string(n);
-    return r;
-  }
-  const std::size_t sizes[] = {n, vectors.size()...};
-  for (std::size_t a = 1; a < sizeof(sizes) / sizeof(sizes[0]); ++a) {
-    if (sizes[a] != n) {
-      r.status = Status::InvalidInput;
-      r.reason = "compact_frame: vector argument " + std::to_string(a) + " has " + std::to_string(sizes[a]) +
-                 " elements for keep.size() = " + std::to_string(n);
-      return r;
-    }
-  }
-  if (n == 0) return r;
-  RowsView rows{descriptors.ptr<std::uint8_t>(0), static_cast<std::size_t>(descriptors.cols) * descriptors.elemSize(),
-                static_cast<std::size_t>(descriptors.step[0]), n};
-  r = compact_parallel(keep, rows, vectors...);
-  if (!r.ok()) {
-    r.reason = "compact_frame: " + r.reason;
-    return r;
-  }
-  descriptors = descriptors.rowRange(0, static_cast<int>(r.count));
-  return r;
-}
 
 // ------------------------------------------------------------------------------------------------
 // Camera
