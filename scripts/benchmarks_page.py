@@ -265,7 +265,7 @@ OTHER_PEERS = [
      "nanoflann (leaf 10)", "BM_nanoflann_kdtree_nn/10"),
     ("bench_culling_box_rule_bench", "box rule, 1000 keypoints x 5 boxes", "BM_BoxRule_Dyncull/5",
      "`cv::Rect2f::contains` loop", "BM_BoxRule_OpenCVRectContains/5"),
-    ("bench_culling_keep_mask_bench", "keep-mask compaction, 1000 features", "BM_Keep_CompactParallel",
+    ("bench_culling_keep_mask_bench", "keep-mask compaction, 1000 features", "BM_Keep_Compact",
      "`push_back` + `Mat::push_back`", "BM_Keep_OpenCVRebuild"),
     ("bench_culling_keep_mask_bench", "dynamic-region raster, 640x480, 5 boxes", "BM_Keep_Rasterise",
      "`setTo` + `cv::rectangle`", "BM_Keep_OpenCVRectangles"),
