@@ -220,18 +220,19 @@ class CullerCore {
   /// The inputs this configuration reads; a frame lacking one gets a non-Ok status naming it.
   CullerInputs inputs() const { return inputs_of(options_); }
 
+  /// From what the enabled stages read (culling/stages/declarations.hpp): the culler makes their tracks
+  /// (prev_keypoints, points_3d, track_ids) by matching descriptors to its keyframe, and their 3-D points
+  /// from the keyframe's depth and pose.
   static CullerInputs inputs_of(const CullerCoreOptions<T>& o) {
-    const PipelineOptions<T>& p = o.pipeline;
+    const FrameInputs read = inputs_read(o.pipeline, /*optional=*/true);
+    const bool points = reads(read, FrameInput::Points3d);
+    const bool tracks = points || reads(read, FrameInput::PrevKeypoints) || reads(read, FrameInput::TrackIds);
     CullerInputs in;
     in.keypoints = true;
-    const bool tracks = p.moving_consistency.enabled || p.reprojection.enabled || p.probability.enabled ||
-                        p.subbox.enabled || p.static_history.enabled;
     in.descriptors = tracks;
-    in.depth = p.depth_mask.enabled || p.reprojection.enabled || p.multiview.enabled || p.edge_evidence.enabled ||
-               p.depth_mask.low_override_by_depth || p.depth_mask.assign_overlaps_by_depth;
-    in.detections =
-        p.box_rule.enabled || p.depth_mask.enabled || p.probability.enabled || p.subbox.enabled || p.tracker.enabled;
-    in.pose = p.reprojection.enabled || p.multiview.enabled || (tracks && o.keyframe_policy == KeyframePolicy::Own);
+    in.depth = reads(read, FrameInput::Depth) || points;
+    in.detections = reads(read, FrameInput::Detections);
+    in.pose = reads(read, FrameInput::CamFromWorld) || points || (tracks && o.keyframe_policy == KeyframePolicy::Own);
     return in;
   }
 

@@ -26,7 +26,7 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
       s.boxes = *frame.detections;
     }
   } else if (options.detections.enabled) {
-    lacks_input(&r->detections, "no detections given");
+    stage_has_inputs(frame, options, &PipelineResult<T>::detections, r);
   }
   if (options.tracker.enabled) {
     // Only dynamic-class boxes are tracked: carrying a missed (or one-frame false positive) low-level box

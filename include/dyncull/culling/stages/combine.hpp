@@ -85,10 +85,7 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
   const std::size_t n = r->num_features;
   kept->assign(n, 0);
   if (!r->static_history.enabled) return;
-  if (!frame.track_ids) {  // given ones hold n ids (accept_inputs)
-    lacks_input(&r->static_history, "no track_ids given");
-    return;
-  }
+  if (!stage_has_inputs(frame, options, &PipelineResult<T>::static_history, r)) return;
   const ReprojectionCheckResult<T>& rp = geometric.reprojection;
   const bool checked = r->reprojection.ran() && rp.labels.size() == n && rp.residual_px.size() == n;
   // A baseline too short to vote (subbox.min_evidence_frames) is too short to prove a slow mover still.
@@ -173,26 +170,20 @@ void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
 /// labels stay those of the stages that did their job.
 template <class T>
 void report_stage_outcomes(PipelineResult<T>* r) {
-  const std::pair<const char*, const StageReport*> stages[] = {
-      {"detections", &r->detections},       {"tracker", &r->tracker},
-      {"box_rule", &r->box_rule},           {"depth_mask", &r->depth_mask},
-      {"probability", &r->probability},     {"moving_consistency", &r->moving_consistency},
-      {"reprojection", &r->reprojection},   {"coherent_motion", &r->coherent_motion},
-      {"subbox", &r->subbox},               {"multiview", &r->multiview},
-      {"static_history", &r->static_history}};
   Status failed = Status::Ok;
-  for (const auto& st : stages) {
-    const Status s = st.second->status;
-    if (!st.second->enabled || s == Status::Ok || s == Status::Skipped) continue;
+  for (const StageDeclaration<T>& stage : kStages<T>) {
+    const StageReport& st = r->*stage.report;
+    const Status s = st.status;
+    if (!st.enabled || s == Status::Ok || s == Status::Skipped) continue;
     if (s != Status::MissingInput && failed == Status::Ok) failed = s;
     if (r->status == Status::Ok) r->status = Status::MissingInput;
     if (!r->reason.empty()) r->reason += "; ";
-    r->reason += st.first;
+    r->reason += stage.name;
     r->reason += ": ";
-    if (st.second->reason.empty())
+    if (st.reason.empty())
       r->reason += to_string(s);
     else
-      r->reason += st.second->reason;
+      r->reason += st.reason;
   }
   if (failed != Status::Ok) r->status = failed;
 }

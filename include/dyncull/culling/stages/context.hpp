@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dyncull/culling/pipeline_types.hpp"
+#include "dyncull/culling/stages/declarations.hpp"
 #include "dyncull/culling/subbox_memory.hpp"
 
 #include <cstddef>
@@ -124,12 +125,6 @@ struct PipelineWork {
 template <class T>
 PipelineWork<T>& work_of(PipelineState<T>* state);
 
-/// An enabled stage that cannot run this frame because an input of the frame was not given (the frame's
-/// status then says so: report_stage_outcomes). `what` names the input as CullingFrame does.
-inline void lacks_input(StageReport* stage, const char* what) {
-  stage->status = Status::MissingInput;
-  stage->reason.assign(what);
-}
 }  // namespace detail
 
 /// Caller-owned state carried between frames. The stages' per-frame buffers are private (reused so the

@@ -23,9 +23,7 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
   GeometricEvidence<T>& g = *out;
   const FlagView in_boxes = regions.dyn_boxes.empty() ? nullptr : FlagView(semantic.in_dyn_box);
   if (options.moving_consistency.enabled) {
-    if (!frame.prev_keypoints) {  // given ones hold n positions (accept_inputs)
-      lacks_input(&r->moving_consistency, "no prev_keypoints given");
-    } else {
+    if (stage_has_inputs(frame, options, &PipelineResult<T>::moving_consistency, r)) {
       check_moving_consistency(*frame.prev_keypoints, kp, options.moving_consistency, &g.moving, frame.track_valid,
                                in_boxes);
       r->moving_consistency.status = g.moving.status;
@@ -38,9 +36,7 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
     g.source.assign(n, CullReason::Epipolar);
   }
   if (options.reprojection.enabled) {
-    if (!frame.points_3d) {  // given ones hold n points (accept_inputs)
-      lacks_input(&r->reprojection, "no points_3d given");
-    } else {
+    if (stage_has_inputs(frame, options, &PipelineResult<T>::reprojection, r)) {
       check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &g.reprojection, frame.track_valid,
                          in_boxes, frame.depth);
       r->reprojection.status = g.reprojection.status;

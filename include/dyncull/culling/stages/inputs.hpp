@@ -20,26 +20,15 @@ void begin_frame(const PipelineOptions<T>& options, PipelineResult<T>* r) {
   r->guard_restored = 0;
   r->history_kept = 0;
   r->unsheltered = 0;
-  for (StageReport* st : {&r->detections, &r->tracker, &r->box_rule, &r->depth_mask, &r->probability,
-                          &r->moving_consistency, &r->reprojection, &r->coherent_motion, &r->subbox, &r->multiview,
-                          &r->static_history}) {
-    st->status = Status::Skipped;
-    st->reason.clear();
-    st->num_dynamic = 0;
+  for (const StageDeclaration<T>& stage : kStages<T>) {
+    StageReport& st = r->*stage.report;
+    st.enabled = stage.enabled(options);
+    st.status = Status::Skipped;
+    st.reason.clear();
+    st.num_dynamic = 0;
   }
-  r->detections.enabled = options.detections.enabled;
-  r->tracker.enabled = options.tracker.enabled;
-  r->box_rule.enabled = options.box_rule.enabled;
-  r->depth_mask.enabled = options.depth_mask.enabled;
-  r->probability.enabled = options.probability.enabled;
-  r->moving_consistency.enabled = options.moving_consistency.enabled;
-  r->reprojection.enabled = options.reprojection.enabled;
-  r->coherent_motion.enabled = options.coherent_motion.enabled;
   if (options.coherent_motion.enabled)
     r->coherent_motion.reason = "runs with the sub-box refinement, on the reprojection check's residuals";
-  r->subbox.enabled = options.subbox.enabled;
-  r->multiview.enabled = options.multiview.enabled;
-  r->static_history.enabled = options.static_history.enabled;
 }
 
 /// False (r filled: InvalidInput, every keypoint Static and kept) when the frame cannot be culled: no

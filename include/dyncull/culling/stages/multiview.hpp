@@ -22,21 +22,9 @@ void check_against_keyframes(const Frame& frame, const PipelineOptions<T>& optio
   m.ok = false;
   if (!options.multiview.enabled) return;
   const auto& kp = *frame.keypoints;
-  if (!frame.cam_from_world || !frame.cam_from_world->all_finite()) {
-    lacks_input(&r->multiview, frame.cam_from_world ? "cam_from_world not finite (tracking lost)"
-                                                    : "no cam_from_world given");
-    return;
-  }
-  if (frame.depth.empty()) {
-    lacks_input(&r->multiview, "no depth given");
-    return;
-  }
   // Before the first keyframe is stored (is_keyframe, or pushed by hand) there is no reference view: an
   // input the check lacks, as a pose or depth would be, so the frame says so.
-  if (keyframes.empty()) {
-    lacks_input(&r->multiview, "no reference keyframe stored yet");
-    return;
-  }
+  if (!stage_has_inputs(frame, options, &PipelineResult<T>::multiview, r, !keyframes.empty())) return;
   // Seeds grow over the whole image: a flag culls wherever it is (DynaSLAM).
   PixelRect roi{0, 0, frame.depth.width, frame.depth.height};
   m.ref_index.resize(std::max<std::size_t>(1, std::min(options.multiview.max_reference_keyframes, keyframes.size())));

@@ -20,10 +20,7 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
   if (!options.probability.enabled) return;
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
-  if (!frame.prev_keypoints) {  // given ones hold n positions (accept_inputs)
-    lacks_input(&r->probability, "no prev_keypoints given");
-    return;
-  }
+  if (!stage_has_inputs(frame, options, &PipelineResult<T>::probability, r)) return;
   const FlagView track_valid = frame.track_valid;  // accept_inputs checked its size
   p.levels.assign(n, MotionLevel::Ignore);
   p.prev.resize(n);

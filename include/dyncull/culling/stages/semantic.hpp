@@ -167,15 +167,12 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
     }
     // Without the detection filter, the box rule is the stage that reads the detections. It still ran on
     // no boxes, so a non-finite keypoint is culled as on any frame.
-    if (!frame.detections && !options.detections.enabled) lacks_input(&r->box_rule, "no detections given");
+    stage_has_inputs(frame, options, &PipelineResult<T>::box_rule, r);
   }
 
   // Inside dynamic-class boxes only the object's depth band is culled.
   if (!options.depth_mask.enabled) return;
-  if (frame.depth.empty()) {
-    lacks_input(&r->depth_mask, "no depth given");
-    return;
-  }
+  if (!stage_has_inputs(frame, options, &PipelineResult<T>::depth_mask, r)) return;
   DepthMaskResult& dm = s.mask;
   depth_mask(frame.depth, regions.dyn_boxes, kp, options.depth_mask, &dm, &s.mask_scratch);
   r->depth_mask.status = dm.status;
