@@ -26,16 +26,18 @@ struct ModelCheckRule {
   std::size_t min_tracks_outside_boxes;  ///< ... when at least this many of them are usable
 };
 
-// An estimator E plugged into check_against_model provides:
-//   E::kMinimalTracks, E::kSubsetLeavesSomeOut (the subset counts only when it excludes tracks),
-//   E::kSizeMismatch, E::kTooFew (reason texts), members `options` (with validate()) and `r` (the result:
-//   status, reason, labels, inlier_mask, num_* counters, fitted_outside_boxes);
-//   size(), sizes_agree(), reset() (its own outputs to "not evaluated", its buffers emptied),
-//   inputs_valid(&why) (checks beyond sizes, flags and options), usable(i) (finite inputs), keep(i) (a
-//   usable track, in index order), begin_fit(subset) (true: hand over the fit tracks by add_to_fit(k, i), the k-th
-//   usable track i, in index order), fit() and polish() (false from fit(): status and reason set), residuals_ready() (false:
-//   status and reason set), label(k, i, limit) for the k-th usable track i (Candidate = no evidence),
-//   finish().
+// An estimator plugged into check_against_model provides:
+//   constants  kMinimalTracks (the model's minimal sample), kSubsetLeavesSomeOut (the subset is reported
+//              only when it excludes a track), kSizeMismatch and kTooFew (reason texts);
+//   members    options (with validate()) and r (the result: status, reason, labels, inlier_mask, the num_*
+//              counters, fitted_outside_boxes);
+//   inputs     size(), sizes_agree(), inputs_valid(&why) (checks beyond sizes, flags and options), usable(i)
+//              (finite inputs);
+//   steps      reset() (its outputs to "not evaluated", its buffers emptied); keep(i) for each usable
+//              track; begin_fit(subset), true to be handed the fit tracks by add_to_fit(k, i); fit();
+//              polish(); residuals_ready(); label(k, i, limit) (Candidate = no evidence); finish().
+//              fit() and residuals_ready() return false with status and reason set.
+// i indexes all tracks, k the usable ones; both follow index order, which RANSAC's sampling depends on.
 
 /// Every track a candidate, nothing fitted; false (InvalidInput, reason set) when the inputs break the
 /// contract, checked in this order: sizes, flag views, options, the estimator's own inputs.
