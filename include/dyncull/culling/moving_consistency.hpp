@@ -1,6 +1,7 @@
 /// @file moving_consistency.hpp
-/// Moving-consistency check (DFD-SLAM, Qian et al. 2024, §3.2 eq. 1-3; DS-SLAM): F by RANSAC on the tracked features, then
-/// each track's distance D = |p2^T F p1| / sqrt(X^2 + Y^2) to its epipolar line; D above a threshold = dynamic.
+/// Moving-consistency check (DFD-SLAM, Qian et al. 2024, §3.2 eq. 1-3; DS-SLAM, Yu et al. 2018): F by RANSAC on
+/// the tracks (outside dynamic-class boxes: SG-SLAM, Cheng et al. 2023), then each track's distance
+/// D = |p2^T F p1| / sqrt(X^2 + Y^2) to its epipolar line; D above a threshold = dynamic (model_check.hpp).
 #pragma once
 
 #include "dyncull/core/flags.hpp"
@@ -8,6 +9,7 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/model_check.hpp"
 #include "dyncull/culling/validation.hpp"
 #include "dyncull/geometry/epipolar.hpp"
 #include "dyncull/geometry/fundamental.hpp"
@@ -16,7 +18,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -97,116 +98,125 @@ struct MovingConsistencyResult {
 
 namespace detail {
 
-/// Every track a candidate with no distance yet; false (status and reason set) when the inputs break
-/// the contract.
-template <class T>
-bool consistency_start(std::size_t n, std::size_t n_prev, FlagView valid, FlagView in_box,
-                       const MovingConsistencyOptions<T>& options, MovingConsistencyResult<T>* out) {
-  MovingConsistencyResult<T>& r = *out;
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_tracks = n;
-  r.num_valid = r.num_fit = r.num_inliers = r.num_dynamic = r.num_static = r.ransac_iterations = 0;
-  r.fitted_outside_boxes = false;
-  r.F.setZero();
-  r.labels.assign(n, FeatureLabel::Candidate);
-  r.distance_px.assign(n, Constants<T>::nan());
-  r.inlier_mask.assign(n, 0);
-  auto stop = [&](std::string why) {
-    r.status = Status::InvalidInput;
-    r.reason = std::move(why);
-    return false;
-  };
-  if (n_prev != n) return stop("prev and cur differ in size");
-  std::string why;
-  if (!flags_fit(valid, n, "valid", "tracks", &why) || !flags_fit(in_box, n, "in_box", "tracks", &why))
-    return stop(why);
-  if (options.validate(&why) != Status::Ok) return stop("invalid options: " + why);
-  return true;
-}
-
-/// The valid, finite tracks compacted into the scratch (their indices in scratch_index); returns those
-/// outside the boxes, for SG-SLAM's fit subset.
+/// The epipolar estimator of check_against_model (model_check.hpp): F by RANSAC on the fit tracks,
+/// polished by the 8-point algorithm, and each track's eq. 3 distance to its epipolar line.
 template <class T, class C1, class C2>
-std::size_t consistency_compact(const C1& prev, const C2& cur, FlagView valid, FlagView in_box,
-                                MovingConsistencyResult<T>* r) {
-  r->scratch_prev.clear();
-  r->scratch_cur.clear();
-  r->scratch_index.clear();
-  std::size_t outside = 0;
-  for (std::size_t i = 0; i < static_cast<std::size_t>(cur.size()); ++i) {
-    if (valid.given && !valid[i]) continue;
-    const T x1 = point_x<T>(prev[i]), y1 = point_y<T>(prev[i]), x2 = point_x<T>(cur[i]), y2 = point_y<T>(cur[i]);
-    if (!std::isfinite(x1) || !std::isfinite(y1) || !std::isfinite(x2) || !std::isfinite(y2)) continue;
-    r->scratch_prev.emplace_back(x1, y1);
-    r->scratch_cur.emplace_back(x2, y2);
+struct EpipolarEstimator {
+  static constexpr std::size_t kMinimalTracks = 8;
+  // With every usable track outside the boxes the subset is the whole set: not reported as the subset.
+  static constexpr bool kSubsetLeavesSomeOut = true;
+  static constexpr const char* kSizeMismatch = "prev and cur differ in size";
+  static constexpr const char* kTooFew = " valid tracks, the moving-consistency check needs at least ";
+
+  const C1& prev;
+  const C2& cur;
+  const MovingConsistencyOptions<T>& options;
+  MovingConsistencyResult<T>* r;
+  bool subset = false;  ///< F is fitted on the tracks outside the boxes, copied apart
+
+  std::size_t size() const { return static_cast<std::size_t>(cur.size()); }
+  bool sizes_agree() const { return static_cast<std::size_t>(prev.size()) == size(); }
+  bool inputs_valid(std::string*) const { return true; }
+
+  void reset() {
+    r->ransac_iterations = 0;
+    r->F.setZero();
+    r->distance_px.assign(size(), Constants<T>::nan());
+    r->scratch_prev.clear();
+    r->scratch_cur.clear();
+    r->scratch_index.clear();
+    r->scratch_fit_prev.clear();
+    r->scratch_fit_cur.clear();
+    r->scratch_fit_index.clear();
+  }
+
+  bool usable(std::size_t i) const {
+    using std::isfinite;
+    return isfinite(point_x<T>(prev[i])) && isfinite(point_y<T>(prev[i])) && isfinite(point_x<T>(cur[i])) &&
+           isfinite(point_y<T>(cur[i]));
+  }
+  /// Every usable track, compacted: the distances are one batch pass over them.
+  void keep(std::size_t i) {
+    r->scratch_prev.emplace_back(point_x<T>(prev[i]), point_y<T>(prev[i]));
+    r->scratch_cur.emplace_back(point_x<T>(cur[i]), point_y<T>(cur[i]));
     r->scratch_index.push_back(static_cast<std::uint32_t>(i));
-    outside += !(in_box.given && in_box[i]);
   }
-  return outside;
-}
+  /// The subset is copied apart; without it F is fitted on the kept tracks as they are.
+  bool begin_fit(bool fit_subset) {
+    subset = fit_subset;
+    return subset;
+  }
+  void add_to_fit(std::size_t k, std::size_t i) {
+    r->scratch_fit_prev.push_back(r->scratch_prev[k]);
+    r->scratch_fit_cur.push_back(r->scratch_cur[k]);
+    r->scratch_fit_index.push_back(static_cast<std::uint32_t>(i));
+  }
+  const std::vector<Vec2<T>>& fit_prev() const { return subset ? r->scratch_fit_prev : r->scratch_prev; }
+  const std::vector<Vec2<T>>& fit_cur() const { return subset ? r->scratch_fit_cur : r->scratch_cur; }
 
-/// F by RANSAC on the compacted tracks, on those outside the boxes alone when `subset`; false (status
-/// and reason set) when F is not usable: Degenerate means one homography explains the tracks (static
-/// camera, pure rotation, planar scene), so F's epipolar lines carry no evidence of motion.
-template <class T>
-bool consistency_fit(bool subset, FlagView in_box, const MovingConsistencyOptions<T>& options,
-                     MovingConsistencyResult<T>* out) {
-  MovingConsistencyResult<T>& r = *out;
-  const std::size_t m = r.scratch_index.size();
-  FundamentalResult<T>& fr = r.scratch_ransac_fit;
-  if (subset) {
-    r.scratch_fit_prev.clear();
-    r.scratch_fit_cur.clear();
-    r.scratch_fit_index.clear();
-    for (std::size_t k = 0; k < m; ++k) {
-      if (in_box[r.scratch_index[k]]) continue;
-      r.scratch_fit_prev.push_back(r.scratch_prev[k]);
-      r.scratch_fit_cur.push_back(r.scratch_cur[k]);
-      r.scratch_fit_index.push_back(r.scratch_index[k]);
+  /// F-RANSAC on the fit tracks; false when F is not usable: Degenerate means one homography explains the
+  /// tracks (static camera, pure rotation, planar scene), so F's epipolar lines carry no evidence of motion.
+  bool fit() {
+    FundamentalResult<T>& fr = r->scratch_ransac_fit;
+    estimate_fundamental_ransac(fit_prev(), fit_cur(), options.fundamental, &r->scratch_fundamental, &fr);
+    const std::vector<std::uint32_t>& fit_index = subset ? r->scratch_fit_index : r->scratch_index;
+    for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r->inlier_mask[fit_index[k]] = fr.inlier_mask[k];
+    r->num_inliers = fr.num_inliers;
+    r->ransac_iterations = fr.iterations;
+    r->F = fr.F;
+    if (fr.ok()) return true;
+    r->status = fr.status;
+    r->reason.assign("fundamental matrix not usable: ").append(fr.reason);  // into the kept buffer
+    for (auto& m8 : r->inlier_mask) m8 = 0;
+    r->num_inliers = 0;
+    return false;
+  }
+
+  /// Refits F by the 8-point algorithm on the fit tracks within max_epipolar_distance_px of it,
+  /// refit_iterations times (stops early below 16 tracks or on a failed fit): at small baselines the
+  /// RANSAC model is noticeably worse than a least-squares fit on its own inliers.
+  void polish() {
+    const std::vector<Vec2<T>>& fp = fit_prev();
+    const std::vector<Vec2<T>>& fc = fit_cur();
+    r->scratch_distance.resize(r->scratch_index.size());
+    for (int it = 0; it < options.refit_iterations; ++it) {
+      if (epipolar_distances(r->F, fp, fc, r->scratch_distance.data(), EpipolarDistance::PointToLine) != Status::Ok)
+        break;  // residuals_ready reports it
+      r->scratch_refit_prev.clear();
+      r->scratch_refit_cur.clear();
+      for (std::size_t k = 0; k < fp.size(); ++k) {
+        if (!(r->scratch_distance[k] <= options.max_epipolar_distance_px)) continue;
+        r->scratch_refit_prev.push_back(fp[k]);
+        r->scratch_refit_cur.push_back(fc[k]);
+      }
+      if (r->scratch_refit_prev.size() < 16) break;
+      FundamentalResult<T>& polished = r->scratch_polished_fit;
+      fundamental_8point(r->scratch_refit_prev, r->scratch_refit_cur, &r->scratch_fundamental, &polished);
+      if (!polished.ok()) break;
+      r->F = polished.F;
     }
   }
-  const std::vector<std::uint32_t>& fit_index = subset ? r.scratch_fit_index : r.scratch_index;
-  estimate_fundamental_ransac(subset ? r.scratch_fit_prev : r.scratch_prev, subset ? r.scratch_fit_cur : r.scratch_cur,
-                              options.fundamental, &r.scratch_fundamental, &fr);
-  r.fitted_outside_boxes = subset;
-  r.num_fit = fit_index.size();
-  for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r.inlier_mask[fit_index[k]] = fr.inlier_mask[k];
-  r.num_inliers = fr.num_inliers;
-  r.ransac_iterations = fr.iterations;
-  r.F = fr.F;
-  if (fr.ok()) return true;
-  r.status = fr.status;
-  r.reason.assign("fundamental matrix not usable: ").append(fr.reason);  // into the kept buffer
-  for (auto& m8 : r.inlier_mask) m8 = 0;
-  r.num_inliers = 0;
-  return false;
-}
 
-/// Polishes F by the 8-point algorithm on the fit tracks within max_epipolar_distance_px of it,
-/// refit_iterations times (stops early below 16 tracks or on a failed fit).
-template <class T>
-void consistency_refit(bool subset, const MovingConsistencyOptions<T>& options, MovingConsistencyResult<T>* r) {
-  const std::vector<Vec2<T>>& fit_prev = subset ? r->scratch_fit_prev : r->scratch_prev;
-  const std::vector<Vec2<T>>& fit_cur = subset ? r->scratch_fit_cur : r->scratch_cur;
-  for (int it = 0; it < options.refit_iterations; ++it) {
-    if (epipolar_distances(r->F, fit_prev, fit_cur, r->scratch_distance.data(), EpipolarDistance::PointToLine) !=
-        Status::Ok)
-      break;  // the final pass reports it
-    r->scratch_refit_prev.clear();
-    r->scratch_refit_cur.clear();
-    for (std::size_t k = 0; k < fit_prev.size(); ++k) {
-      if (!(r->scratch_distance[k] <= options.max_epipolar_distance_px)) continue;
-      r->scratch_refit_prev.push_back(fit_prev[k]);
-      r->scratch_refit_cur.push_back(fit_cur[k]);
-    }
-    if (r->scratch_refit_prev.size() < 16) break;
-    FundamentalResult<T>& polished = r->scratch_polished_fit;
-    fundamental_8point(r->scratch_refit_prev, r->scratch_refit_cur, &r->scratch_fundamental, &polished);
-    if (!polished.ok()) break;
-    r->F = polished.F;
+  /// The eq. 3 distance of every usable track; false when F = 0 (Degenerate) or is not finite
+  /// (NonFinite): no epipolar line, so no track has evidence.
+  bool residuals_ready() {
+    r->scratch_distance.resize(r->scratch_index.size());
+    const Status ds = epipolar_distances(r->F, r->scratch_prev, r->scratch_cur, r->scratch_distance.data(),
+                                         EpipolarDistance::PointToLine);
+    if (ds == Status::Ok) return true;
+    r->status = ds;
+    r->reason = std::string("epipolar distances not usable (") + to_string(ds) + "): F is zero or not finite";
+    return false;
   }
-}
+
+  FeatureLabel label(std::size_t k, std::size_t i, T limit) {
+    const T d = r->scratch_distance[k];
+    r->distance_px[i] = d;
+    if (!std::isfinite(d)) return FeatureLabel::Candidate;  // at the epipole: the line is undefined
+    return d > limit ? FeatureLabel::Dynamic : FeatureLabel::Static;
+  }
+  void finish() {}
+};
 
 }  // namespace detail
 
@@ -220,43 +230,11 @@ void check_moving_consistency(const C1& prev, const C2& cur, const MovingConsist
                               MovingConsistencyResult<T>* out, FlagView valid = nullptr, FlagView in_box = nullptr) {
   static_assert(is_point_container_v<C1> && is_point_container_v<C2>,
                 "dyncull::check_moving_consistency: prev and cur must hold points (see PointTraits)");
-  MovingConsistencyResult<T>& r = *out;
-  const std::size_t n = static_cast<std::size_t>(cur.size());
-  if (!detail::consistency_start(n, static_cast<std::size_t>(prev.size()), valid, in_box, options, out)) return;
-  const std::size_t outside = detail::consistency_compact<T>(prev, cur, valid, in_box, out);
-  const std::size_t m = r.scratch_index.size();
-  r.num_valid = m;
-  if (m < options.min_tracks || m < 8) {
-    r.status = Status::Skipped;
-    r.reason = std::to_string(m) + " valid tracks, the moving-consistency check needs at least " +
-               std::to_string(options.min_tracks < 8 ? 8 : options.min_tracks);
-    return;
-  }
-  const bool subset =
-      in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes && outside < m;
-  if (!detail::consistency_fit(subset, in_box, options, out)) return;
-  r.scratch_distance.resize(m);
-  detail::consistency_refit(subset, options, out);
-  const Status ds =
-      epipolar_distances(r.F, r.scratch_prev, r.scratch_cur, r.scratch_distance.data(), EpipolarDistance::PointToLine);
-  if (ds != Status::Ok) {
-    // F = 0 (Degenerate) or non-finite (NonFinite): no epipolar line, so no track has evidence.
-    r.status = ds;
-    r.reason = std::string("epipolar distances not usable (") + to_string(ds) + "): F is zero or not finite";
-    return;
-  }
-  // DFD-SLAM eq. 3: a track further than the threshold from its epipolar line is dynamic.
-  const T t_out = options.max_epipolar_distance_px, t_in = options.max_epipolar_distance_in_boxes_px;
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::uint32_t i = r.scratch_index[k];
-    const T d = r.scratch_distance[k];
-    r.distance_px[i] = d;
-    if (!std::isfinite(d)) continue;  // at the epipole: the line is undefined, no evidence
-    const bool dyn = d > ((in_box.given && in_box[i]) ? t_in : t_out);
-    r.labels[i] = dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;
-    r.num_dynamic += dyn;
-    r.num_static += !dyn;
-  }
+  detail::EpipolarEstimator<T, C1, C2> epipolar{prev, cur, options, out};
+  const detail::ModelCheckRule<T> rule{options.max_epipolar_distance_px, options.max_epipolar_distance_in_boxes_px,
+                                       options.min_tracks, options.fit_outside_boxes,
+                                       options.min_tracks_outside_boxes};
+  detail::check_against_model(epipolar, valid, in_box, rule);
 }
 
 /// Convenience overload returning a fresh result.

@@ -1,9 +1,7 @@
 /// @file reprojection_check.hpp
-/// RGB-D moving-consistency check: the camera pose is fitted by PnP-RANSAC on tracks outside the
-/// dynamic boxes (SG-SLAM's fit subset), and a track is dynamic when its 3-D point reprojects far from it.
-/// It is the depth counterpart of the epipolar check (DFD-SLAM, Qian et al. 2024, eq. 3): the epipolar distance only sees the
-/// motion across the epipolar line, the reprojection residual all of it in the image, and the optional
-/// depth residual (measured against predicted depth) the motion along the viewing ray (docs/algorithms.md).
+/// RGB-D form of the moving-consistency check (DFD-SLAM, Qian et al. 2024, eq. 3): the pose by PnP-RANSAC on the
+/// tracks outside dynamic boxes (SG-SLAM, Cheng et al. 2023), then each track's reprojection residual, and
+/// optionally its depth residual, against a threshold (model_check.hpp).
 #pragma once
 
 #include "dyncull/core/camera.hpp"
@@ -14,6 +12,7 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
+#include "dyncull/culling/model_check.hpp"
 #include "dyncull/culling/validation.hpp"
 #include "dyncull/geometry/pnp.hpp"
 #include "dyncull/geometry/pose_covariance.hpp"
@@ -26,7 +25,6 @@
 #include <cstdint>
 #include <limits>
 #include <string>
-#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -142,94 +140,6 @@ struct ReprojectionCheckResult {
 
 namespace detail {
 
-/// Every track a candidate with no residual yet; false (status and reason set) when the inputs break
-/// the contract.
-template <class T, class Raw>
-bool reprojection_start(std::size_t n, std::size_t n_points, FlagView valid, FlagView in_box,
-                        const PinholeCamera<T>& camera, const ReprojectionCheckOptions<T>& options,
-                        const DepthView<Raw>& depth, ReprojectionCheckResult<T>* out) {
-  ReprojectionCheckResult<T>& r = *out;
-  r.status = Status::Ok;
-  r.reason.clear();
-  r.num_tracks = n;
-  r.num_valid = r.num_fit = r.num_inliers = r.num_dynamic = r.num_static = r.num_depth_dynamic = 0;
-  r.fitted_outside_boxes = false;
-  r.cam_from_world = Rigid3<T>();
-  r.labels.assign(n, FeatureLabel::Candidate);
-  r.residual_px.assign(n, Constants<T>::nan());
-  r.residual_vec.assign(n, Vec2<T>(Constants<T>::nan(), Constants<T>::nan()));
-  r.inlier_noise_px = Constants<T>::nan();
-  r.uncertainty_px.assign(n, Constants<T>::nan());
-  r.depth_residual_m.assign(n, Constants<T>::nan());
-  r.inlier_mask.assign(n, 0);
-  auto stop = [&](std::string why) {
-    r.status = Status::InvalidInput;
-    r.reason = std::move(why);
-    return false;
-  };
-  if (n_points != n) return stop("points and pixels differ in size");
-  std::string why;
-  if (!flags_fit(valid, n, "valid", "tracks", &why) || !flags_fit(in_box, n, "in_box", "tracks", &why))
-    return stop(why);
-  if (options.validate(&why) != Status::Ok) return stop("invalid options: " + why);
-  if (depth.validate(&why) != Status::Ok) return stop(why);
-  if (!camera.valid()) return stop("invalid camera intrinsics");
-  return true;
-}
-
-/// The pose by PnP-RANSAC on the usable tracks (valid, finite point and pixel), on those outside the
-/// boxes alone when there are enough of them (SG-SLAM's fit subset); false (status and reason set)
-/// with too few tracks or no pose.
-template <class T, class Points3, class Pixels>
-bool reprojection_fit(const Points3& points, const Pixels& pixels, const PinholeCamera<T>& camera, FlagView valid,
-                      FlagView in_box, const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* out) {
-  ReprojectionCheckResult<T>& r = *out;
-  const std::size_t n = static_cast<std::size_t>(pixels.size());
-  std::size_t usable = 0, outside = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (valid.given && !valid[i]) continue;
-    const T X = point_x<T>(points[i]), Y = point_y<T>(points[i]), Z = point_z<T>(points[i]);
-    const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
-    if (!(std::isfinite(X) && std::isfinite(Y) && std::isfinite(Z) && std::isfinite(u) && std::isfinite(v))) continue;
-    ++usable;
-    outside += !(in_box.given && in_box[i]);
-  }
-  r.num_valid = usable;
-  if (usable < options.min_tracks || usable < 4) {
-    r.status = Status::Skipped;
-    r.reason = std::to_string(usable) + " tracks with a 3-D point, the reprojection check needs at least " +
-               std::to_string(options.min_tracks < 4 ? 4 : options.min_tracks);
-    return false;
-  }
-  const bool subset = in_box.given && options.fit_outside_boxes && outside >= options.min_tracks_outside_boxes;
-  r.scratch_points.clear();
-  r.scratch_pixels.clear();
-  r.scratch_index.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    if ((valid.given && !valid[i]) || (subset && in_box[i])) continue;
-    const Vec3<T> X(point_x<T>(points[i]), point_y<T>(points[i]), point_z<T>(points[i]));
-    const Vec2<T> x(point_x<T>(pixels[i]), point_y<T>(pixels[i]));
-    if (!X.allFinite() || !x.allFinite()) continue;
-    r.scratch_points.push_back(X);
-    r.scratch_pixels.push_back(x);
-    r.scratch_index.push_back(static_cast<std::uint32_t>(i));
-  }
-  r.fitted_outside_boxes = subset;
-  r.num_fit = r.scratch_index.size();
-  PnpResult<T>& pr = r.scratch_pose_fit;
-  solve_pnp_ransac(r.scratch_points, r.scratch_pixels, camera, options.pnp, &r.scratch_pnp, &pr);
-  if (!pr.ok() || !pr.cam_from_world.all_finite()) {
-    r.status = pr.ok() ? Status::NonFinite : pr.status;
-    r.reason.assign("pose not found: ").append(pr.ok() ? "non-finite pose" : pr.reason);  // into the kept buffer
-    return false;
-  }
-  r.cam_from_world = pr.cam_from_world;
-  r.num_inliers = pr.num_inliers;
-  for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r.scratch_index.size(); ++k)
-    r.inlier_mask[r.scratch_index[k]] = pr.inlier_mask[k];
-  return true;
-}
-
 /// Track i's residuals at the fitted pose and its label: dynamic when the pixel residual exceeds its
 /// limit (tighter in a box; widened to uncertainty_sigmas times the pose's spread there when `cov`), or
 /// when the depth residual exceeds max_depth_residual_sigmas of the sensor's axial noise; a point behind
@@ -287,6 +197,98 @@ void reprojection_inlier_noise(ReprojectionCheckResult<T>* r) {
   }
 }
 
+/// The pose estimator of check_against_model (model_check.hpp): the pose by PnP-RANSAC (refined by LM
+/// inside solve_pnp_ransac) on the fit tracks, and each track's reprojection (and depth) residual. The
+/// epipolar distance sees only the motion across the epipolar line, the reprojection residual all of it in
+/// the image, and the depth residual the motion along the viewing ray (docs/algorithms.md).
+template <class T, class Points3, class Pixels, class Raw>
+struct ReprojectionEstimator {
+  static constexpr std::size_t kMinimalTracks = 4;
+  static constexpr bool kSubsetLeavesSomeOut = false;  // the subset flag reports the rule as met
+  static constexpr const char* kSizeMismatch = "points and pixels differ in size";
+  static constexpr const char* kTooFew = " tracks with a 3-D point, the reprojection check needs at least ";
+
+  const Points3& points;
+  const Pixels& pixels;
+  const PinholeCamera<T>& camera;
+  const ReprojectionCheckOptions<T>& options;
+  const DepthView<Raw>& depth;
+  ReprojectionCheckResult<T>* r;
+  PoseCovariance cov = PoseCovariance::Zero();
+  bool use_cov = false, use_depth = false;
+
+  std::size_t size() const { return static_cast<std::size_t>(pixels.size()); }
+  bool sizes_agree() const { return static_cast<std::size_t>(points.size()) == size(); }
+  bool inputs_valid(std::string* why) const {
+    if (depth.validate(why) != Status::Ok) return false;
+    if (camera.valid()) return true;
+    *why = "invalid camera intrinsics";
+    return false;
+  }
+
+  void reset() {
+    const std::size_t n = size();
+    const T nan = Constants<T>::nan();
+    r->num_depth_dynamic = 0;
+    r->cam_from_world = Rigid3<T>();
+    r->residual_px.assign(n, nan);
+    r->residual_vec.assign(n, Vec2<T>(nan, nan));
+    r->inlier_noise_px = nan;
+    r->uncertainty_px.assign(n, nan);
+    r->depth_residual_m.assign(n, nan);
+    r->scratch_points.clear();
+    r->scratch_pixels.clear();
+    r->scratch_index.clear();
+  }
+
+  Vec3<T> point(std::size_t i) const {
+    return Vec3<T>(point_x<T>(points[i]), point_y<T>(points[i]), point_z<T>(points[i]));
+  }
+  Vec2<T> pixel(std::size_t i) const { return Vec2<T>(point_x<T>(pixels[i]), point_y<T>(pixels[i])); }
+  bool usable(std::size_t i) const { return point(i).allFinite() && pixel(i).allFinite(); }  // no depth: no point
+  void keep(std::size_t) {}  // the residuals are read from the inputs
+  bool begin_fit(bool) { return true; }
+  void add_to_fit(std::size_t, std::size_t i) {
+    r->scratch_points.push_back(point(i));
+    r->scratch_pixels.push_back(pixel(i));
+    r->scratch_index.push_back(static_cast<std::uint32_t>(i));
+  }
+
+  bool fit() {
+    PnpResult<T>& pr = r->scratch_pose_fit;
+    solve_pnp_ransac(r->scratch_points, r->scratch_pixels, camera, options.pnp, &r->scratch_pnp, &pr);
+    if (!pr.ok() || !pr.cam_from_world.all_finite()) {
+      r->status = pr.ok() ? Status::NonFinite : pr.status;
+      r->reason.assign("pose not found: ").append(pr.ok() ? "non-finite pose" : pr.reason);  // into the kept buffer
+      return false;
+    }
+    r->cam_from_world = pr.cam_from_world;
+    r->num_inliers = pr.num_inliers;
+    for (std::size_t k = 0; k < pr.inlier_mask.size() && k < r->scratch_index.size(); ++k)
+      r->inlier_mask[r->scratch_index[k]] = pr.inlier_mask[k];
+    return true;
+  }
+  void polish() {}  // PnP-RANSAC's LM refinement is the polish
+
+  /// The pose's uncertainty widens each track's limit by the spread it gives that track's projection.
+  bool residuals_ready() {
+    const PnpResult<T>& pr = r->scratch_pose_fit;
+    use_cov = options.uncertainty_sigmas > T(0) &&
+              pose_covariance(r->scratch_points, pr.inlier_mask, r->cam_from_world, camera,
+                              std::max(pr.rmse_px, double(options.min_noise_px)), &cov);
+    use_depth = options.max_depth_residual_sigmas > T(0) && !depth.empty();
+    return true;
+  }
+
+  FeatureLabel label(std::size_t, std::size_t i, T limit) {
+    const Vec2<T> x = pixel(i);
+    const bool dyn = reprojection_label(i, point(i), x.x(), x.y(), limit, camera, use_cov ? &cov : nullptr,
+                                        use_depth ? &depth : nullptr, options, r);
+    return dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;  // behind the camera: dynamic
+  }
+  void finish() { reprojection_inlier_noise(r); }
+};
+
 }  // namespace detail
 
 /// Runs the check on n tracks: points[i] is the 3-D point of track i in any fixed frame (world, or the
@@ -305,31 +307,10 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
                         const DepthView<Raw>& depth = DepthView<Raw>{}) {
   static_assert(is_point_container_v<Points3> && is_point_container_v<Pixels>,
                 "dyncull::check_reprojection: points and pixels must hold points (see PointTraits)");
-  ReprojectionCheckResult<T>& r = *out;
-  const std::size_t n = static_cast<std::size_t>(pixels.size());
-  if (!detail::reprojection_start(n, static_cast<std::size_t>(points.size()), valid, in_box, camera, options, depth,
-                                  out))
-    return;
-  if (!detail::reprojection_fit(points, pixels, camera, valid, in_box, options, out)) return;
-  // The pose's uncertainty widens each track's limit by the spread it gives that track's projection.
-  PoseCovariance cov = PoseCovariance::Zero();
-  const bool use_cov = options.uncertainty_sigmas > T(0) &&
-                       pose_covariance(r.scratch_points, r.scratch_pose_fit.inlier_mask, r.cam_from_world, camera,
-                                       std::max(r.scratch_pose_fit.rmse_px, double(options.min_noise_px)), &cov);
-  const bool use_depth = options.max_depth_residual_sigmas > T(0) && !depth.empty();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (valid.given && !valid[i]) continue;
-    const Vec3<T> X(point_x<T>(points[i]), point_y<T>(points[i]), point_z<T>(points[i]));
-    const T u = point_x<T>(pixels[i]), v = point_y<T>(pixels[i]);
-    if (!X.allFinite() || !std::isfinite(u) || !std::isfinite(v)) continue;
-    const T limit = (in_box.given && in_box[i]) ? options.max_residual_in_boxes_px : options.max_residual_px;
-    const bool dyn = detail::reprojection_label(i, X, u, v, limit, camera, use_cov ? &cov : nullptr,
-                                                use_depth ? &depth : nullptr, options, &r);
-    r.labels[i] = dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;
-    r.num_dynamic += dyn;
-    r.num_static += !dyn;
-  }
-  detail::reprojection_inlier_noise(&r);
+  detail::ReprojectionEstimator<T, Points3, Pixels, Raw> reprojection{points, pixels, camera, options, depth, out};
+  const detail::ModelCheckRule<T> rule{options.max_residual_px, options.max_residual_in_boxes_px, options.min_tracks,
+                                       options.fit_outside_boxes, options.min_tracks_outside_boxes};
+  detail::check_against_model(reprojection, valid, in_box, rule);
 }
 
 /// Convenience overload returning a fresh result.
