@@ -65,7 +65,6 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_EQ(o.subbox.min_evidence_frames, 2);
   EXPECT_TRUE(o.subbox.short_baseline_keeps_last_vote);
   EXPECT_FLOAT_EQ(o.reprojection.max_residual_in_boxes_px, 1.5f);
-  EXPECT_FLOAT_EQ(o.reprojection.uncertainty_sigmas, 0.f);
   EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
   EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
   EXPECT_DOUBLE_EQ(o.guard.min_fraction, 0.10);

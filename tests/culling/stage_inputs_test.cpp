@@ -539,9 +539,7 @@ TYPED_TEST(StageInputsTest, ReprojectionPropertyStatusOrDefinedLabels) {
     o.pnp.ransac.max_iterations = 50;
     o.max_residual_px = maybe_wild(rng, T(3));
     o.max_residual_in_boxes_px = maybe_wild(rng, T(1.5));
-    o.uncertainty_sigmas = rng.index(3) == 0 ? T(1) : maybe_wild(rng, T(0));
     o.max_depth_residual_sigmas = rng.index(3) == 0 ? T(3) : maybe_wild(rng, T(0));
-    o.min_noise_px = maybe_wild(rng, T(0.5));
     o.min_tracks = rng.index(20);
     const auto r = check_reprojection(points, pixels, camera, o, nullptr, nullptr, view);
     ASSERT_EQ(r.labels.size(), pixels.size());
@@ -561,9 +559,6 @@ TYPED_TEST(StageInputsTest, ReprojectionOptionsNameTheBadField) {
   std::string why;
   ReprojectionCheckOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
-  o.min_noise_px = -std::numeric_limits<T>::infinity();
-  expect_names_field(o, "min_noise_px");
-  o = ReprojectionCheckOptions<T>{};
   o.pnp.ransac.max_iterations = 0;
   expect_names_field(o, "pnp");
 }
