@@ -409,11 +409,9 @@ void depth_mask_property(std::uint64_t seed) {
     for (auto& p : points) p = Vec2<double>(wild<double>(rng, 0, w), wild<double>(rng, 0, h));
     DepthMaskOptions o;
     o.mode = rng.index(2) ? DepthMaskMode::Robust : DepthMaskMode::Plain;
-    o.form = rng.index(3) == 0 ? DepthThresholdForm::DynamicVins : DepthThresholdForm::DldSlam;
     o.missing_depth = static_cast<MissingDepth>(rng.index(3));
     o.occluded_centre_search = rng.index(2) == 0;
     o.eps_m = maybe_wild(rng, 0.3);
-    o.near_margin_m = maybe_wild(rng, 0.0);
     o.histogram_bin_m = maybe_wild(rng, 0.1);
     o.histogram_max_m = maybe_wild(rng, 12.0);
     o.histogram_stride_px = maybe_wild_int(rng, 0);
