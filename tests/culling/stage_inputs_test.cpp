@@ -287,8 +287,6 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     o.sigma2 = maybe_wild_int(rng, 4);
     o.static_needs_evidence = rng.index(2) == 0;
     o.static_max_dynamic_ratio = maybe_wild(rng, T(0.3));
-    o.whole_box_spare_min_points = rng.index(3);
-    o.whole_box_spare_max_ratio = maybe_wild(rng, T(0.1));
     o.dilation_radius_px = maybe_wild_int(rng, 3);
     std::vector<std::uint8_t> in_object(n);
     for (auto& f : in_object) f = static_cast<std::uint8_t>(rng.index(2));

@@ -201,55 +201,6 @@ TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
   EXPECT_NE(bad.reason.find("static_max_dynamic_ratio"), std::string::npos) << bad.reason;
 }
 
-// A seated person whose upper body fills six cells: the whole-box rule culls every cell, and with
-// whole_box_spare_min_points it spares the one whose own vote is clearly static (the still legs), but not
-// a cell with too many flags or too few votes.
-TYPED_TEST(SubBoxTest, WholeBoxRuleSparesClearlyStaticCells) {
-  using T = TypeParam;
-  std::vector<Vec2<T>> pts;
-  std::vector<FeatureLabel> geo;
-  auto add = [&](T x, T y, int n_static, int n_dynamic) { add_votes(&pts, &geo, x, y, n_static, n_dynamic); };
-  for (int c = 0; c < 6; ++c) add(T(5 + 30 * (c % 3)), T(5 + 30 * (c / 3)), 0, 5);  // cells 0-5: all flagged
-  add(T(2), T(62), 9, 1);   // cell 6: 1 of 10 flagged
-  add(T(32), T(62), 6, 2);  // cell 7: 2 of 8 flagged (0.25)
-  add(T(62), T(62), 3, 0);  // cell 8: 3 votes, all static
-  const std::size_t first_legs = 30, after_legs = 40;
-  const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(90), T(90)}};
-  SubBoxOptions<T> o;
-  o.static_needs_evidence = true;
-  const auto paper = refine_subboxes(pts, geo, boxes, o);
-  ASSERT_TRUE(paper.ok()) << paper.reason;
-  EXPECT_TRUE(paper.votes[0].whole_box);
-  EXPECT_EQ(paper.votes[0].num_spared_cells, 0);
-  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(paper.labels[i], FeatureLabel::Dynamic) << i;
-
-  o.whole_box_spare_min_points = 6;
-  o.whole_box_spare_max_ratio = T(0.1);
-  const auto r = refine_subboxes(pts, geo, boxes, o);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_TRUE(r.votes[0].whole_box);
-  EXPECT_EQ(r.votes[0].num_spared_cells, 1);
-  EXPECT_EQ(r.votes[0].num_dynamic_cells, 8);
-  for (int c = 0; c < 9; ++c) EXPECT_EQ(r.cells[static_cast<std::size_t>(c)], c == 6 ? 0 : 1) << "cell " << c;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const bool legs = i >= first_legs && i < after_legs;
-    EXPECT_EQ(r.labels[i], legs ? FeatureLabel::Static : FeatureLabel::Dynamic) << i;
-  }
-
-  // Below sigma2 the option changes nothing: cell 7's 25 % and cell 8's three votes stay as voted.
-  std::vector<FeatureLabel> calm = geo;
-  for (std::size_t i = 10; i < 30; ++i) calm[i] = FeatureLabel::Static;  // cells 2-5 now static
-  const auto few = refine_subboxes(pts, calm, boxes, o);
-  ASSERT_TRUE(few.ok());
-  EXPECT_FALSE(few.votes[0].whole_box);
-  EXPECT_EQ(few.votes[0].num_spared_cells, 0);
-
-  o.whole_box_spare_max_ratio = Constants<T>::nan();
-  const auto bad = refine_subboxes(pts, geo, boxes, o);
-  EXPECT_EQ(bad.status, Status::InvalidInput);
-  EXPECT_NE(bad.reason.find("whole_box_spare_max_ratio"), std::string::npos) << bad.reason;
-}
-
 // A walker's box overlapping a still chair's box: with per-box object bits the walker's dynamic
 // sub-boxes act only on the walker's own features, and only they vote.
 TYPED_TEST(SubBoxTest, OverlappingBoxesActOnTheirOwnObjectsOnly) {

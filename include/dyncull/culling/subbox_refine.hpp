@@ -50,17 +50,10 @@ struct SubBoxOptions {
   /// 0.3 tolerates the 15-25 % false flags of still parts noted at merge_ratio.
   bool static_needs_evidence = false;
   T static_max_dynamic_ratio = T(0.3);
-  /// The whole-box rule (sigma2) spares a cell whose own vote is clearly static: at least
-  /// whole_box_spare_min_points labelled features, at most whole_box_spare_max_ratio of them flagged (our
-  /// extension; 0 = off, the paper: every cell of the box turns dynamic). A seated person's still legs
-  /// outvote the flags there while its swaying upper body fills the other cells.
-  std::size_t whole_box_spare_min_points = 0;
-  T whole_box_spare_max_ratio = T(0.1);
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
 
   /// InvalidInput naming the first field out of its range: grid in [1, 8]; sigma1, merge_ratio,
-  /// static_max_dynamic_ratio and whole_box_spare_max_ratio finite and >= 0 (above 1 they switch their
-  /// rule off); sigma2 >= 0; dilation_radius_px in [0, 1024].
+  /// static_max_dynamic_ratio finite and >= 0 (above 1 they switch their rule off); sigma2 >= 0; dilation_radius_px in [0, 1024].
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -71,8 +64,6 @@ struct SubBoxOptions {
     if (!finite_in(merge_ratio, 0, kBig)) return invalid_option(reason, "merge_ratio", "must be finite and >= 0");
     if (!finite_in(static_max_dynamic_ratio, 0, kBig))
       return invalid_option(reason, "static_max_dynamic_ratio", "must be finite and >= 0");
-    if (!finite_in(whole_box_spare_max_ratio, 0, kBig))
-      return invalid_option(reason, "whole_box_spare_max_ratio", "must be finite and >= 0");
     if (dilation_radius_px < 0 || dilation_radius_px > 1024)
       return invalid_option(reason, "dilation_radius_px", "must be in [0, 1024]");
     if (reason) reason->clear();
@@ -83,8 +74,7 @@ struct SubBoxOptions {
 /// Per-box vote. Cell (row, col) is cells[row * grid + col]; state 1 = dynamic.
 struct SubBoxVote {
   bool whole_box = false;       ///< more than sigma2 dynamic sub-boxes: the whole box is dynamic
-  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (whole_box: grid*grid less spared)
-  int num_spared_cells = 0;     ///< clearly static cells the whole-box rule left static (whole_box_spare_min_points)
+  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (whole_box: grid*grid)
   int num_merged_cells = 0;     ///< static or empty cells merged because they touch a dynamic one
 };
 
@@ -326,22 +316,6 @@ void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::ui
     }
 }
 
-/// Algorithm 1's sigma2 rule: more than sigma2 dynamic cells make the whole box dynamic, except cells
-/// with at least whole_box_spare_min_points votes and a dynamic share of at most whole_box_spare_max_ratio.
-template <class T>
-void subbox_whole_box(const std::uint32_t* dc, const std::uint32_t* sc, const SubBoxOptions<T>& options,
-                      std::size_t cells_per_box, std::uint8_t* cells, SubBoxVote* vote) {
-  vote->whole_box = true;
-  for (std::size_t c = 0; c < cells_per_box; ++c) {
-    const std::uint32_t total = dc[c] + sc[c];
-    const bool spared = options.whole_box_spare_min_points > 0 && total >= options.whole_box_spare_min_points &&
-                        T(dc[c]) <= options.whole_box_spare_max_ratio * T(total);
-    cells[c] = spared ? 0 : 1;
-    vote->num_spared_cells += spared;
-  }
-  vote->num_dynamic_cells = static_cast<int>(cells_per_box) - vote->num_spared_cells;
-}
-
 /// Box b's cells: voted, merged, the whole box by sigma2, and with static_needs_evidence a static cell
 /// needs its own evidence (an empty cell, or one over static_max_dynamic_ratio dynamic, is dynamic).
 template <class T>
@@ -356,7 +330,9 @@ void subbox_decide_cells(std::size_t b, std::size_t cells_per_box, const SubBoxO
   subbox_merge(st, dc, sc, options, cells, &vote);
   for (std::size_t c = 0; c < cells_per_box; ++c) vote.num_dynamic_cells += cells[c];
   if (vote.num_dynamic_cells > options.sigma2) {
-    subbox_whole_box(dc, sc, options, cells_per_box, cells, &vote);
+    vote.whole_box = true;  // Algorithm 1's sigma2 rule: every cell of the box
+    std::fill(cells, cells + cells_per_box, std::uint8_t{1});
+    vote.num_dynamic_cells = static_cast<int>(cells_per_box);
     ++r->num_whole_boxes;
   }
   if (options.static_needs_evidence && !vote.whole_box)
