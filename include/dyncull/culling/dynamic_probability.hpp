@@ -36,12 +36,6 @@ enum class FlowModel : std::uint8_t {
   Homography = 2,   ///< ego-motion compensated for pure rotation / planar scenes: |p_curr - H p_prev|
 };
 
-/// Where K of eq. 3 comes from. Algorithm 1 step 9 re-runs "steps 5-8" (the flow test) on the
-/// matched feature of the last frame, so K = that feature's previous M (default): not self-
-/// sustaining. The text's reading (K = last frame's final decision) is offered; with it a person
-/// that was dynamic once stays dynamic whenever a1 + a3 >= threshold.
-enum class TemporalSource : std::uint8_t { PreviousMotion = 0, PreviousDecision = 1 };
-
 /// Camera-motion model for the ego-motion-compensated variants (x_curr ~ matrix x_prev).
 template <class T>
 struct EgoMotion {
@@ -73,13 +67,11 @@ struct DynamicProbabilityOptions {
   /// static), and t = fallback_motion_threshold_px.
   std::size_t min_reference_features = 8;
   T fallback_motion_threshold_px = T(3);
-  TemporalSource temporal_source = TemporalSource::PreviousMotion;
   /// Reference features are those with these levels (in no mask, or in a low-level mask).
   bool low_level_in_reference = true;
 
   /// InvalidInput naming the first field out of its range: weights finite, >= 0 and summing to 1 (within
-  /// 1e-3); threshold finite; the pixel thresholds and mad_scale finite and >= 0; temporal_source one of
-  /// its values.
+  /// 1e-3); threshold finite; the pixel thresholds and mad_scale finite and >= 0.
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -95,8 +87,6 @@ struct DynamicProbabilityOptions {
     if (!finite_in(mad_scale, 0, kBig)) return invalid_option(reason, "mad_scale", "must be finite and >= 0");
     if (!finite_in(fallback_motion_threshold_px, 0, kBig))
       return invalid_option(reason, "fallback_motion_threshold_px", "must be finite and >= 0");
-    if (static_cast<int>(temporal_source) > 1)
-      return invalid_option(reason, "temporal_source", "must be PreviousMotion or PreviousDecision");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -359,7 +349,7 @@ void dp_combine(const std::vector<MotionLevel>& levels, const DynamicProbability
     const bool tracked = use_store && (*track_ids)[i] >= 0;
     if (tracked) {
       if (const TrackStateStore::State* st = store->find((*track_ids)[i]))
-        k = o.temporal_source == TemporalSource::PreviousMotion ? st->moving != 0 : st->dynamic != 0;
+        k = st->moving != 0;  // Algorithm 1 step 9 re-runs the flow test (steps 5-8) on the last frame
     }
     temporal[i] = static_cast<std::uint8_t>(k);
     bool dynamic = false;
