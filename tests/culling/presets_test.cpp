@@ -112,7 +112,6 @@ TEST(Presets, DefaultsOfTheGeometricOptions) {
   EXPECT_EQ(s.grid, 3);
   EXPECT_DOUBLE_EQ(s.sigma1, 0.5);
   EXPECT_EQ(s.dilation_radius_px, 15);
-  EXPECT_FALSE(s.merge_8_neighbours);
   const MultiViewOptions<double> v;
   EXPECT_DOUBLE_EQ(v.depth_threshold_m, 0.4);
   EXPECT_DOUBLE_EQ(v.max_parallax_deg, 30.0);

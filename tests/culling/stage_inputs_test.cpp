@@ -577,13 +577,13 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
     std::vector<Box<T>> boxes(nb);
     for (auto& b : boxes) b = wild_box<T>(rng, -10, 90, -10, 90, 80, 80);
     CoherentMotionOptions<T> o;
-    o.grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
+    const int grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
     o.min_points = rng.index(6);
     o.sigmas = maybe_wild(rng, T(10));
     o.min_noise_px = maybe_wild(rng, T(0.2));
     o.min_median_px = maybe_wild(rng, T(0.5));
     CoherentMotionResult<T> r;
-    flag_coherent_cells(points, residuals, boxes, wild<T>(rng, 0, 2), o, labels.data(), &r);
+    flag_coherent_cells(points, residuals, boxes, grid, wild<T>(rng, 0, 2), o, labels.data(), &r);
     if (r.status != Status::Ok && r.status != Status::Skipped) {
       EXPECT_FALSE(r.reason.empty()) << trial;
       continue;

@@ -35,10 +35,6 @@ struct SubBoxOptions {
   /// sub-boxes whose points clearly agree on "static" (the legs of a person who only moves the upper
   /// body) even with the 15-25 % false flags that a 0.5 px in-box epipolar threshold gives on still parts.
   T merge_ratio = T(0.35);
-  bool merge_8_neighbours = false;  ///< false: 4-neighbours (edge-sharing), true: 8 (corners too)
-  /// Features outside every box keep their geometric label (there is no semantic evidence against it);
-  /// false: they become static (trust only boxed objects).
-  bool keep_geometric_outside_boxes = true;
   /// When an object mask is given, only features inside it vote: the floor and wall behind a person
   /// otherwise outvote the person in the border sub-boxes, and a walker crossing a chair's box makes
   /// the chair's sub-boxes dynamic. false: every labelled feature in the rectangle votes (the paper).
@@ -53,7 +49,8 @@ struct SubBoxOptions {
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
 
   /// InvalidInput naming the first field out of its range: grid in [1, 8]; sigma1, merge_ratio,
-  /// static_max_dynamic_ratio finite and >= 0 (above 1 they switch their rule off); sigma2 >= 0; dilation_radius_px in [0, 1024].
+  /// static_max_dynamic_ratio finite and >= 0 (above 1 they switch their rule off); sigma2 >= 0;
+  /// dilation_radius_px in [0, 1024].
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -250,7 +247,7 @@ void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometr
       r.num_added += !geo_dyn;
     } else if (in_box) {
       r.num_rescued += geo_dyn;
-    } else if (geo_dyn && options.keep_geometric_outside_boxes) {
+    } else if (geo_dyn) {  // outside every box the geometric label stands
       r.labels[i] = FeatureLabel::Dynamic;
       r.reasons[i] = CullReason::Epipolar;
     }
@@ -288,7 +285,7 @@ void subbox_count_votes(const Points& points, ArrayView<FeatureLabel> geometric,
 }
 
 /// Algorithm 1 line 14 in one pass against the voted states `st` (1 dynamic, 0 static, 2 empty), so
-/// merging never chains: a cell touching a voted dynamic one (4- or 8-neighbours) becomes dynamic when
+/// merging never chains: a cell touching a voted dynamic one (edge-sharing) becomes dynamic when
 /// it is empty or its dynamic share reaches merge_ratio.
 template <class T>
 void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::uint32_t* sc,
@@ -304,7 +301,7 @@ void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::ui
       bool touches = false;
       for (int dr = -1; dr <= 1 && !touches; ++dr)
         for (int dcol = -1; dcol <= 1 && !touches; ++dcol) {
-          if ((dr == 0 && dcol == 0) || (!options.merge_8_neighbours && dr != 0 && dcol != 0)) continue;
+          if ((dr == 0) == (dcol == 0)) continue;  // the 4 edge-sharing neighbours only
           const int rr = row + dr, cc = col + dcol;
           if (rr < 0 || cc < 0 || rr >= g || cc >= g) continue;
           touches = st[static_cast<std::size_t>(rr * g + cc)] == 1;
