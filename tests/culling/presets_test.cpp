@@ -105,7 +105,6 @@ TEST(Presets, DefaultsOfTheGeometricOptions) {
   const ReprojectionCheckOptions<double> p;
   EXPECT_DOUBLE_EQ(p.max_residual_px, 3.0);
   EXPECT_DOUBLE_EQ(p.pnp.ransac.max_residual, 2.0);
-  EXPECT_TRUE(p.fit_outside_boxes);
   EXPECT_EQ(p.min_tracks_outside_boxes, 20u);
   EXPECT_FALSE(presets::none<double>().reprojection.enabled);
   const SubBoxOptions<double> s;

@@ -38,8 +38,7 @@ struct ReprojectionCheckOptions {
   /// walkers' and 40 % of the swaying upper body's; 1.5 px (the default) trades a little of the first for
   /// more of the second (docs/algorithms.md).
   T max_residual_in_boxes_px = T(1.5);
-  /// Fit the pose only on tracks outside dynamic boxes when at least min_tracks_outside_boxes remain.
-  bool fit_outside_boxes = true;
+  /// The pose is fitted only on tracks outside dynamic boxes when at least this many remain.
   std::size_t min_tracks_outside_boxes = 20;
   /// Depth residual (needs the current depth image): when > 0, a track is also dynamic when the depth
   /// measured at its pixel differs from its point's depth at the fitted pose by more than this many
@@ -54,7 +53,8 @@ struct ReprojectionCheckOptions {
   std::size_t min_tracks = 15;  ///< fewer usable tracks: Skipped
 
   /// InvalidInput naming the first field out of its range: the pixel thresholds positive and finite;
-  /// max_depth_residual_sigmas and the depth noise model finite and >= 0; pnp (and pnp.ransac) passing their own validate().
+  /// max_depth_residual_sigmas and the depth noise model finite and >= 0; pnp (and pnp.ransac) passing
+  /// their own validate().
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -280,7 +280,7 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
                 "dyncull::check_reprojection: points and pixels must hold points (see PointTraits)");
   detail::ReprojectionEstimator<T, Points3, Pixels, Raw> reprojection{points, pixels, camera, options, depth, out};
   const detail::ModelCheckRule<T> rule{options.max_residual_px, options.max_residual_in_boxes_px, options.min_tracks,
-                                       options.fit_outside_boxes, options.min_tracks_outside_boxes};
+                                       true, options.min_tracks_outside_boxes};
   detail::check_against_model(reprojection, valid, in_box, rule);
 }
 
