@@ -275,7 +275,7 @@ OTHER_PEERS = [
      "`cv::BFMatcher`", "BM_OpenCvBfMatcherL2/1000/256"),
     ("bench_culling_descriptor_switch_bench", "5 nearest of 200 keyframes (eq. 18)", "BM_NearestKeyframes/200",
      "`cv::norm` loop + partial sort", "BM_OpenCvNormKeyframes/200"),
-    ("bench_culling_reprojection_check_bench", "reprojection check, ~1100 tracks", "BM_ReprojectionCheck_Dyncull/0",
+    ("bench_culling_reprojection_check_bench", "reprojection check, ~1100 tracks", "BM_ReprojectionCheck_Dyncull",
      "`solvePnPRansac` + `projectPoints`", "BM_ReprojectionCheck_OpenCV"),
     ("bench_culling_subbox_refine_bench", "sub-box mask with 15 px dilation", "BM_SubBox_Mask_Dyncull", "`cv::dilate`",
      "BM_SubBox_Mask_PeerCvDilate"),
@@ -469,8 +469,8 @@ paper's plain loop (mean flow, fixed threshold); the extra cost is four medians 
 people, chair, TV, cup). `Dyncull/refits/boxes`: the number of refits and whether the fit uses only the features
 outside the boxes (the default is 2/1); `PartsFloor` is our F-RANSAC plus one batch distance pass, the floor of
 the 1.2x target. Without boxes every estimator is inaccurate on this small-baseline frame.""",
-    "bench_culling_reprojection_check_bench": """Each track's exact 3-D point at the previous frame; `/1` adds the
-propagated uncertainty, `DyncullWithDepth` the depth residual the preset uses; the OpenCV peer is `solvePnPRansac`
+    "bench_culling_reprojection_check_bench": """Each track's exact 3-D point at the previous frame; `DyncullWithDepth`
+the depth residual the preset uses; the OpenCV peer is `solvePnPRansac`
 (P3P, 300 iterations, 2 px, 0.999) plus `projectPoints` with the same thresholds.""",
     "bench_culling_pipeline_bench": """One frame of the culling scene (about 1100 features, 5 boxes, 640x480 depth, a
 keyframe 8 frames back) through `cull_frame`, against pyramidal LK (21x21, 3 levels) of the same features between

@@ -53,8 +53,8 @@ void BM_CoherentMotion_Cells(benchmark::State& state) {
   const CoherentMotionOptions<float> o;
   for (auto _ : state) {
     std::copy(d.reprojection.labels.begin(), d.reprojection.labels.end(), labels.begin());
-    flag_coherent_cells(d.scene.keypoints, d.reprojection.residual_vec, d.boxes, d.reprojection.inlier_noise_px, o,
-                        labels.data(), &r);
+    flag_coherent_cells(d.scene.keypoints, d.reprojection.residual_vec, d.boxes, 3, d.reprojection.inlier_noise_px,
+                        o, labels.data(), &r);
     benchmark::DoNotOptimize(labels.data());
   }
   state.counters["features"] = double(labels.size());

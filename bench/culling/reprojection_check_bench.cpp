@@ -1,6 +1,6 @@
-// RGB-D reprojection check at ~1000 tracks: ours (PnP-RANSAC outside the boxes, residual and propagated
-// uncertainty of every track) vs the epipolar check on the same tracks vs OpenCV solvePnPRansac +
-// projectPoints, same data, with the labels' precision and recall as counters.
+// RGB-D reprojection check at ~1000 tracks: ours (PnP-RANSAC outside the boxes, residual of every track) vs
+// the epipolar check on the same tracks vs OpenCV solvePnPRansac + projectPoints, same data, with the labels'
+// precision and recall as counters.
 #include "dyncull/culling/moving_consistency.hpp"
 #include "dyncull/culling/reprojection_check.hpp"
 
@@ -57,11 +57,10 @@ void accuracy(benchmark::State& state, IsDynamic&& is_dynamic) {
   state.counters["tracks"] = double(truth.size());
 }
 
-// Ours, default options; range(0) = 1 adds the uncertainty propagation (1 sigma).
+// Ours, default options.
 void BM_ReprojectionCheck_Dyncull(benchmark::State& state) {
   const Data& d = data();
   ReprojectionCheckOptions<float> o;
-  o.uncertainty_sigmas = float(state.range(0));
   ReprojectionCheckResult<float> r;
   for (auto _ : state) {
     check_reprojection(d.scene.prev_points_world, d.scene.keypoints, d.scene.camera, o, &r, d.scene.track_valid,
@@ -70,7 +69,7 @@ void BM_ReprojectionCheck_Dyncull(benchmark::State& state) {
   }
   accuracy(state, [&](std::size_t i) { return r.labels[i] == FeatureLabel::Dynamic; });
 }
-BENCHMARK(BM_ReprojectionCheck_Dyncull)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ReprojectionCheck_Dyncull)->Unit(benchmark::kMicrosecond);
 
 // Ours with the depth residual at 5 sigma (the recommended preset), reading the scene's depth image.
 void BM_ReprojectionCheck_DyncullWithDepth(benchmark::State& state) {

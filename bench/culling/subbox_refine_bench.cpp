@@ -47,12 +47,9 @@ const Data& data() {
   return d;
 }
 
-// arg 1: the whole-box rule spares clearly static cells (whole_box_spare_min_points 6, off by default):
-// one more pass over the 9 cells of each box that turns dynamic as a whole.
 void BM_SubBox_Vote_Dyncull(benchmark::State& state) {
   const Data& d = data();
   SubBoxOptions<float> o;
-  if (state.range(0) == 1) o.whole_box_spare_min_points = 6;
   SubBoxResult<float> r;
   for (auto _ : state) {
     refine_subboxes(d.scene.keypoints, d.geometric, d.boxes, o, &r);
@@ -71,11 +68,8 @@ void BM_SubBox_Vote_Dyncull(benchmark::State& state) {
   state.counters["epipolar_precision"] = pr_geo.precision;
   state.counters["epipolar_recall"] = pr_geo.recall;
   state.counters["whole_boxes"] = double(r.num_whole_boxes);
-  int spared = 0;
-  for (const SubBoxVote& v : r.votes) spared += v.num_spared_cells;
-  state.counters["spared_cells"] = double(spared);
 }
-BENCHMARK(BM_SubBox_Vote_Dyncull)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SubBox_Vote_Dyncull)->Unit(benchmark::kMicrosecond);
 
 // Floor: bin every feature into the 3x3 cells of every box and count dynamic / static votes. Any
 // implementation of Algorithm 1 does at least this; the rest (merging, sigma2, relabelling) is on top.

@@ -100,13 +100,12 @@ TYPED_TEST(BoxRule, OptionsChangeTheOutcomeAsDocumented) {
                                           {Box<T>{T(300), T(0), T(400), T(100)}, kChair, T(1)}};
   const std::vector<Vec2<T>> pts = {{T(50), T(50)}, {T(93), T(50)}, {T(350), T(50)}};
   BoxRuleOptions<T> o;
-  o.high_as_candidate = true;   // RTD-SLAM §III.D: everything boxed goes to geometry
   o.medium_as_candidate = false;
-  o.low_shrink_px = T(5);       // the tv box no longer shelters x = 93
   const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80(), o);
-  EXPECT_EQ(r.labels[0], FeatureLabel::Candidate);
-  EXPECT_EQ(r.labels[1], FeatureLabel::Candidate);
-  EXPECT_EQ(r.labels[2], FeatureLabel::Static);
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
+  EXPECT_EQ(r.labels[1], FeatureLabel::Static);  // the tv box shelters x = 93
+  EXPECT_EQ(r.reasons[1], CullReason::LowLevelOverride);
+  EXPECT_EQ(r.labels[2], FeatureLabel::Static);  // the chair: no candidate
 }
 
 TYPED_TEST(BoxRule, EmptyInvalidAndIgnoredBoxes) {
@@ -179,46 +178,11 @@ TYPED_TEST(BoxRule, MatchesScalarOracleOnRandomScenes) {
   }
 }
 
-// A negative high padding that inverts a box leaves no box: it is not counted and holds nothing.
-TYPED_TEST(BoxRule, PaddingThatInvertsABoxDropsIt) {
-  using T = TypeParam;
-  const std::vector<Detection<T>> dets = {{Box<T>{T(10), T(10), T(30), T(30)}, kPerson, T(1)},
-                                          {Box<T>{T(100), T(100), T(300), T(300)}, kPerson, T(1)}};
-  const std::vector<Vec2<T>> pts = {{T(20), T(20)}, {T(200), T(200)}, {T(105), T(105)}};
-  BoxRuleOptions<T> o;
-  o.high_padding_px = T(-50);
-  const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80(), o);
-  ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.num_high_boxes, 1u);
-  EXPECT_EQ(r.labels[0], FeatureLabel::Static);
-  EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);  // inside the shrunk box
-  EXPECT_EQ(r.box_index[1], 1);
-  EXPECT_EQ(r.labels[2], FeatureLabel::Static);   // shrunk away
-  EXPECT_NE(r.reason.find("1 invalid"), std::string::npos) << r.reason;
-}
-
 TYPED_TEST(BoxRule, OptionsAreValidatedWithTheFieldNamed) {
   using T = TypeParam;
   std::string why = "unchanged";
   EXPECT_EQ(BoxRuleOptions<T>{}.validate(&why), Status::Ok);
   EXPECT_TRUE(why.empty());
-  const std::vector<Detection<T>> dets = {{Box<T>{T(10), T(10), T(30), T(30)}, kPerson, T(1)}};
-  const std::vector<Vec2<T>> pts = {{T(20), T(20)}, {std::numeric_limits<T>::quiet_NaN(), T(0)}};
-  for (int c = 0; c < 4; ++c) {
-    BoxRuleOptions<T> o;
-    const char* field = c < 2 ? "high_padding_px" : "low_shrink_px";
-    const T v = c % 2 ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::quiet_NaN();
-    (c < 2 ? o.high_padding_px : o.low_shrink_px) = v;
-    EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-    EXPECT_NE(why.find(field), std::string::npos) << why;
-    const BoxRuleResult<T> r = apply_box_rule(pts, dets, MotionLevelTable::coco80(), o);
-    EXPECT_EQ(r.status, Status::InvalidInput);
-    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
-    // Per-point outputs keep their size, and decide nothing.
-    ASSERT_EQ(r.labels.size(), pts.size());
-    EXPECT_EQ(r.labels[0], FeatureLabel::Static);
-    EXPECT_EQ(r.num_dynamic, 0u);
-  }
 }
 
 // Points and boxes with NaN, +-Inf and huge finite values mixed with ordinary ones.

@@ -61,7 +61,7 @@ TYPED_TEST(CoherentMotionTest, SharedSubThresholdMotionFlagsItsCellsOnly) {
 
   const auto before = s.labels;
   CoherentMotionResult<T> r;
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_cells_tested, 9u);
   EXPECT_EQ(r.num_cells_flagged, 3u);
@@ -88,26 +88,26 @@ TYPED_TEST(CoherentMotionTest, SmallOffsetsNoiseAndSparseCellsAreNotMotion) {
   {
     auto s = make_cell_scene<T>(200, 0.2, Vec2<double>(0.4, 0.0));  // 0.4 px < min_median_px 0.5
     CoherentMotionResult<T> r;
-    flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.2), o, s.labels.data(), &r);
+    flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.2), o, s.labels.data(), &r);
     ASSERT_TRUE(r.ok());
     EXPECT_EQ(r.num_cells_flagged, 0u);
     auto lower = o;
     lower.min_median_px = T(0.3);
-    flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.2), lower, s.labels.data(), &r);
+    flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.2), lower, s.labels.data(), &r);
     EXPECT_EQ(r.num_cells_flagged, 3u);
   }
   {
     // 1 px shared shift under 1.5 px noise with 9 features a cell: standard error 0.63 px, z about 1.6.
     auto s = make_cell_scene<T>(9, 1.5, Vec2<double>(1.0, 0.0));
     CoherentMotionResult<T> r;
-    flag_coherent_cells(s.points, s.residuals, s.boxes, T(1.5), o, s.labels.data(), &r);
+    flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(1.5), o, s.labels.data(), &r);
     ASSERT_TRUE(r.ok());
     EXPECT_EQ(r.num_cells_flagged, 0u);
   }
   {
     auto s = make_cell_scene<T>(3, 0.1, Vec2<double>(3.0, 0.0));  // 3 features a cell, min_points 4
     CoherentMotionResult<T> r;
-    flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.1), o, s.labels.data(), &r);
+    flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.1), o, s.labels.data(), &r);
     ASSERT_TRUE(r.ok());
     EXPECT_EQ(r.num_cells_tested, 0u);
     EXPECT_EQ(r.num_cells_flagged, 0u);
@@ -116,9 +116,9 @@ TYPED_TEST(CoherentMotionTest, SmallOffsetsNoiseAndSparseCellsAreNotMotion) {
     // A noise estimate of 0 (or NaN: no fit) falls back to the floor min_noise_px.
     auto s = make_cell_scene<T>(20, 0.25, Vec2<double>(0.7, 0.4));
     CoherentMotionResult<T> r;
-    flag_coherent_cells(s.points, s.residuals, s.boxes, T(0), o, s.labels.data(), &r);
+    flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0), o, s.labels.data(), &r);
     EXPECT_NEAR(double(r.noise_px), double(o.min_noise_px), 1e-6);
-    flag_coherent_cells(s.points, s.residuals, s.boxes, std::numeric_limits<T>::quiet_NaN(), o, s.labels.data(), &r);
+    flag_coherent_cells(s.points, s.residuals, s.boxes, 3, std::numeric_limits<T>::quiet_NaN(), o, s.labels.data(), &r);
     EXPECT_NEAR(double(r.noise_px), double(o.min_noise_px), 1e-6);
   }
 }
@@ -137,7 +137,7 @@ TYPED_TEST(CoherentMotionTest, OnlyTheObjectsEligibleStaticFeaturesChange) {
   }
   s.labels[40] = FeatureLabel::Candidate;  // cell 2
   CoherentMotionResult<T> r;
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r,
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r,
                       nullptr, bits, eligible);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_cells_tested, 7u);
@@ -158,24 +158,22 @@ TYPED_TEST(CoherentMotionTest, BadInputGetsAReason) {
   CoherentMotionResult<T> r;
   CoherentMotionOptions<T> bad;
   bad.sigmas = T(0);
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), bad, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), bad, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_FALSE(r.reason.empty());
   bad = CoherentMotionOptions<T>{};
   bad.min_noise_px = std::numeric_limits<T>::quiet_NaN();
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), bad, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), bad, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
-  bad = CoherentMotionOptions<T>{};
-  bad.grid = 9;
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), bad, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 9, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(s.labels, before);
 
   const CoherentMotionOptions<T> o;
-  flag_coherent_cells(s.points, s.residuals, std::vector<Box<T>>{}, T(0.25), o, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, std::vector<Box<T>>{}, 3, T(0.25), o, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::Skipped);
   EXPECT_FALSE(r.reason.empty());
-  flag_coherent_cells(s.points, nullptr, s.boxes, T(0.25), o, s.labels.data(), &r);
+  flag_coherent_cells(s.points, nullptr, s.boxes, 3, T(0.25), o, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
 
   // Non-finite residuals (no 3-D point) take no part, an invalid box is passed over, a NaN point lies in
@@ -186,7 +184,7 @@ TYPED_TEST(CoherentMotionTest, BadInputGetsAReason) {
   s.points[25] = Vec2<T>(nan, nan);
   std::vector<Box<T>> boxes = s.boxes;
   boxes.push_back(Box<T>{T(50), T(50), T(10), T(10)});  // x1 < x0
-  flag_coherent_cells(s.points, s.residuals, boxes, T(0.25), o, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, boxes, 3, T(0.25), o, s.labels.data(), &r);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.num_cells_tested, 8u);
   EXPECT_EQ(r.num_cells_flagged, 2u);
@@ -197,11 +195,11 @@ TYPED_TEST(CoherentMotionTest, BadInputGetsAReason) {
 TEST(CoherentMotion, BuffersAreReusedAcrossFrames) {
   auto s = make_cell_scene<double>(20, 0.25, Vec2<double>(0.7, 0.4));
   CoherentMotionResult<double> r;
-  flag_coherent_cells(s.points, s.residuals, s.boxes, 0.25, CoherentMotionOptions<double>{}, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, 0.25, CoherentMotionOptions<double>{}, s.labels.data(), &r);
   ASSERT_TRUE(r.ok());
   const auto* order = r.scratch_order.data();
   const auto* u = r.scratch_u.data();
-  flag_coherent_cells(s.points, s.residuals, s.boxes, 0.25, CoherentMotionOptions<double>{}, s.labels.data(), &r);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, 0.25, CoherentMotionOptions<double>{}, s.labels.data(), &r);
   EXPECT_EQ(r.scratch_order.data(), order);
   EXPECT_EQ(r.scratch_u.data(), u);
   EXPECT_EQ(r.num_cells_flagged, 3u);
@@ -219,17 +217,17 @@ TYPED_TEST(CoherentMotionTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
   const std::vector<std::uint32_t> few_bits(10, 1u), bits(n, 1u);
   const std::string tail = " has 10 entries for " + std::to_string(n) + " points";
   CoherentMotionResult<T> r;
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), o, s.labels.data(), &r, few);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), o, s.labels.data(), &r, few);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.reason, "in_object_mask" + tail);
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), o, s.labels.data(), &r, all, few_bits);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), o, s.labels.data(), &r, all, few_bits);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.reason, "object_box_bits" + tail);
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), o, s.labels.data(), &r, all, bits, few);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), o, s.labels.data(), &r, all, bits, few);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.reason, "eligible" + tail);
   EXPECT_EQ(s.labels, before);
-  flag_coherent_cells(s.points, s.residuals, s.boxes, T(0.25), o, s.labels.data(), &r, all, bits, all);
+  flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), o, s.labels.data(), &r, all, bits, all);
   EXPECT_TRUE(r.ok()) << r.reason;
 }
 
@@ -241,12 +239,12 @@ TYPED_TEST(CoherentMotionTest, ShortOrMissingResidualsAreInvalidInputAndNotRead)
   const auto before = s.labels;
   const std::vector<Vec2<T>> short_residuals(s.residuals.begin(), s.residuals.begin() + 10);
   CoherentMotionResult<T> r;
-  flag_coherent_cells(s.points, short_residuals, s.boxes, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
+  flag_coherent_cells(s.points, short_residuals, s.boxes, 3, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.reason, "residuals has 10 entries for " + std::to_string(n) + " points");
   EXPECT_EQ(r.num_flagged, 0u);
   EXPECT_EQ(s.labels, before);
-  flag_coherent_cells(s.points, nullptr, s.boxes, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
+  flag_coherent_cells(s.points, nullptr, s.boxes, 3, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_EQ(r.reason, "residuals is required (" + std::to_string(n) + " points)");
   EXPECT_EQ(s.labels, before);

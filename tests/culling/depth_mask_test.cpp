@@ -91,8 +91,8 @@ TYPED_TEST(DepthMask, PlainRuleSeparatesPersonFromWall) {
 }
 
 // A chair 0.9 m in front of a person, inside the person's box: DLD-SLAM's one-sided band (everything nearer
-// than d_c + eps) takes the chair in; near_margin_m = 0.5 leaves it out and keeps the person whole.
-TYPED_TEST(DepthMask, NearMarginLeavesOutWhatStandsInFrontOfTheObject) {
+// than d_c + eps) takes the chair in, in the robust and the plain rule.
+TYPED_TEST(DepthMask, OneSidedBandTakesInWhatStandsInFrontOfTheObject) {
   using Raw = TypeParam;
   Scene<Raw> s;
   s.fill(4.0);
@@ -105,29 +105,23 @@ TYPED_TEST(DepthMask, NearMarginLeavesOutWhatStandsInFrontOfTheObject) {
   s.hole(70, 30, 72, 32);  // a Kinect hole on the person: still masked (mask_missing_depth)
   const Box<double> box{55, 15, 105, 105};
   DepthMaskOptions o;  // robust, one-sided (paper) band
-  Mask one_sided(W, H), two_sided(W, H);
+  Mask one_sided(W, H);
   const DepthMaskBoxInfo a = depth_mask_box(s.view(), box, o, one_sided.view());
   ASSERT_TRUE(a.ok()) << a.reason;
   EXPECT_TRUE(a.rule_applies);
   EXPECT_NEAR(a.d_c_m, 2.5, 1e-6);
   EXPECT_TRUE(one_sided.test(80, 90));   // chair pixel taken in by the one-sided band
-  o.near_margin_m = 0.5;
-  const DepthMaskBoxInfo b = depth_mask_box(s.view(), box, o, two_sided.view());
-  ASSERT_TRUE(b.ok()) << b.reason;
-  EXPECT_FALSE(two_sided.test(80, 90));  // chair left out
-  EXPECT_TRUE(two_sided.test(80, 50));   // person kept
-  EXPECT_TRUE(two_sided.test(71, 31));   // hole kept
-  EXPECT_FALSE(two_sided.test(56, 16));  // wall left out
+  EXPECT_TRUE(one_sided.test(80, 50));   // person
+  EXPECT_TRUE(one_sided.test(71, 31));   // hole
+  EXPECT_FALSE(one_sided.test(56, 16));  // wall left out
   EXPECT_LT(box_iou(s, one_sided, box), 0.8);
-  EXPECT_GT(box_iou(s, two_sided, box), 0.99);
   // Point labels follow the raster.
   const std::vector<Box<double>> boxes{box};
   const std::vector<Vec2<float>> pts{{80.f, 90.f}, {80.f, 50.f}};
   const DepthMaskResult r = depth_mask(s.view(), boxes, pts, o);
   ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.labels[0], FeatureLabel::Static);
+  EXPECT_EQ(r.labels[0], FeatureLabel::Dynamic);
   EXPECT_EQ(r.labels[1], FeatureLabel::Dynamic);
-  // The plain rule ignores the option (paper behaviour).
   o.mode = DepthMaskMode::Plain;
   Mask plain(W, H);
   depth_mask_box(s.view(), box, o, plain.view());
@@ -515,30 +509,6 @@ TYPED_TEST(DepthMask, ValidRangeIsAParameter) {
   EXPECT_TRUE(m.test(80, 60));
   // Everything beyond 3 m invalid: the corners have no depth and the plain rule cannot apply.
   EXPECT_FALSE(depth_mask_box(s.view(0.f, 3.f), box, o).rule_applies);
-}
-
-TYPED_TEST(DepthMask, DynamicVinsThresholdForm) {
-  using Raw = TypeParam;
-  Scene<Raw> s;
-  s.fill(4.0);
-  s.person(80, 60, 20, 40, 1.5);
-  const Box<double> box{55, 15, 105, 105};
-  DepthMaskOptions o;
-  o.form = DepthThresholdForm::DynamicVins;
-  o.mode = DepthMaskMode::Plain;
-  // d_max - d_c = 2.5 > 1.0: midpoint (4.0 + 1.5) / 2.
-  EXPECT_NEAR(depth_mask_box(s.view(), box, o).threshold_m, 2.75, 1e-6);
-  // Wall at 2.0 m: 0.5 <= 1.0 -> d_c + 1.0.
-  Scene<Raw> near;
-  near.fill(2.0);
-  near.person(80, 60, 20, 40, 1.5);
-  EXPECT_NEAR(depth_mask_box(near.view(), box, o).threshold_m, 2.5, 1e-6);
-  // Centre without depth, corners valid -> the corner depth.
-  s.hole(78, 58, 82, 62);
-  EXPECT_NEAR(depth_mask_box(s.view(), box, o).threshold_m, 4.0, 1e-6);
-  // Nothing valid -> whole box.
-  Scene<Raw> empty;
-  EXPECT_EQ(depth_mask_box(empty.view(), box, o).outcome, DepthMaskOutcome::WholeBox);
 }
 
 TEST(DepthMaskRaw, ThresholdIsComparedInRawUnits) {

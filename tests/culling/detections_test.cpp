@@ -109,9 +109,7 @@ TYPED_TEST(Detections, ClassDependentConfidence) {
   const std::vector<YoloBox<T>> in = {{0, T(0.5), T(0.5), T(0.2), T(0.2), T(0.3)},    // person kept
                                       {56, T(0.5), T(0.5), T(0.2), T(0.2), T(0.3)},   // chair dropped
                                       {56, T(0.5), T(0.5), T(0.2), T(0.2), T(0.5)},   // chair kept
-                                      {62, T(0.5), T(0.5), T(0.2), T(0.2), T(0.5)}};  // tv: own threshold 0.6
-  o.class_min_confidence.assign(80, T(-1));
-  o.class_min_confidence[62] = T(0.6);
+                                      {62, T(0.5), T(0.5), T(0.2), T(0.2), T(0.3)}};  // tv dropped
   const DetectionsResult<T> r = convert_yolo_detections(in, 640, 480, o);
   EXPECT_EQ(r.rejections[0], BoxRejection::None);
   EXPECT_EQ(r.rejections[1], BoxRejection::LowConfidence);
@@ -210,8 +208,6 @@ TYPED_TEST(Detections, OptionsAreValidatedWithTheFieldNamed) {
       {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = T(1.5); }},
       {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = T(-0.1); }},
       {"min_confidence_person", [](DetectionOptions<T>* o) { o->min_confidence_person = std::numeric_limits<T>::quiet_NaN(); }},
-      {"class_min_confidence[3]", [](DetectionOptions<T>* o) { o->class_min_confidence.assign(5, T(-1)); o->class_min_confidence[3] = std::numeric_limits<T>::quiet_NaN(); }},
-      {"class_min_confidence[1]", [](DetectionOptions<T>* o) { o->class_min_confidence = {T(0.5), T(2)}; }},
       {"letterbox.scale", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.scale = T(0); }},
       {"letterbox.scale", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.scale = std::numeric_limits<T>::quiet_NaN(); }},
       {"letterbox.pad_x", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.pad_x = std::numeric_limits<T>::infinity(); }},
@@ -233,11 +229,10 @@ TYPED_TEST(Detections, OptionsAreValidatedWithTheFieldNamed) {
     EXPECT_NE(b.reason.find(c.field), std::string::npos) << b.reason;
     EXPECT_TRUE(b.detections.empty());
   }
-  // Thresholds of 0 and 1, negative per-class entries (use the default) and huge finite padding are fine.
+  // Thresholds of 0 and 1 and huge finite padding are fine.
   DetectionOptions<T> edge;
   edge.min_confidence = T(0);
   edge.min_confidence_person = T(1);
-  edge.class_min_confidence = {T(-1), T(0.3)};
   edge.box_padding_px = T(1e30);
   EXPECT_EQ(edge.validate(), Status::Ok);
   const DetectionsResult<T> all = filter_detections(px, 640, 480, edge);

@@ -97,7 +97,7 @@ TYPED_TEST(DynamicProbability, TemporalTermFromTheTrackStore) {
   using T = TypeParam;
   // Frame by frame: background + one person (tracks 1000..1019) + one tv (tracks 2000..2009).
   TrackStateStore store;
-  auto run = [&](Vec2<double> person_motion, Vec2<double> tv_motion, TemporalSource source) {
+  auto run = [&](Vec2<double> person_motion, Vec2<double> tv_motion) {
     Random rng(3);
     Frame<T> f;
     f.add(rng, 100, Box<double>{0, 0, 640, 480}, MotionLevel::Ignore, {1, 0}, 0.2, kBackground);
@@ -108,22 +108,14 @@ TYPED_TEST(DynamicProbability, TemporalTermFromTheTrackStore) {
     for (std::size_t i = 100; i < 120; ++i) ids[i] = 1000 + std::int64_t(i);
     for (std::size_t i = 120; i < 130; ++i) ids[i] = 2000 + std::int64_t(i);
     DynamicProbabilityOptions<T> o;
-    o.temporal_source = source;
     store.begin_frame();
     const auto r = dynamic_probability(f.prev, f.curr, f.levels, o, EgoMotion<T>{}, &store, &ids);
     return std::make_pair(f.count(r, kWalkingPerson, FeatureLabel::Dynamic), f.count(r, kTv, FeatureLabel::Dynamic));
   };
-  const auto src = TemporalSource::PreviousMotion;
-  EXPECT_EQ(run({5, 0}, {0, 0}, src), std::make_pair(std::size_t(20), std::size_t(0)));  // walking
-  EXPECT_EQ(run({0, 0}, {4, 0}, src), std::make_pair(std::size_t(20), std::size_t(0)));  // stopped: K keeps it one frame; tv glitch: not enough
-  EXPECT_EQ(run({0, 0}, {4, 0}, src), std::make_pair(std::size_t(0), std::size_t(10)));  // still person static; tv moved twice: dynamic
-  EXPECT_EQ(run({0, 0}, {0, 0}, src), std::make_pair(std::size_t(0), std::size_t(0)));
-  // The text's reading (K = last decision) makes a person that was dynamic once stay dynamic.
-  store.clear();
-  const auto dec = TemporalSource::PreviousDecision;
-  EXPECT_EQ(run({5, 0}, {0, 0}, dec).first, 20u);
-  EXPECT_EQ(run({0, 0}, {0, 0}, dec).first, 20u);
-  EXPECT_EQ(run({0, 0}, {0, 0}, dec).first, 20u);
+  EXPECT_EQ(run({5, 0}, {0, 0}), std::make_pair(std::size_t(20), std::size_t(0)));  // walking
+  EXPECT_EQ(run({0, 0}, {4, 0}), std::make_pair(std::size_t(20), std::size_t(0)));  // stopped: K keeps it one frame; tv glitch: not enough
+  EXPECT_EQ(run({0, 0}, {4, 0}), std::make_pair(std::size_t(0), std::size_t(10)));  // still person static; tv moved twice: dynamic
+  EXPECT_EQ(run({0, 0}, {0, 0}), std::make_pair(std::size_t(0), std::size_t(0)));
   // Tracks unseen for more than max_age frames are forgotten.
   EXPECT_GT(store.size(), 0u);
   store.begin_frame();

@@ -65,7 +65,6 @@ TEST(Presets, RecommendedCombinesThemWithTheGuard) {
   EXPECT_EQ(o.subbox.min_evidence_frames, 2);
   EXPECT_TRUE(o.subbox.short_baseline_keeps_last_vote);
   EXPECT_FLOAT_EQ(o.reprojection.max_residual_in_boxes_px, 1.5f);
-  EXPECT_FLOAT_EQ(o.reprojection.uncertainty_sigmas, 0.f);
   EXPECT_FLOAT_EQ(o.subbox.merge_ratio, 0.35f);
   EXPECT_EQ(o.candidates, CandidatePolicy::Verify);
   EXPECT_DOUBLE_EQ(o.guard.min_fraction, 0.10);
@@ -106,14 +105,12 @@ TEST(Presets, DefaultsOfTheGeometricOptions) {
   const ReprojectionCheckOptions<double> p;
   EXPECT_DOUBLE_EQ(p.max_residual_px, 3.0);
   EXPECT_DOUBLE_EQ(p.pnp.ransac.max_residual, 2.0);
-  EXPECT_TRUE(p.fit_outside_boxes);
   EXPECT_EQ(p.min_tracks_outside_boxes, 20u);
   EXPECT_FALSE(presets::none<double>().reprojection.enabled);
   const SubBoxOptions<double> s;
   EXPECT_EQ(s.grid, 3);
   EXPECT_DOUBLE_EQ(s.sigma1, 0.5);
   EXPECT_EQ(s.dilation_radius_px, 15);
-  EXPECT_FALSE(s.merge_8_neighbours);
   const MultiViewOptions<double> v;
   EXPECT_DOUBLE_EQ(v.depth_threshold_m, 0.4);
   EXPECT_DOUBLE_EQ(v.max_parallax_deg, 30.0);

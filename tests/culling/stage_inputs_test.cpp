@@ -287,8 +287,6 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     o.sigma2 = maybe_wild_int(rng, 4);
     o.static_needs_evidence = rng.index(2) == 0;
     o.static_max_dynamic_ratio = maybe_wild(rng, T(0.3));
-    o.whole_box_spare_min_points = rng.index(3);
-    o.whole_box_spare_max_ratio = maybe_wild(rng, T(0.1));
     o.dilation_radius_px = maybe_wild_int(rng, 3);
     std::vector<std::uint8_t> in_object(n);
     for (auto& f : in_object) f = static_cast<std::uint8_t>(rng.index(2));
@@ -409,11 +407,9 @@ void depth_mask_property(std::uint64_t seed) {
     for (auto& p : points) p = Vec2<double>(wild<double>(rng, 0, w), wild<double>(rng, 0, h));
     DepthMaskOptions o;
     o.mode = rng.index(2) ? DepthMaskMode::Robust : DepthMaskMode::Plain;
-    o.form = rng.index(3) == 0 ? DepthThresholdForm::DynamicVins : DepthThresholdForm::DldSlam;
     o.missing_depth = static_cast<MissingDepth>(rng.index(3));
     o.occluded_centre_search = rng.index(2) == 0;
     o.eps_m = maybe_wild(rng, 0.3);
-    o.near_margin_m = maybe_wild(rng, 0.0);
     o.histogram_bin_m = maybe_wild(rng, 0.1);
     o.histogram_max_m = maybe_wild(rng, 12.0);
     o.histogram_stride_px = maybe_wild_int(rng, 0);
@@ -539,9 +535,7 @@ TYPED_TEST(StageInputsTest, ReprojectionPropertyStatusOrDefinedLabels) {
     o.pnp.ransac.max_iterations = 50;
     o.max_residual_px = maybe_wild(rng, T(3));
     o.max_residual_in_boxes_px = maybe_wild(rng, T(1.5));
-    o.uncertainty_sigmas = rng.index(3) == 0 ? T(1) : maybe_wild(rng, T(0));
     o.max_depth_residual_sigmas = rng.index(3) == 0 ? T(3) : maybe_wild(rng, T(0));
-    o.min_noise_px = maybe_wild(rng, T(0.5));
     o.min_tracks = rng.index(20);
     const auto r = check_reprojection(points, pixels, camera, o, nullptr, nullptr, view);
     ASSERT_EQ(r.labels.size(), pixels.size());
@@ -561,9 +555,6 @@ TYPED_TEST(StageInputsTest, ReprojectionOptionsNameTheBadField) {
   std::string why;
   ReprojectionCheckOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
-  o.min_noise_px = -std::numeric_limits<T>::infinity();
-  expect_names_field(o, "min_noise_px");
-  o = ReprojectionCheckOptions<T>{};
   o.pnp.ransac.max_iterations = 0;
   expect_names_field(o, "pnp");
 }
@@ -586,13 +577,13 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
     std::vector<Box<T>> boxes(nb);
     for (auto& b : boxes) b = wild_box<T>(rng, -10, 90, -10, 90, 80, 80);
     CoherentMotionOptions<T> o;
-    o.grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
+    const int grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
     o.min_points = rng.index(6);
     o.sigmas = maybe_wild(rng, T(10));
     o.min_noise_px = maybe_wild(rng, T(0.2));
     o.min_median_px = maybe_wild(rng, T(0.5));
     CoherentMotionResult<T> r;
-    flag_coherent_cells(points, residuals, boxes, wild<T>(rng, 0, 2), o, labels.data(), &r);
+    flag_coherent_cells(points, residuals, boxes, grid, wild<T>(rng, 0, 2), o, labels.data(), &r);
     if (r.status != Status::Ok && r.status != Status::Skipped) {
       EXPECT_FALSE(r.reason.empty()) << trial;
       continue;

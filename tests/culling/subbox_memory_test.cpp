@@ -87,15 +87,12 @@ TEST(SubBoxMemory, ApplyingStatesKeepsStaticCellsAndCullsTheObjectElsewhere) {
   EXPECT_EQ(r.labels[3], FeatureLabel::Static) << "outside the object";
   EXPECT_EQ(r.labels[4], FeatureLabel::Dynamic) << "unknown cell: the box rule";
   EXPECT_EQ(r.labels[5], FeatureLabel::Dynamic);
-  EXPECT_EQ(r.labels[6], FeatureLabel::Dynamic) << "outside the boxes, flagged (keep_geometric_outside_boxes)";
+  EXPECT_EQ(r.labels[6], FeatureLabel::Dynamic) << "outside the boxes, flagged: the geometric label stands";
   EXPECT_EQ(r.reasons[6], CullReason::Epipolar);
   EXPECT_EQ(r.num_rescued, 1u);
   EXPECT_EQ(r.num_dynamic, 4u);
   EXPECT_EQ(r.votes[0].num_dynamic_cells, 8);
   EXPECT_EQ(r.dyn_count[4] + r.static_count[4], 0u) << "nothing was voted";
-  options.keep_geometric_outside_boxes = false;
-  apply_subbox_states(pts, geo, boxes, states, options, &r, in_object);
-  EXPECT_EQ(r.labels[6], FeatureLabel::Static);
   options.grid = 9;
   apply_subbox_states(pts, geo, boxes, states, options, &r);
   EXPECT_EQ(r.status, Status::InvalidInput);

@@ -31,28 +31,11 @@ namespace dyncull {
 
 template <class T>
 struct BoxRuleOptions {
-  /// Extra growth of high-level boxes in pixels (padding usually already applied by detections.hpp).
-  T high_padding_px = T(0);
-  /// Shrink of low-level boxes in pixels before the override test: a tv box drawn a little too
-  /// large must not shelter a person's edge (CDS-SLAM's abandoned rule used 5 px).
-  T low_shrink_px = T(0);
   /// Features in a medium-level box (and no low/high box) become Candidate; false: Static.
   bool medium_as_candidate = true;
-  /// RTD-SLAM §III.D sends every boxed feature to geometric verification: when true, features in a
-  /// high-level box become Candidate instead of Dynamic.
-  bool high_as_candidate = false;
-  /// Whether a low-level box also shelters medium-level features (consistent with Zhu et al. 2024 Table 2).
-  bool low_overrides_medium = true;
 
-  /// Ok, or InvalidInput naming the first bad field: both paddings finite. Negative values are
-  /// allowed (a negative high padding shrinks; a box it empties is skipped like an invalid box).
+  /// Ok: every value is valid (the nested validate() of PipelineOptions).
   Status validate(std::string* reason = nullptr) const {
-    auto bad = [&](const char* why) {
-      if (reason) *reason = why;
-      return Status::InvalidInput;
-    };
-    if (!std::isfinite(high_padding_px)) return bad("high_padding_px must be finite");
-    if (!std::isfinite(low_shrink_px)) return bad("low_shrink_px must be finite");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -138,12 +121,11 @@ struct BoxRuleScratch {
 
 namespace detail {
 
-/// The boxes the rule tests, with their level bit and detection index: high-level boxes padded by
-/// high_padding_px, low-level ones shrunk by low_shrink_px, medium ones as detected; Ignore-level classes
-/// left out. Returns the boxes skipped as invalid (or padded to nothing).
+/// The boxes the rule tests, as detected, with their level bit and detection index; Ignore-level classes
+/// left out. Returns the boxes skipped as invalid.
 template <class Dets, class T>
-std::size_t effective_boxes(const Dets& detections, const MotionLevelTable& levels, const BoxRuleOptions<T>& options,
-                            BoxRuleScratch<T>* scratch, BoxRuleResult<T>* r) {
+std::size_t effective_boxes(const Dets& detections, const MotionLevelTable& levels, BoxRuleScratch<T>* scratch,
+                            BoxRuleResult<T>* r) {
   std::vector<Box<T>>& boxes = scratch->boxes;
   boxes.clear();
   scratch->bits.clear();
@@ -158,25 +140,17 @@ std::size_t effective_boxes(const Dets& detections, const MotionLevelTable& leve
       ++skipped;
       continue;
     }
-    Box<T> e = d.box;
     std::uint8_t bit = kInMedium;
     if (level == MotionLevel::High) {
-      e = d.box.padded(options.high_padding_px);
       bit = kInHigh;
-      if (!e.valid()) {  // shrunk to nothing by a negative padding
-        ++skipped;
-        continue;
-      }
       ++r->num_high_boxes;
     } else if (level == MotionLevel::Low) {
-      e = d.box.padded(-options.low_shrink_px);
       bit = kInLow;
-      if (!e.valid()) continue;
       ++r->num_low_boxes;
     } else {
       ++r->num_medium_boxes;
     }
-    boxes.push_back(e);
+    boxes.push_back(d.box);
     scratch->bits.push_back(bit);
     scratch->source.push_back(static_cast<std::int32_t>(b));
   }
@@ -184,8 +158,8 @@ std::size_t effective_boxes(const Dets& detections, const MotionLevelTable& leve
 }
 
 /// Zhang et al. 2023, Algorithm 1 as a table over the membership bits (high, medium, low) and the
-/// non-finite bit: high -> dynamic (candidate with high_as_candidate) unless also low; medium ->
-/// candidate with medium_as_candidate unless low overrides it; a non-finite point is never static.
+/// non-finite bit: high -> dynamic unless also low; medium -> candidate with medium_as_candidate unless
+/// also low (a low-level box shelters both, Zhu et al. 2024 Table 2); a non-finite point is never static.
 template <class T>
 void box_rule_table(const BoxRuleOptions<T>& options, FeatureLabel label_of[16], CullReason reason_of[16]) {
   for (unsigned f = 0; f < 16; ++f) {
@@ -199,11 +173,11 @@ void box_rule_table(const BoxRuleOptions<T>& options, FeatureLabel label_of[16],
       if (low) {
         reason_of[f] = CullReason::LowLevelOverride;
       } else {
-        label_of[f] = options.high_as_candidate ? FeatureLabel::Candidate : FeatureLabel::Dynamic;
+        label_of[f] = FeatureLabel::Dynamic;
         reason_of[f] = CullReason::HighLevelBox;
       }
     } else if (medium) {
-      if (low && options.low_overrides_medium) {
+      if (low) {
         reason_of[f] = CullReason::LowLevelOverride;
       } else if (options.medium_as_candidate) {
         label_of[f] = FeatureLabel::Candidate;
@@ -260,8 +234,8 @@ void label_by_table(std::size_t n, const FeatureLabel label_of[16], const CullRe
 }  // namespace detail
 
 /// Applies the box rule to every point, writing into `*out` and reusing its and `*scratch`'s
-/// buffers. Boxes of Ignore-level classes take no part; invalid (non-finite or inverted) boxes, and
-/// high-level boxes a negative high_padding_px empties, are skipped and counted in `reason`. Options
+/// buffers. Boxes of Ignore-level classes take no part; invalid (non-finite or inverted) boxes are
+/// skipped and counted in `reason`. Options
 /// failing BoxRuleOptions::validate give InvalidInput with every point Static (None): nothing is decided.
 template <class Points, class Dets, class T>
 void apply_box_rule(const Points& points, const Dets& detections, const MotionLevelTable& levels,
@@ -280,7 +254,7 @@ void apply_box_rule(const Points& points, const Dets& detections, const MotionLe
     r.num_static = n;
     return;
   }
-  const std::size_t skipped = detail::effective_boxes(detections, levels, options, scratch, &r);
+  const std::size_t skipped = detail::effective_boxes(detections, levels, scratch, &r);
   if (skipped) {
     r.reason.assign(std::to_string(skipped));
     r.reason += " invalid box(es) skipped";

@@ -32,8 +32,6 @@ struct BoxTrackerOptions {
   int max_missed_frames = 2;
   /// Velocity average: v = (1 - a) v_old + a v_new (a = 1: last displacement only).
   T velocity_smoothing = T(0.5);
-  /// Only detections of the track's class continue it.
-  bool same_class_only = true;
 
   /// Ok, or InvalidInput naming the first bad field: min_iou and velocity_smoothing in [0, 1],
   /// grow_px_per_frame finite and >= 0, max_missed_frames in [0, 1000].
@@ -149,7 +147,7 @@ class BoxTracker {
         continue;
       }
       for (std::size_t t = 0; t < tracks_.size(); ++t) {
-        if (options_.same_class_only && detections[d].class_id != tracks_[t].detection.class_id) continue;
+        if (detections[d].class_id != tracks_[t].detection.class_id) continue;  // only the track's class continues it
         const T o = iou(detections[d].box, predicted_[t]);
         if (o >= options_.min_iou) pairs_.push_back(Pair{o, d, t});
       }

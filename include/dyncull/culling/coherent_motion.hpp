@@ -30,7 +30,6 @@ namespace dyncull {
 /// (at least min_noise_px). 1.2533 sigma / sqrt(N) is the standard error of a median of N Gaussian samples.
 template <class T>
 struct CoherentMotionOptions {
-  int grid = 3;                 ///< grid x grid cells per box, as SubBoxOptions::grid
   std::size_t min_points = 4;   ///< fewer features with a residual: the cell is not tested
   /// Far above a statistical 3: the residuals of a still object near the camera share an offset too (the
   /// map points' error and the pose fitted on the far background), which the noise does not model.
@@ -38,12 +37,11 @@ struct CoherentMotionOptions {
   T min_noise_px = T(0.2);      ///< floor of the noise: LK and map points rarely do better at 640x480
   T min_median_px = T(0.5);     ///< a shared offset below this is never motion
 
-  /// InvalidInput naming the first field out of its range: grid in [1, 8], min_points >= 1, sigmas and
+  /// InvalidInput naming the first field out of its range: min_points >= 1, sigmas and
   /// min_noise_px positive and finite, min_median_px finite and >= 0.
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
-    if (grid < 1 || grid > 8) return invalid_option(reason, "grid", "must be in [1, 8]");
     if (min_points < 1) return invalid_option(reason, "min_points", "must be >= 1");
     if (!(sigmas > T(0)) || !std::isfinite(sigmas)) return invalid_option(reason, "sigmas", "must be positive and finite");
     if (!(min_noise_px > T(0)) || !std::isfinite(min_noise_px))
@@ -87,7 +85,8 @@ namespace detail {
 /// Nothing flagged yet; false (status and reason set) when the inputs break the contract or there is
 /// nothing to test (Skipped: no features or no boxes).
 template <class T>
-bool coherent_start(std::size_t n, std::size_t nb, ArrayView<Vec2<T>> residuals, const CoherentMotionOptions<T>& options,
+bool coherent_start(std::size_t n, std::size_t nb, ArrayView<Vec2<T>> residuals, int grid,
+                    const CoherentMotionOptions<T>& options,
                     const FeatureLabel* labels, FlagView in_object_mask, BoxBitsView object_box_bits,
                     FlagView eligible, CoherentMotionResult<T>* out) {
   CoherentMotionResult<T>& r = *out;
@@ -102,13 +101,14 @@ bool coherent_start(std::size_t n, std::size_t nb, ArrayView<Vec2<T>> residuals,
   };
   std::string why;
   if (options.validate(&why) != Status::Ok) return stop(Status::InvalidInput, "invalid options: " + why);
+  if (grid < 1 || grid > 8) return stop(Status::InvalidInput, "grid must be in [1, 8]");
   if (!residuals.given) return stop(Status::InvalidInput, "residuals is required (" + std::to_string(n) + " points)");
   if (!flags_fit(residuals, n, "residuals", "points", &why) ||
       !flags_fit(in_object_mask, n, "in_object_mask", "points", &why) ||
       !flags_fit(object_box_bits, n, "object_box_bits", "points", &why) ||
       !flags_fit(eligible, n, "eligible", "points", &why))
     return stop(Status::InvalidInput, why);
-  r.cells.assign(nb * static_cast<std::size_t>(options.grid * options.grid), 0);
+  r.cells.assign(nb * static_cast<std::size_t>(grid * grid), 0);
   if (n == 0 || nb == 0) return stop(Status::Skipped, n == 0 ? "no features" : "no boxes");
   if (!labels) return stop(Status::InvalidInput, "labels is required");
   return true;
@@ -161,7 +161,8 @@ bool cell_moves_coherently(ArrayView<Vec2<T>> residuals, std::uint32_t begin, st
 
 }  // namespace detail
 
-/// Flags the cells of each box whose features' residual vectors share a significant median, and turns
+/// Flags the cells of a grid x grid division of each box (the sub-box vote's SubBoxOptions::grid, in
+/// [1, 8]) whose features' residual vectors share a significant median, and turns
 /// their Static labels Dynamic (Candidate labels, features without evidence, stay). residuals[i]: measured
 /// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
 /// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: min_noise_px).
@@ -171,7 +172,7 @@ bool cell_moves_coherently(ArrayView<Vec2<T>> residuals, std::uint32_t begin, st
 /// (nothing read). labels is a raw pointer that must hold points.size() entries.
 template <class T, class Points, class Boxes>
 void flag_coherent_cells(const Points& points, detail::NonDeduced<ArrayView<Vec2<T>>> residuals, const Boxes& boxes,
-                         T noise_px,
+                         int grid, T noise_px,
                          const CoherentMotionOptions<T>& options, FeatureLabel* labels, CoherentMotionResult<T>* out,
                          FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
                          FlagView eligible = nullptr) {
@@ -179,9 +180,10 @@ void flag_coherent_cells(const Points& points, detail::NonDeduced<ArrayView<Vec2
   CoherentMotionResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
   const std::size_t nb = static_cast<std::size_t>(boxes.size());
-  if (!detail::coherent_start(n, nb, residuals, options, labels, in_object_mask, object_box_bits, eligible, out))
+  if (!detail::coherent_start(n, nb, residuals, grid, options, labels, in_object_mask, object_box_bits, eligible,
+                              out))
     return;
-  const int g = options.grid;
+  const int g = grid;
   const std::size_t cells_per_box = static_cast<std::size_t>(g * g);
   r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, options.min_noise_px) : options.min_noise_px;
   r.scratch_order.resize(n);

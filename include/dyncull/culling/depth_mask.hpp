@@ -2,7 +2,7 @@
 /// Depth-threshold object mask inside a detection box (DLD-SLAM, Yu et al. 2024, §3.3 eq. 1-2): d_max = max of the four
 /// corner depths, d_c = centre depth; if d_max - d_c > eps the mask is the box pixels with valid depth
 /// below d_c + eps. Plain rule exactly as published, plus a robust variant (patch statistics,
-/// histogram fallback, missing depth) and the Dynamic-VINS threshold form.
+/// histogram fallback, missing depth).
 ///
 /// API (for the pipeline):
 ///   DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>&, const Box<T>&, const DepthMaskOptions&, MaskView out = {});
@@ -50,16 +50,11 @@ enum class DepthMaskMode : std::uint8_t { Plain = 0, Robust = 1 };
 /// the border band and the shadows beside a person go with the wall they lie on, not with the person.
 enum class MissingDepth : std::uint8_t { Nearest = 0, InMask = 1, OutOfMask = 2 };
 
-/// DldSlam: threshold d_c + eps iff d_max - d_c > eps. DynamicVins (HITSZ-NRSL/Dynamic-VINS
-/// setSemanticMask): both valid: midpoint (d_c + d_max)/2 if d_max - d_c > eps, else d_c + eps;
-/// only the corner valid: d_max; neither valid: whole box.
-enum class DepthThresholdForm : std::uint8_t { DldSlam = 0, DynamicVins = 1 };
-
 /// What produced a box's mask.
 enum class DepthMaskOutcome : std::uint8_t {
   RuleApplied = 0,    ///< threshold from the d_c / d_max rule
   HistogramFallback,  ///< rule did not apply: foreground cluster of the box's depth histogram
-  WholeBox,           ///< too little depth to decide: every box pixel is masked (robust / Dynamic-VINS)
+  WholeBox,           ///< too little depth to decide: every box pixel is masked (robust mode)
   NotApplied,         ///< plain rule did not apply: empty mask, features are Candidates
   EmptyBox,           ///< box invalid or outside the image
 };
@@ -77,11 +72,8 @@ constexpr const char* to_string(DepthMaskOutcome o) noexcept {
 
 struct DepthMaskOptions {
   DepthMaskMode mode = DepthMaskMode::Robust;
-  DepthThresholdForm form = DepthThresholdForm::DldSlam;
   /// eps of DLD-SLAM eq. 2 in metres (paper: empirical, 0.3-0.5 m indoors; 0.3 m fits TUM best).
   double eps_m = 0.3;
-  /// eps of the Dynamic-VINS form (their 1000 mm).
-  double dynamic_vins_eps_m = 1.0;
 
   // ---- robust mode ----
   /// d_c = lower median of the valid depths in a (2r+1)^2 window at the centre (Kinect holes).
@@ -111,10 +103,6 @@ struct DepthMaskOptions {
   double max_object_depth_extent_m = 1.5;
   /// Below this fraction of box pixels with depth the whole box is masked.
   double min_valid_fraction = 0.05;
-  /// Two-sided band (robust mode, DldSlam form): when > 0, pixels nearer than d_c - near_margin_m are
-  /// left out too. DLD-SLAM's band is one-sided (everything in front of the object is masked), which
-  /// takes in a chair or the floor between the camera and a person; 0 (default) keeps the paper's rule.
-  double near_margin_m = 0.0;
   /// Occluded centre (robust mode, several boxes): when box b's centre lies in another box a and b's
   /// d_c is a's object depth (a walker in front of a seated person), d_c measures the occluder and b's
   /// band would leave b's own object out. Then b's d_c is re-estimated from b's pixels outside a: if
@@ -135,12 +123,9 @@ struct DepthMaskOptions {
     using detail::finite_in;
     using detail::invalid_option;
     if (static_cast<int>(mode) > 1) return invalid_option(reason, "mode", "must be Plain or Robust");
-    if (static_cast<int>(form) > 1) return invalid_option(reason, "form", "must be DldSlam or DynamicVins");
     if (static_cast<int>(missing_depth) > 2)
       return invalid_option(reason, "missing_depth", "must be Nearest, InMask or OutOfMask");
     if (!finite_in(eps_m, 0, 1e4)) return invalid_option(reason, "eps_m", "must be finite and in [0, 1e4] m");
-    if (!finite_in(dynamic_vins_eps_m, 0, 1e4))
-      return invalid_option(reason, "dynamic_vins_eps_m", "must be finite and in [0, 1e4] m");
     if (centre_patch_radius_px < 0 || centre_patch_radius_px > 7)
       return invalid_option(reason, "centre_patch_radius_px", "must be in [0, 7]");
     if (!finite_in(histogram_bin_m, 1e-3, 1e4))
@@ -158,8 +143,6 @@ struct DepthMaskOptions {
     if (!finite_in(max_object_depth_extent_m, 0, 1e4))
       return invalid_option(reason, "max_object_depth_extent_m", "must be finite and in [0, 1e4] m");
     if (!finite_in(min_valid_fraction, 0, 1)) return invalid_option(reason, "min_valid_fraction", "must be in [0, 1]");
-    if (!finite_in(near_margin_m, 0, 1e4))
-      return invalid_option(reason, "near_margin_m", "must be finite and in [0, 1e4] m");
     if (!finite_in(occluded_centre_max_fraction, 0, 1))
       return invalid_option(reason, "occluded_centre_max_fraction", "must be in [0, 1]");
     if (!finite_in(occluded_cluster_fraction, 0, 1))
@@ -864,20 +847,9 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
     band->none = false;
     band->all = true;
   };
-  if (o.form == DepthThresholdForm::DynamicVins) {
-    const double e = eps_raw(o.dynamic_vins_eps_m);
-    info.rule_applies = true;
-    if (dc > 0 && dmax > 0) set_threshold(dmax - dc > e ? (dmax + dc) / 2 : dc + e, DepthMaskOutcome::RuleApplied);
-    else if (dmax > 0) set_threshold(dmax, DepthMaskOutcome::RuleApplied);
-    else if (dc > 0) set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
-    else whole_box();
-    info.masks_missing = band->missing == MissingDepth::InMask || band->all;
-    return;
-  }
   // DLD-SLAM eq. 1-2: the rule applies when the background is deeper than the centre by more than eps.
   const double e = eps_raw(o.eps_m);
   info.rule_applies = dc > 0 && dmax - dc > e;
-  if (robust && o.near_margin_m > 0 && dc > 0) band->lo = std::max(range.lo, dc - eps_raw(o.near_margin_m));
   if (info.rule_applies) {
     set_threshold(dc + e, DepthMaskOutcome::RuleApplied);
   } else if (!robust) {
@@ -1103,8 +1075,7 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
     detail::plan_box(depth, range, detail::as_box(boxes[b]), options, &scratch->histogram, &r.boxes[b], &bands[b]);
     if (!r.boxes[b].ok()) ++bad;
   }
-  if (options.occluded_centre_search && options.mode == DepthMaskMode::Robust &&
-      options.form == DepthThresholdForm::DldSlam) {
+  if (options.occluded_centre_search && options.mode == DepthMaskMode::Robust) {
     for (std::size_t b = 0; b < r.boxes.size(); ++b) {
       if (!r.boxes[b].ok() || r.boxes[b].outcome == DepthMaskOutcome::WholeBox) continue;
       for (std::size_t a = 0; a < r.boxes.size(); ++a) {

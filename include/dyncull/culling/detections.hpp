@@ -86,20 +86,14 @@ struct DetectionOptions {
   /// (SG-SLAM: 0.1 for person vs 0.985 for other classes).
   T min_confidence_person = T(0.25);
   int person_class_id = 0;
-  /// Per-class thresholds indexed by class id; entries < 0 (or ids past the end) use the above.
-  std::vector<T> class_min_confidence;
   Letterbox<T> letterbox;
 
   T threshold_for(int class_id) const {
-    if (class_id >= 0 && static_cast<std::size_t>(class_id) < class_min_confidence.size() &&
-        class_min_confidence[static_cast<std::size_t>(class_id)] >= T(0))
-      return class_min_confidence[static_cast<std::size_t>(class_id)];
     return class_id == person_class_id ? min_confidence_person : min_confidence;
   }
 
   /// Ok, or InvalidInput naming the first bad field: box_padding_px finite; min_confidence and
-  /// min_confidence_person in [0, 1]; class_min_confidence entries in [0, 1] or negative (= use the
-  /// default), never NaN; a letterbox in use (input_width or input_height set) needs both sizes
+  /// min_confidence_person in [0, 1]; a letterbox in use (input_width or input_height set) needs both sizes
   /// positive, a finite scale > 0 and finite pads.
   Status validate(std::string* reason = nullptr) const {
     auto bad = [&](const std::string& why) {
@@ -110,11 +104,6 @@ struct DetectionOptions {
     if (!std::isfinite(box_padding_px)) return bad("box_padding_px must be finite");
     if (!unit(min_confidence)) return bad("min_confidence must be in [0, 1]");
     if (!unit(min_confidence_person)) return bad("min_confidence_person must be in [0, 1]");
-    for (std::size_t c = 0; c < class_min_confidence.size(); ++c) {
-      const T v = class_min_confidence[c];
-      if (!(v < T(0)) && !unit(v))
-        return bad("class_min_confidence[" + std::to_string(c) + "] must be in [0, 1] (or negative for the default)");
-    }
     if (letterbox.input_width != 0 || letterbox.input_height != 0) {
       if (letterbox.input_width <= 0) return bad("letterbox.input_width must be positive when a letterbox is set");
       if (letterbox.input_height <= 0) return bad("letterbox.input_height must be positive when a letterbox is set");

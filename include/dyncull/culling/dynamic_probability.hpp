@@ -36,12 +36,6 @@ enum class FlowModel : std::uint8_t {
   Homography = 2,   ///< ego-motion compensated for pure rotation / planar scenes: |p_curr - H p_prev|
 };
 
-/// Where K of eq. 3 comes from. Algorithm 1 step 9 re-runs "steps 5-8" (the flow test) on the
-/// matched feature of the last frame, so K = that feature's previous M (default): not self-
-/// sustaining. The text's reading (K = last frame's final decision) is offered; with it a person
-/// that was dynamic once stays dynamic whenever a1 + a3 >= threshold.
-enum class TemporalSource : std::uint8_t { PreviousMotion = 0, PreviousDecision = 1 };
-
 /// Camera-motion model for the ego-motion-compensated variants (x_curr ~ matrix x_prev).
 template <class T>
 struct EgoMotion {
@@ -66,20 +60,13 @@ struct DynamicProbabilityOptions {
   /// the spread of the background's own flow (LK noise, parallax) plus a floor in pixels.
   T min_motion_threshold_px = T(1.5);
   T mad_scale = T(3);
-  /// Reference flow (U, V): component-wise median of the reference features (true), or their
-  /// mean as eq. 4 (false; a few mislabelled movers drag the mean).
-  bool median_reference = true;
   /// Fewer reference features than this: all features form the reference (most of a frame is
   /// static), and t = fallback_motion_threshold_px.
   std::size_t min_reference_features = 8;
   T fallback_motion_threshold_px = T(3);
-  TemporalSource temporal_source = TemporalSource::PreviousMotion;
-  /// Reference features are those with these levels (in no mask, or in a low-level mask).
-  bool low_level_in_reference = true;
 
   /// InvalidInput naming the first field out of its range: weights finite, >= 0 and summing to 1 (within
-  /// 1e-3); threshold finite; the pixel thresholds and mad_scale finite and >= 0; temporal_source one of
-  /// its values.
+  /// 1e-3); threshold finite; the pixel thresholds and mad_scale finite and >= 0.
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -95,8 +82,6 @@ struct DynamicProbabilityOptions {
     if (!finite_in(mad_scale, 0, kBig)) return invalid_option(reason, "mad_scale", "must be finite and >= 0");
     if (!finite_in(fallback_motion_threshold_px, 0, kBig))
       return invalid_option(reason, "fallback_motion_threshold_px", "must be finite and >= 0");
-    if (static_cast<int>(temporal_source) > 1)
-      return invalid_option(reason, "temporal_source", "must be PreviousMotion or PreviousDecision");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -251,15 +236,13 @@ void dp_flow(const Prev& prev_points, const Curr& curr_points, const EgoMotion<T
   }
 }
 
-/// The reference set of eq. 4: features with flow in no mask (and in low-level ones when
-/// low_level_in_reference); every feature with flow when fewer than min_reference_features are left.
+/// The reference set of eq. 4: features with flow in no mask or in a low-level one; every feature with
+/// flow when fewer than min_reference_features are left.
 template <class T>
 void dp_reference_set(const std::vector<MotionLevel>& levels, const DynamicProbabilityOptions<T>& o,
                       DynamicProbabilityScratch<T>* scratch, DynamicProbabilityResult<T>* r) {
   const std::size_t n = levels.size();
-  auto is_reference = [&](MotionLevel l) {
-    return l == MotionLevel::Ignore || (o.low_level_in_reference && l == MotionLevel::Low);
-  };
+  auto is_reference = [](MotionLevel l) { return l == MotionLevel::Ignore || l == MotionLevel::Low; };
   std::vector<std::size_t>& ref = scratch->ref;
   ref.clear();
   ref.reserve(n);
@@ -274,10 +257,10 @@ void dp_reference_set(const std::vector<MotionLevel>& levels, const DynamicProba
   r->num_reference = ref.size();
 }
 
-/// MeanFlow (eq. 4): (U, V) = the reference features' flow, median or mean; residual = |flow - (U, V)|.
+/// MeanFlow (eq. 4): (U, V) = the component-wise median of the reference features' flow (eq. 4's mean
+/// is dragged by a few mislabelled movers); residual = |flow - (U, V)|.
 template <class T>
-void dp_reference_flow(const DynamicProbabilityOptions<T>& o, DynamicProbabilityScratch<T>* scratch,
-                       DynamicProbabilityResult<T>* r) {
+void dp_reference_flow(DynamicProbabilityScratch<T>* scratch, DynamicProbabilityResult<T>* r) {
   const std::vector<std::size_t>& ref = scratch->ref;
   const std::vector<Vec2<T>>& flow = scratch->flow;
   if (!ref.empty()) {
@@ -291,13 +274,7 @@ void dp_reference_flow(const DynamicProbabilityOptions<T>& o, DynamicProbability
       u.push_back(flow[i].x());
       v.push_back(flow[i].y());
     }
-    if (o.median_reference) {
-      r->reference_flow = Vec2<T>(median_in_place(u), median_in_place(v));
-    } else {
-      Vec2<T> s = Vec2<T>::Zero();
-      for (std::size_t i : ref) s += flow[i];
-      r->reference_flow = s / T(ref.size());
-    }
+    r->reference_flow = Vec2<T>(median_in_place(u), median_in_place(v));
   }
   const Vec2<T> ref_flow = r->reference_flow;  // a local: stores into r must not force reloads
   T* res = r->residual_px.data();
@@ -359,7 +336,7 @@ void dp_combine(const std::vector<MotionLevel>& levels, const DynamicProbability
     const bool tracked = use_store && (*track_ids)[i] >= 0;
     if (tracked) {
       if (const TrackStateStore::State* st = store->find((*track_ids)[i]))
-        k = o.temporal_source == TemporalSource::PreviousMotion ? st->moving != 0 : st->dynamic != 0;
+        k = st->moving != 0;  // Algorithm 1 step 9 re-runs the flow test (steps 5-8) on the last frame
     }
     temporal[i] = static_cast<std::uint8_t>(k);
     bool dynamic = false;
@@ -398,7 +375,7 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
   if (!detail::dp_start(curr_points.size(), prev_points.size(), levels.size(), track_ids, o, ego, out)) return;
   detail::dp_flow(prev_points, curr_points, ego, scratch, out);           // flow, F / H residuals
   detail::dp_reference_set(levels, o, scratch, out);                      // eq. 4's static reference
-  if (ego.model == FlowModel::MeanFlow) detail::dp_reference_flow(o, scratch, out);  // eq. 4
+  if (ego.model == FlowModel::MeanFlow) detail::dp_reference_flow(scratch, out);  // eq. 4
   detail::dp_motion_threshold(o, scratch, out);                           // t of eq. 5
   detail::dp_combine(levels, o, store, track_ids, scratch->has_flow, out);  // eq. 3 and 5
 }

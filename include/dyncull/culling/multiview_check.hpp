@@ -38,7 +38,6 @@ struct MultiViewOptions {
   T max_projected_depth_m = T(7);    ///< projections deeper than this are not used (DynaSLAM)
   T border_px = T(0);                ///< projections closer than this to the image edge are not used
   T region_depth_tolerance_m = T(0.2);  ///< region growing: |d - d_seed| below this joins the region
-  std::size_t max_region_pixels = 0;     ///< cap per seed region (0 = no cap)
 
   /// InvalidInput naming the first field out of its range: max_parallax_deg in (0, 180];
   /// depth_threshold_m > 0; search_radius_px in [0, 256]; the depth gates > 0 (not NaN; +Inf = no gate);
@@ -317,12 +316,10 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
         in_run = ok;
       }
     };
-    const std::size_t cap = options.max_region_pixels > 0 ? options.max_region_pixels : static_cast<std::size_t>(-1);
-    std::size_t region = 0;
     stack->clear();
     stack->push_back(static_cast<std::uint32_t>(seed_idx));
     bool first = true;
-    while (!stack->empty() && region < cap) {
+    while (!stack->empty()) {
       const std::uint32_t idx = stack->back();
       stack->pop_back();
       const int y = static_cast<int>(idx / static_cast<std::uint32_t>(w));
@@ -336,7 +333,6 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
       for (int xx = x0; xx <= x1; ++xx) mrow[xx] = 1;
       const std::size_t run = static_cast<std::size_t>(x1 - x0 + 1);
       set += run;
-      region += run;
       if (y - 1 >= rr0) scan_row(y - 1, x0, x1);
       if (y + 1 < rr1) scan_row(y + 1, x0, x1);
     }

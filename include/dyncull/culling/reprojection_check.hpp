@@ -15,9 +15,6 @@
 #include "dyncull/culling/model_check.hpp"
 #include "dyncull/culling/validation.hpp"
 #include "dyncull/geometry/pnp.hpp"
-#include "dyncull/geometry/pose_covariance.hpp"
-
-#include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -41,18 +38,8 @@ struct ReprojectionCheckOptions {
   /// walkers' and 40 % of the swaying upper body's; 1.5 px (the default) trades a little of the first for
   /// more of the second (docs/algorithms.md).
   T max_residual_in_boxes_px = T(1.5);
-  /// Fit the pose only on tracks outside dynamic boxes when at least min_tracks_outside_boxes remain.
-  bool fit_outside_boxes = true;
+  /// The pose is fitted only on tracks outside dynamic boxes when at least this many remain.
   std::size_t min_tracks_outside_boxes = 20;
-  /// When > 0, a track is dynamic only when its residual also exceeds this many standard deviations of
-  /// its predicted position, propagated from the fitted pose's covariance (sigma^2 (J^T J)^-1 over the fit
-  /// inliers, sigma their RMS residual, at least min_noise_px). When the tracks outside the boxes are few
-  /// or all on one far wall, the pose is loose and a still object near the camera reprojects pixels
-  /// away: its threshold grows instead of it being culled. Off by default: on the dynamic_vo sim, 1 sigma
-  /// kept a seated person's legs in such frames but lost 0.07-0.11 of the recall, mostly on walkers that
-  /// fill the view, which is when the pose is loosest (3 sigma: recall 0.29; docs/algorithms.md).
-  T uncertainty_sigmas = T(0);
-  T min_noise_px = T(0.5);
   /// Depth residual (needs the current depth image): when > 0, a track is also dynamic when the depth
   /// measured at its pixel differs from its point's depth at the fitted pose by more than this many
   /// standard deviations of that difference, sqrt(2) sigma(z) (two measurements) with the Kinect axial
@@ -66,8 +53,8 @@ struct ReprojectionCheckOptions {
   std::size_t min_tracks = 15;  ///< fewer usable tracks: Skipped
 
   /// InvalidInput naming the first field out of its range: the pixel thresholds positive and finite;
-  /// uncertainty_sigmas, min_noise_px, max_depth_residual_sigmas and the depth noise model finite and
-  /// >= 0; pnp (and pnp.ransac) passing their own validate().
+  /// max_depth_residual_sigmas and the depth noise model finite and >= 0; pnp (and pnp.ransac) passing
+  /// their own validate().
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -76,9 +63,6 @@ struct ReprojectionCheckOptions {
       return invalid_option(reason, "max_residual_px", "must be positive and finite");
     if (!(max_residual_in_boxes_px > T(0)) || !std::isfinite(max_residual_in_boxes_px))
       return invalid_option(reason, "max_residual_in_boxes_px", "must be positive and finite");
-    if (!finite_in(uncertainty_sigmas, 0, kBig))
-      return invalid_option(reason, "uncertainty_sigmas", "must be finite and >= 0");
-    if (!finite_in(min_noise_px, 0, kBig)) return invalid_option(reason, "min_noise_px", "must be finite and >= 0");
     if (!finite_in(max_depth_residual_sigmas, 0, kBig))
       return invalid_option(reason, "max_depth_residual_sigmas", "must be finite and >= 0");
     if (!finite_in(depth_sigma_base_m, 0, kBig))
@@ -119,7 +103,6 @@ struct ReprojectionCheckResult {
   /// Robust standard deviation of one residual component over the fit's PnP inliers (1.4826 times the
   /// median absolute component): the tracking and map noise of static tracks this frame. NaN when no fit.
   T inlier_noise_px = Constants<T>::nan();
-  std::vector<T> uncertainty_px;  ///< predicted sd of the position (sqrt of the 2x2 trace); NaN when off
   /// Measured minus predicted depth (m); NaN where not evaluated (depth residual off, no depth there).
   std::vector<T> depth_residual_m;
   std::vector<std::uint8_t> inlier_mask;  ///< PnP-RANSAC inliers (0 for tracks not used in the fit)
@@ -141,12 +124,12 @@ struct ReprojectionCheckResult {
 namespace detail {
 
 /// Track i's residuals at the fitted pose and its label: dynamic when the pixel residual exceeds its
-/// limit (tighter in a box; widened to uncertainty_sigmas times the pose's spread there when `cov`), or
+/// limit (tighter in a box), or
 /// when the depth residual exceeds max_depth_residual_sigmas of the sensor's axial noise; a point behind
 /// the camera is dynamic.
 template <class T, class Raw>
 bool reprojection_label(std::size_t i, const Vec3<T>& X, T u, T v, T limit, const PinholeCamera<T>& camera,
-                        const PoseCovariance* cov, const DepthView<Raw>* depth,
+                        const DepthView<Raw>* depth,
                         const ReprojectionCheckOptions<T>& options, ReprojectionCheckResult<T>* r) {
   const Vec3<T> pc = r->cam_from_world.R * X + r->cam_from_world.t;
   T res = std::numeric_limits<T>::infinity();
@@ -154,11 +137,6 @@ bool reprojection_label(std::size_t i, const Vec3<T>& X, T u, T v, T limit, cons
     const T du = camera.fx * pc.x() / pc.z() + camera.cx - u, dv = camera.fy * pc.y() / pc.z() + camera.cy - v;
     res = std::sqrt(du * du + dv * dv);
     r->residual_vec[i] = Vec2<T>(-du, -dv);
-    if (cov) {
-      const T sd = projected_spread_px(camera, pc, *cov);
-      r->uncertainty_px[i] = sd;
-      limit = std::max(limit, options.uncertainty_sigmas * sd);
-    }
   }
   r->residual_px[i] = res;
   bool dyn = !(res <= limit);
@@ -214,8 +192,7 @@ struct ReprojectionEstimator {
   const ReprojectionCheckOptions<T>& options;
   const DepthView<Raw>& depth;
   ReprojectionCheckResult<T>* r;
-  PoseCovariance cov = PoseCovariance::Zero();
-  bool use_cov = false, use_depth = false;
+  bool use_depth = false;
 
   std::size_t size() const { return static_cast<std::size_t>(pixels.size()); }
   bool sizes_agree() const { return static_cast<std::size_t>(points.size()) == size(); }
@@ -234,7 +211,6 @@ struct ReprojectionEstimator {
     r->residual_px.assign(n, nan);
     r->residual_vec.assign(n, Vec2<T>(nan, nan));
     r->inlier_noise_px = nan;
-    r->uncertainty_px.assign(n, nan);
     r->depth_residual_m.assign(n, nan);
     r->scratch_points.clear();
     r->scratch_pixels.clear();
@@ -270,19 +246,14 @@ struct ReprojectionEstimator {
   }
   void polish() {}  // PnP-RANSAC's LM refinement is the polish
 
-  /// The pose's uncertainty widens each track's limit by the spread it gives that track's projection.
   bool residuals_ready() {
-    const PnpResult<T>& pr = r->scratch_pose_fit;
-    use_cov = options.uncertainty_sigmas > T(0) &&
-              pose_covariance(r->scratch_points, pr.inlier_mask, r->cam_from_world, camera,
-                              std::max(pr.rmse_px, double(options.min_noise_px)), &cov);
     use_depth = options.max_depth_residual_sigmas > T(0) && !depth.empty();
     return true;
   }
 
   FeatureLabel label(std::size_t, std::size_t i, T limit) {
     const Vec2<T> x = pixel(i);
-    const bool dyn = reprojection_label(i, point(i), x.x(), x.y(), limit, camera, use_cov ? &cov : nullptr,
+    const bool dyn = reprojection_label(i, point(i), x.x(), x.y(), limit, camera,
                                         use_depth ? &depth : nullptr, options, r);
     return dyn ? FeatureLabel::Dynamic : FeatureLabel::Static;  // behind the camera: dynamic
   }
@@ -309,7 +280,7 @@ void check_reprojection(const Points3& points, const Pixels& pixels, const Pinho
                 "dyncull::check_reprojection: points and pixels must hold points (see PointTraits)");
   detail::ReprojectionEstimator<T, Points3, Pixels, Raw> reprojection{points, pixels, camera, options, depth, out};
   const detail::ModelCheckRule<T> rule{options.max_residual_px, options.max_residual_in_boxes_px, options.min_tracks,
-                                       options.fit_outside_boxes, options.min_tracks_outside_boxes};
+                                       true, options.min_tracks_outside_boxes};
   detail::check_against_model(reprojection, valid, in_box, rule);
 }
 

@@ -35,10 +35,6 @@ struct SubBoxOptions {
   /// sub-boxes whose points clearly agree on "static" (the legs of a person who only moves the upper
   /// body) even with the 15-25 % false flags that a 0.5 px in-box epipolar threshold gives on still parts.
   T merge_ratio = T(0.35);
-  bool merge_8_neighbours = false;  ///< false: 4-neighbours (edge-sharing), true: 8 (corners too)
-  /// Features outside every box keep their geometric label (there is no semantic evidence against it);
-  /// false: they become static (trust only boxed objects).
-  bool keep_geometric_outside_boxes = true;
   /// When an object mask is given, only features inside it vote: the floor and wall behind a person
   /// otherwise outvote the person in the border sub-boxes, and a walker crossing a chair's box makes
   /// the chair's sub-boxes dynamic. false: every labelled feature in the rectangle votes (the paper).
@@ -50,17 +46,11 @@ struct SubBoxOptions {
   /// 0.3 tolerates the 15-25 % false flags of still parts noted at merge_ratio.
   bool static_needs_evidence = false;
   T static_max_dynamic_ratio = T(0.3);
-  /// The whole-box rule (sigma2) spares a cell whose own vote is clearly static: at least
-  /// whole_box_spare_min_points labelled features, at most whole_box_spare_max_ratio of them flagged (our
-  /// extension; 0 = off, the paper: every cell of the box turns dynamic). A seated person's still legs
-  /// outvote the flags there while its swaying upper body fills the other cells.
-  std::size_t whole_box_spare_min_points = 0;
-  T whole_box_spare_max_ratio = T(0.1);
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
 
   /// InvalidInput naming the first field out of its range: grid in [1, 8]; sigma1, merge_ratio,
-  /// static_max_dynamic_ratio and whole_box_spare_max_ratio finite and >= 0 (above 1 they switch their
-  /// rule off); sigma2 >= 0; dilation_radius_px in [0, 1024].
+  /// static_max_dynamic_ratio finite and >= 0 (above 1 they switch their rule off); sigma2 >= 0;
+  /// dilation_radius_px in [0, 1024].
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -71,8 +61,6 @@ struct SubBoxOptions {
     if (!finite_in(merge_ratio, 0, kBig)) return invalid_option(reason, "merge_ratio", "must be finite and >= 0");
     if (!finite_in(static_max_dynamic_ratio, 0, kBig))
       return invalid_option(reason, "static_max_dynamic_ratio", "must be finite and >= 0");
-    if (!finite_in(whole_box_spare_max_ratio, 0, kBig))
-      return invalid_option(reason, "whole_box_spare_max_ratio", "must be finite and >= 0");
     if (dilation_radius_px < 0 || dilation_radius_px > 1024)
       return invalid_option(reason, "dilation_radius_px", "must be in [0, 1024]");
     if (reason) reason->clear();
@@ -83,8 +71,7 @@ struct SubBoxOptions {
 /// Per-box vote. Cell (row, col) is cells[row * grid + col]; state 1 = dynamic.
 struct SubBoxVote {
   bool whole_box = false;       ///< more than sigma2 dynamic sub-boxes: the whole box is dynamic
-  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (whole_box: grid*grid less spared)
-  int num_spared_cells = 0;     ///< clearly static cells the whole-box rule left static (whole_box_spare_min_points)
+  int num_dynamic_cells = 0;    ///< after merging and static_needs_evidence (whole_box: grid*grid)
   int num_merged_cells = 0;     ///< static or empty cells merged because they touch a dynamic one
 };
 
@@ -260,7 +247,7 @@ void subbox_label_features(const Points& points, ArrayView<FeatureLabel> geometr
       r.num_added += !geo_dyn;
     } else if (in_box) {
       r.num_rescued += geo_dyn;
-    } else if (geo_dyn && options.keep_geometric_outside_boxes) {
+    } else if (geo_dyn) {  // outside every box the geometric label stands
       r.labels[i] = FeatureLabel::Dynamic;
       r.reasons[i] = CullReason::Epipolar;
     }
@@ -298,7 +285,7 @@ void subbox_count_votes(const Points& points, ArrayView<FeatureLabel> geometric,
 }
 
 /// Algorithm 1 line 14 in one pass against the voted states `st` (1 dynamic, 0 static, 2 empty), so
-/// merging never chains: a cell touching a voted dynamic one (4- or 8-neighbours) becomes dynamic when
+/// merging never chains: a cell touching a voted dynamic one (edge-sharing) becomes dynamic when
 /// it is empty or its dynamic share reaches merge_ratio.
 template <class T>
 void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::uint32_t* sc,
@@ -314,7 +301,7 @@ void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::ui
       bool touches = false;
       for (int dr = -1; dr <= 1 && !touches; ++dr)
         for (int dcol = -1; dcol <= 1 && !touches; ++dcol) {
-          if ((dr == 0 && dcol == 0) || (!options.merge_8_neighbours && dr != 0 && dcol != 0)) continue;
+          if ((dr == 0) == (dcol == 0)) continue;  // the 4 edge-sharing neighbours only
           const int rr = row + dr, cc = col + dcol;
           if (rr < 0 || cc < 0 || rr >= g || cc >= g) continue;
           touches = st[static_cast<std::size_t>(rr * g + cc)] == 1;
@@ -324,22 +311,6 @@ void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::ui
       cells[c] = (touches && weak) ? 1 : 0;
       vote->num_merged_cells += cells[c];
     }
-}
-
-/// Algorithm 1's sigma2 rule: more than sigma2 dynamic cells make the whole box dynamic, except cells
-/// with at least whole_box_spare_min_points votes and a dynamic share of at most whole_box_spare_max_ratio.
-template <class T>
-void subbox_whole_box(const std::uint32_t* dc, const std::uint32_t* sc, const SubBoxOptions<T>& options,
-                      std::size_t cells_per_box, std::uint8_t* cells, SubBoxVote* vote) {
-  vote->whole_box = true;
-  for (std::size_t c = 0; c < cells_per_box; ++c) {
-    const std::uint32_t total = dc[c] + sc[c];
-    const bool spared = options.whole_box_spare_min_points > 0 && total >= options.whole_box_spare_min_points &&
-                        T(dc[c]) <= options.whole_box_spare_max_ratio * T(total);
-    cells[c] = spared ? 0 : 1;
-    vote->num_spared_cells += spared;
-  }
-  vote->num_dynamic_cells = static_cast<int>(cells_per_box) - vote->num_spared_cells;
 }
 
 /// Box b's cells: voted, merged, the whole box by sigma2, and with static_needs_evidence a static cell
@@ -356,7 +327,9 @@ void subbox_decide_cells(std::size_t b, std::size_t cells_per_box, const SubBoxO
   subbox_merge(st, dc, sc, options, cells, &vote);
   for (std::size_t c = 0; c < cells_per_box; ++c) vote.num_dynamic_cells += cells[c];
   if (vote.num_dynamic_cells > options.sigma2) {
-    subbox_whole_box(dc, sc, options, cells_per_box, cells, &vote);
+    vote.whole_box = true;  // Algorithm 1's sigma2 rule: every cell of the box
+    std::fill(cells, cells + cells_per_box, std::uint8_t{1});
+    vote.num_dynamic_cells = static_cast<int>(cells_per_box);
     ++r->num_whole_boxes;
   }
   if (options.static_needs_evidence && !vote.whole_box)

@@ -66,17 +66,16 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
       if (!r->reprojection.ran() || geometric.reprojection.residual_vec.size() != n) {
         r->coherent_motion.reason = "needs the reprojection check's residuals (reprojection.enabled, points_3d)";
       } else {
-        CoherentMotionOptions<T> co = options.coherent_motion;
-        co.grid = options.subbox.grid;  // the cells the vote will count
         // High-level objects only: a candidate (a chair) stays verified on its own evidence.
         v.coherent_eligible.resize(n);
         for (std::size_t i = 0; i < n; ++i) v.coherent_eligible[i] = semantic_labels[i] == FeatureLabel::Dynamic;
         v.evidence.assign(geometric.labels.begin(), geometric.labels.end());
         v.coherent_ran = true;
         evidence = v.evidence;
-        flag_coherent_cells(kp, geometric.reprojection.residual_vec, regions.dyn_boxes,
-                            geometric.reprojection.inlier_noise_px, co, v.evidence.data(), &v.coherent, in_object,
-                            box_bits, v.coherent_eligible);
+        // The cells the sub-box vote will count.
+        flag_coherent_cells(kp, geometric.reprojection.residual_vec, regions.dyn_boxes, options.subbox.grid,
+                            geometric.reprojection.inlier_noise_px, options.coherent_motion, v.evidence.data(),
+                            &v.coherent, in_object, box_bits, v.coherent_eligible);
         r->coherent_motion.status = v.coherent.status;
         r->coherent_motion.reason = v.coherent.reason;
         r->coherent_motion.num_dynamic = v.coherent.num_flagged;
