@@ -46,8 +46,8 @@ void track(const dyncull::sim::Scene& scene, int i, const dyncull::sim::FrameDat
     next.ids.push_back(t->ids[k]);
     next.tracked.push_back(1);
   }
-  const int cell = 24, cols = frame.width / cell;
-  std::vector<std::uint8_t> occupied(std::size_t(cols) * (frame.height / cell) + 1, 0);
+  const int cell = 24, cols = (frame.width + cell - 1) / cell, rows = (frame.height + cell - 1) / cell;
+  std::vector<std::uint8_t> occupied(std::size_t(cols) * rows, 0);
   for (const HostFeature& p : next.cur) occupied[std::size_t(int(p.y) / cell) * cols + int(p.x) / cell] = 1;
   const float nan = std::nanf("");
   for (int v = cell / 2; v + cell / 2 <= frame.height; v += cell)
