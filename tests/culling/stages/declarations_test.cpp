@@ -2,6 +2,7 @@
 // front-end order, with the name its option has; what the presets read of a frame follows from the
 // declarations; a stage lacking a declared input reports it by name and does not run.
 #include "dyncull/culling/presets.hpp"
+#include "dyncull/culling/stages/declarations.hpp"
 
 #include <gtest/gtest.h>
 
