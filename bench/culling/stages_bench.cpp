@@ -8,7 +8,7 @@
 #include "dyncull/culling/stages/context.hpp"
 #include "dyncull/culling/stages/geometric.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
-#include "dyncull/culling/stages/multiview.hpp"
+#include "dyncull/culling/stages/evidence.hpp"
 #include "dyncull/culling/stages/probability.hpp"
 #include "dyncull/culling/stages/region_votes.hpp"
 #include "dyncull/culling/stages/semantic.hpp"
@@ -65,7 +65,7 @@ struct StageRun {
                              &state.subbox_memory, &w.votes, &r);
         break;
       case Stage::MultiView:
-        detail::check_against_keyframes(frame, o, state.keyframes, &w.multiview, &r);
+        detail::run_evidence_stages(frame, o, state.keyframes, &w, &r);
         break;
       case Stage::Combine:
         detail::combine_evidence(o, w, &r);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
+#include "dyncull/culling/stages/evidence.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
 
 #include <gtest/gtest.h>
@@ -26,6 +27,16 @@ inline void PrintTo(FeatureLabel label, std::ostream* os) { *os << to_string(lab
 inline void PrintTo(CullReason reason, std::ostream* os) { *os << to_string(reason); }
 
 namespace test {
+
+/// The multi-view stage's output in a frame's buffers.
+template <class T>
+detail::StageFlags<MultiViewStage<T>>& multiview_flags(detail::PipelineWork<T>* w) {
+  return w->template flags_of<MultiViewStage<T>>();
+}
+template <class T>
+const detail::StageFlags<MultiViewStage<T>>& multiview_flags(const detail::PipelineWork<T>* w) {
+  return w->template flags_of<MultiViewStage<T>>();
+}
 
 /// One frame drawn by hand: owns every input a CullingFrame points to. Depth in float metres, 0 = none.
 template <class T>
@@ -205,8 +216,9 @@ Parts parts_of(const detail::PipelineWork<T>& w) {
                    .add(v.subbox.cells)
                    .add(v.ok)
                    .str();
-  const auto& m = w.multiview;
-  p["multiview"] = Bytes().add(m.check.labels).add(m.mask).add(m.ref_index).add(m.dynamic).add(m.ok).str();
+  const auto& m = w.template flags_of<MultiViewStage<T>>();
+  p["multiview"] =
+      Bytes().add(m.work.check.labels).add(m.work.mask).add(m.work.ref_index).add(m.dynamic).add(m.ok).str();
   p["history"] = Bytes().add(w.still_frames).add(w.history_kept).add(w.keypoint_depth).str();
   return p;
 }

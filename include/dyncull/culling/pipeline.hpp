@@ -8,9 +8,9 @@
 #include "dyncull/culling/stages/boxes.hpp"
 #include "dyncull/culling/stages/combine.hpp"
 #include "dyncull/culling/stages/context.hpp"
+#include "dyncull/culling/stages/evidence.hpp"
 #include "dyncull/culling/stages/geometric.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
-#include "dyncull/culling/stages/multiview.hpp"
 #include "dyncull/culling/stages/probability.hpp"
 #include "dyncull/culling/stages/region_votes.hpp"
 #include "dyncull/culling/stages/semantic.hpp"
@@ -34,7 +34,7 @@ namespace dyncull {
 /// Each stage reads the earlier stages' outputs and writes only its own (stages/context.hpp):
 ///   boxes -> semantic evidence (box rule, depth masks) -> geometric evidence (tracks, 3-D points)
 ///   -> probability (semantic labels in the masks) -> region votes (coherent cells, sub-boxes)
-///   -> multi-view flags -> combination -> static history -> survivor guard -> keyframe store.
+///   -> evidence stages (stages/list.hpp: the multi-view check) -> combination -> static history -> survivor guard -> keyframe store.
 template <class T, class Keypoints, class Prev, class Raw, class Points3>
 const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, Points3>& frame,
                                     const PipelineOptions<T>& options, PipelineState<T>* state) {
@@ -53,7 +53,7 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
   detail::score_probability(frame, options, w.regions, w.semantic, w.geometric, &s.track_states, &w.probability, &r);
   detail::vote_regions(frame, options, s.frame_index, w.regions, w.semantic, w.semantic_labels(), w.geometric,
                        &s.subbox_memory, &w.votes, &r);
-  detail::check_against_keyframes(frame, options, s.keyframes, &w.multiview, &r);
+  detail::run_evidence_stages(frame, options, s.keyframes, &w, &r);
   detail::combine_evidence(options, w, &r);
   detail::apply_static_history(frame, options, w.geometric, &s.static_history, &w.still_frames, &w.history_kept, &r);
   detail::guard_survivors(options, &r);

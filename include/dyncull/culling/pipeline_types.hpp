@@ -22,8 +22,9 @@
 #include "dyncull/culling/motion_levels.hpp"
 #include "dyncull/culling/moving_consistency.hpp"
 #include "dyncull/culling/reprojection_check.hpp"
-#include "dyncull/culling/multiview_check.hpp"
 #include "dyncull/culling/static_history.hpp"
+#include "dyncull/culling/stages/list.hpp"
+#include "dyncull/culling/stages/stage.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
 #include "dyncull/culling/validation.hpp"
 
@@ -202,25 +203,6 @@ struct StaticHistoryStageOptions : StaticHistoryOptions<T> {
   bool enabled = false;
 };
 
-/// The multi-view check (RTD-SLAM §III.A after DynaSLAM; needs the current pose, depth and a keyframe) with
-/// its switch. Its flags cull wherever they are (DynaSLAM).
-template <class T>
-struct MultiViewStageOptions : MultiViewOptions<T> {
-  bool enabled = false;
-  std::size_t max_reference_keyframes = 2;  ///< keyframes checked per frame (DynaSLAM: 5)
-
-  static constexpr std::size_t kMaxReferenceKeyframes = 64;
-
-  /// MultiViewOptions::validate, then max_reference_keyframes in [1, 64].
-  Status validate(std::string* reason = nullptr) const {
-    if (MultiViewOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
-    if (max_reference_keyframes < 1 || max_reference_keyframes > kMaxReferenceKeyframes)
-      return detail::invalid_option(reason, "max_reference_keyframes", "must be in [1, 64]");
-    if (reason) reason->clear();
-    return Status::Ok;
-  }
-};
-
 /// Minimum-survivor guard: if fewer than max(min_fraction * n, min_survivors) features stay static, first
 /// soften (restore the culls of single geometric stages and of candidates), then undo all culling.
 /// ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
@@ -238,10 +220,30 @@ struct SurvivorGuardOptions {
   }
 };
 
+namespace detail {
+/// PipelineOptions and PipelineResult hold the options and the report of each listed evidence stage as a
+/// member named as the stage, from the stage's slots (stages/stage.hpp).
+template <class List>
+struct OptionSlots;
+template <class... Stages>
+struct OptionSlots<StageList<Stages...>> : Stages::OptionsSlot... {};
+template <class List>
+struct ReportSlots;
+template <class... Stages>
+struct ReportSlots<StageList<Stages...>> : Stages::ReportSlot... {};
+
+/// Each listed stage's options pass their validate(), in list order; the first failure's reason stands.
+template <class Options, class... Stages>
+bool slots_valid(const Options& options, StageList<Stages...>, std::string* reason) {
+  return ((validate_nested(options.*Stages::kOptions, Stages::kName, reason) == Status::Ok) && ...);
+}
+}  // namespace detail
+
 /// Which stages run and their options, in front-end order; each stage's `enabled` is its one switch.
+/// The evidence stages' options (stages/list.hpp: `multiview`) come from detail::OptionSlots.
 /// presets.hpp builds the papers' configurations.
 template <class T>
-struct PipelineOptions {
+struct PipelineOptions : detail::OptionSlots<EvidenceStages<T>> {
   DetectionStageOptions<T> detections{};
   TrackerStageOptions<T> tracker{};
   MotionLevelTable levels = MotionLevelTable::coco80();
@@ -254,7 +256,6 @@ struct PipelineOptions {
   CoherentMotionStageOptions<T> coherent_motion{};
   SubBoxStageOptions<T> subbox{};
   StaticHistoryStageOptions<T> static_history{};
-  MultiViewStageOptions<T> multiview{};
   /// What happens to the features still labelled Candidate (medium-level boxes) at the end.
   CandidatePolicy candidates = CandidatePolicy::Verify;
   SurvivorGuardOptions guard{};
@@ -276,7 +277,7 @@ struct PipelineOptions {
         validate_nested(coherent_motion, "coherent_motion", reason) != Status::Ok ||
         validate_nested(subbox, "subbox", reason) != Status::Ok ||
         validate_nested(static_history, "static_history", reason) != Status::Ok ||
-        validate_nested(multiview, "multiview", reason) != Status::Ok ||
+        !detail::slots_valid(*this, EvidenceStages<T>{}, reason) ||
         validate_nested(guard, "guard", reason) != Status::Ok)
       return Status::InvalidInput;
     if (static_cast<int>(candidates) > 2)
@@ -284,17 +285,6 @@ struct PipelineOptions {
     if (reason) reason->clear();
     return Status::Ok;
   }
-};
-
-/// Outcome of one stage in one frame. status: Ok (ran), Skipped (disabled, nothing to do this frame, or an
-/// earlier stage it builds on did not run), MissingInput (enabled, but an input of the frame it needs was
-/// not given: the reason names it), or the stage's own failure.
-struct StageReport {
-  bool enabled = false;
-  Status status = Status::Skipped;
-  std::string reason;
-  std::size_t num_dynamic = 0;  ///< features this stage labelled Dynamic (before combination)
-  bool ran() const { return enabled && status == Status::Ok; }
 };
 
 /// What the stages saw of one feature this frame (diagnostics: which stage left a kept feature static).
@@ -313,9 +303,10 @@ struct FeatureTrace {
 /// input of the frame. The reason then says "stage: why" for each such stage, as the stage's option is
 /// named, joined with "; ", and the labels and keep mask are those of the stages that did their job
 /// (labelled() is true). A frame refused at entry (invalid options, depth view or sizes: refused is true)
-/// is InvalidInput with nothing culled and labelled() false.
+/// is InvalidInput with nothing culled and labelled() false. The evidence stages' reports (`multiview`)
+/// come from detail::ReportSlots.
 template <class T>
-struct PipelineResult {
+struct PipelineResult : detail::ReportSlots<EvidenceStages<T>> {
   Status status = Status::Ok;
   std::string reason;
   bool refused = false;  ///< the frame could not be culled at all: every keypoint Static and kept
@@ -327,7 +318,7 @@ struct PipelineResult {
   std::vector<std::uint8_t> keep;    ///< 1 = static: apply to every parallel per-keypoint array
   std::size_t num_features = 0, num_static = 0, num_dynamic = 0;
   StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, reprojection,
-      coherent_motion, subbox, multiview;
+      coherent_motion, subbox;
   StageReport static_history;       ///< PipelineOptions::static_history
   std::size_t history_kept = 0;     ///< features the static history kept against a region's cull
   std::size_t unsheltered = 0;      ///< features low_override_by_depth took out of a low-level box's shelter
@@ -364,6 +355,7 @@ struct CullingFrame {
 namespace detail {
 inline bool is_soft_cull(CullReason r) {
   return r == CullReason::Epipolar || r == CullReason::Reprojection || r == CullReason::MultiView ||
+         r == CullReason::EvidenceStage ||
          r == CullReason::SubBox || r == CullReason::CoherentMotion || r == CullReason::MediumLevelBox ||
          r == CullReason::TrackedBox;
 }
@@ -375,10 +367,6 @@ inline bool is_regional_cull(CullReason r) {
          r == CullReason::TrackedBox || r == CullReason::MediumLevelBox;
 }
 
-template <class T, class Keypoints>
-bool keypoint_in_image(const Keypoints& kp, std::size_t i, int w, int h, int* u, int* v) {
-  return pixel_of(point_x<T>(kp[i]), point_y<T>(kp[i]), w, h, u, v);
-}
 }  // namespace detail
 
 }  // namespace dyncull

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
+#include "dyncull/culling/stages/evidence.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +26,6 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
   const bool geo_ok = w.geometric.ok;
   const FeatureLabel* const evidence = w.evidence();
   const bool subbox_ok = w.votes.ok;
-  const bool mv_ok = w.multiview.ok;
   for (std::size_t i = 0; i < n; ++i) {
     FeatureLabel lab = sem_labels[i];
     CullReason why = sem_reasons[i];
@@ -59,11 +59,12 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
       lab = FeatureLabel::Dynamic;
       why = w.evidence_source(i);
     }
-    if (mv_ok && w.multiview.dynamic[i]) {
+    CullReason flag_reason = CullReason::None;
+    if (evidence_flagged(w, i, &flag_reason)) {
       geo_flagged = true;
       if (lab != FeatureLabel::Dynamic) {  // DynaSLAM: a multi-view flag culls wherever it is
         lab = FeatureLabel::Dynamic;
-        why = CullReason::MultiView;
+        why = flag_reason;
       }
     }
     if (lab == FeatureLabel::Candidate) {

@@ -1,6 +1,6 @@
 /// @file context.hpp
 /// The per-frame data the culling stages exchange (box regions, per-feature semantic and geometric
-/// evidence, region votes, multi-view flags) and the caller-owned PipelineState that keeps them between
+/// evidence, region votes, the evidence stages' flags) and the caller-owned PipelineState that keeps them between
 /// frames so no stage allocates after warm-up. Each stage writes only its own part.
 #pragma once
 
@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 namespace dyncull {
@@ -82,15 +83,20 @@ struct RegionVotes {
   bool ok = false;
 };
 
-/// Multi-view check against stored keyframes (RTD-SLAM §III.A), grown into a mask over the depth image.
-template <class T>
-struct MultiViewFlags {
-  MultiViewResult<T> check;
-  Mask mask;
-  std::vector<std::uint32_t> flood_stack;
-  std::vector<std::size_t> ref_index;
+/// An evidence stage's output (stages/stage.hpp): its buffers and one flag per feature, valid when ok.
+template <class Stage>
+struct StageFlags {
+  using StageType = Stage;
+  typename Stage::Work work;
   std::vector<std::uint8_t> dynamic;
   bool ok = false;
+};
+
+template <class List>
+struct StageFlagsOf;
+template <class... Stages>
+struct StageFlagsOf<StageList<Stages...>> {
+  using type = std::tuple<StageFlags<Stages>...>;
 };
 
 /// Everything the stages of one frame write, reused between frames.
@@ -101,7 +107,7 @@ struct PipelineWork {
   ProbabilityEvidence<T> probability;
   GeometricEvidence<T> geometric;
   RegionVotes<T> votes;
-  MultiViewFlags<T> multiview;
+  typename StageFlagsOf<EvidenceStages<T>>::type evidence_flags;  ///< one StageFlags per evidence stage
   std::vector<std::uint16_t> still_frames;  ///< static history count per feature this frame
   std::vector<std::uint8_t> history_kept;   ///< 1: kept static by its history this frame
   std::vector<T> keypoint_depth;
@@ -112,6 +118,15 @@ struct PipelineWork {
   }
   const std::vector<CullReason>& semantic_reasons() const {
     return probability.ok ? probability.reasons : semantic.reasons;
+  }
+  /// The output of the evidence stage Stage (stages/list.hpp).
+  template <class Stage>
+  const StageFlags<Stage>& flags_of() const {
+    return std::get<StageFlags<Stage>>(evidence_flags);
+  }
+  template <class Stage>
+  StageFlags<Stage>& flags_of() {
+    return std::get<StageFlags<Stage>>(evidence_flags);
   }
   /// The geometric evidence the vote and the combination read (with the coherent cells' flags).
   const FeatureLabel* evidence() const { return votes.coherent_ran ? votes.evidence.data() : geometric.labels.data(); }
@@ -124,6 +139,14 @@ struct PipelineWork {
 
 template <class T>
 PipelineWork<T>& work_of(PipelineState<T>* state);
+
+/// What an evidence stage reads besides the frame and its options: the earlier stages' outputs and the
+/// stored keyframes.
+template <class T>
+struct EvidenceContext {
+  const PipelineWork<T>& earlier;
+  const KeyframeRing<T>& keyframes;
+};
 
 }  // namespace detail
 
