@@ -83,6 +83,13 @@ TYPED_TEST(Declarations, WhatThePresetsReadOfAFrame) {
   EXPECT_TRUE(reads(inputs_read(epipolar, /*optional=*/true), I::Depth));
 }
 
+/// The check a stage makes before it runs: the inputs its declaration needs, against the frame.
+template <class T, class Frame>
+bool has_inputs(const Frame& frame, const PipelineOptions<T>& o, detail::ReportMember<T> report, PipelineResult<T>* r,
+                bool keyframe_stored = true) {
+  return detail::has_needed_inputs(frame, detail::needs_of(o, report), &(r->*report), keyframe_stored);
+}
+
 // A frame of 3 keypoints with nothing else: each stage names the first input it lacks.
 TYPED_TEST(Declarations, AStageLackingAnInputNamesItAndDoesNotRun) {
   using T = TypeParam;
@@ -91,7 +98,7 @@ TYPED_TEST(Declarations, AStageLackingAnInputNamesItAndDoesNotRun) {
   frame.keypoints = &kp;
   const PipelineOptions<T> o = presets::rtd_slam<T>();
   PipelineResult<T> r;
-  EXPECT_FALSE(detail::stage_has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
+  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
   EXPECT_EQ(r.multiview.status, Status::MissingInput);
   EXPECT_EQ(r.multiview.reason, "no cam_from_world given");
   const Rigid3<T> lost = [] {
@@ -100,19 +107,19 @@ TYPED_TEST(Declarations, AStageLackingAnInputNamesItAndDoesNotRun) {
     return p;
   }();
   frame.cam_from_world = &lost;
-  EXPECT_FALSE(detail::stage_has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
+  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
   EXPECT_EQ(r.multiview.reason, "cam_from_world not finite (tracking lost)");
   const Rigid3<T> pose;
   const std::vector<float> depth(4, 1.f);
   frame.cam_from_world = &pose;
   frame.depth = DepthView<float>{depth.data(), 2, 2};
-  EXPECT_FALSE(detail::stage_has_inputs(frame, o, &PipelineResult<T>::multiview, &r, /*keyframe_stored=*/false));
+  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r, /*keyframe_stored=*/false));
   EXPECT_EQ(r.multiview.reason, "no reference keyframe stored yet");
   r.multiview = StageReport{};
-  EXPECT_TRUE(detail::stage_has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
+  EXPECT_TRUE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
   EXPECT_EQ(r.multiview.status, Status::Skipped);  // untouched: the stage runs
-  EXPECT_TRUE(detail::stage_has_inputs(frame, o, &PipelineResult<T>::tracker, &r));  // reads nothing
-  EXPECT_FALSE(detail::stage_has_inputs(frame, o, &PipelineResult<T>::static_history, &r));
+  EXPECT_TRUE(has_inputs(frame, o, &PipelineResult<T>::tracker, &r));  // reads nothing
+  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::static_history, &r));
   EXPECT_EQ(r.static_history.reason, "no track_ids given");
 }
 

@@ -8,9 +8,24 @@
 namespace dyncull {
 namespace detail {
 
+/// What the box stages read: the detection filter's and the box tracker's options, the class levels, and
+/// the inputs the filter needs (its declaration).
+template <class T>
+struct BoxesSlice {
+  const DetectionStageOptions<T>& detections;
+  const TrackerStageOptions<T>& tracker;
+  const MotionLevelTable& levels;
+  FrameInputs detections_needs;
+  BoxesSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : detections(o.detections),
+        tracker(o.tracker),
+        levels(o.levels),
+        detections_needs(needs_of(o, &PipelineResult<T>::detections)) {}
+};
+
 /// Fills `out` with this frame's boxes; reports into r.detections and r.tracker.
 template <class T, class Frame>
-void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTracker<T>* tracker, BoxRegions<T>* out,
+void collect_boxes(const Frame& frame, const NonDeduced<BoxesSlice<T>>& options, BoxTracker<T>* tracker, BoxRegions<T>* out,
                    PipelineResult<T>* r) {
   const int W = frame.camera.width, H = frame.camera.height;
   BoxRegions<T>& s = *out;
@@ -26,7 +41,7 @@ void collect_boxes(const Frame& frame, const PipelineOptions<T>& options, BoxTra
       s.boxes = *frame.detections;
     }
   } else if (options.detections.enabled) {
-    stage_has_inputs(frame, options, &PipelineResult<T>::detections, r);
+    has_needed_inputs(frame, options.detections_needs, &r->detections);
   }
   if (options.tracker.enabled) {
     // Only dynamic-class boxes are tracked: carrying a missed (or one-frame false positive) low-level box

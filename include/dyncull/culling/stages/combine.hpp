@@ -17,9 +17,18 @@
 namespace dyncull {
 namespace detail {
 
+/// What the combination reads: the policy for candidates, and whether a dynamic sub-box culls them.
+struct CombineSlice {
+  CandidatePolicy candidates;
+  bool subbox_verifies_candidates;
+  template <class T>
+  CombineSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : candidates(o.candidates), subbox_verifies_candidates(o.subbox.verifies_candidates) {}
+};
+
 /// r.labels / r.reasons from the stages' evidence.
 template <class T>
-void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& w, PipelineResult<T>* r) {
+void combine_evidence(const CombineSlice& options, const PipelineWork<T>& w, PipelineResult<T>* r) {
   const std::size_t n = r->num_features;
   const std::vector<FeatureLabel>& sem_labels = w.semantic_labels();
   const std::vector<CullReason>& sem_reasons = w.semantic_reasons();
@@ -39,7 +48,7 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
     bool geo_flagged = geo_dyn;
     if (subbox_ok) {
       const CullReason vote = w.votes.subbox.reasons[i];
-      if (lab == FeatureLabel::Candidate && !options.subbox.verifies_candidates) {
+      if (lab == FeatureLabel::Candidate && !options.subbox_verifies_candidates) {
         // Stays a candidate, verified below on its own evidence: flagged itself inside a dynamic sub-box,
         // or by the multi-view check.
         geo_flagged = geo_dyn && vote == CullReason::SubBox;
@@ -78,20 +87,33 @@ void combine_evidence(const PipelineOptions<T>& options, const PipelineWork<T>& 
   }
 }
 
+/// What the static history reads: its options, the shortest baseline that may vote (a slow mover is not
+/// proven still over fewer frames), and the inputs it needs (its declaration).
+template <class T>
+struct StaticHistorySlice {
+  const StaticHistoryStageOptions<T>& static_history;
+  int min_evidence_frames;
+  FrameInputs needs;
+  StaticHistorySlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : static_history(o.static_history),
+        min_evidence_frames(o.subbox.min_evidence_frames),
+        needs(needs_of(o, &PipelineResult<T>::static_history)) {}
+};
+
 /// A track proven still over its last frames outweighs its region's cull (PipelineOptions::static_history).
 template <class T, class Frame>
-void apply_static_history(const Frame& frame, const PipelineOptions<T>& options, const GeometricEvidence<T>& geometric,
+void apply_static_history(const Frame& frame, const NonDeduced<StaticHistorySlice<T>>& options, const GeometricEvidence<T>& geometric,
                           StaticHistory* history, std::vector<std::uint16_t>* still_frames,
                           std::vector<std::uint8_t>* kept, PipelineResult<T>* r) {
   const std::size_t n = r->num_features;
   kept->assign(n, 0);
   if (!r->static_history.enabled) return;
-  if (!stage_has_inputs(frame, options, &PipelineResult<T>::static_history, r)) return;
+  if (!has_needed_inputs(frame, options.needs, &r->static_history)) return;
   const ReprojectionCheckResult<T>& rp = geometric.reprojection;
   const bool checked = r->reprojection.ran() && rp.labels.size() == n && rp.residual_px.size() == n;
   // A baseline too short to vote (subbox.min_evidence_frames) is too short to prove a slow mover still.
   const bool evaluated = checked && (frame.evidence_frames <= 0 ||
-                                     frame.evidence_frames >= std::max(1, options.subbox.min_evidence_frames));
+                                     frame.evidence_frames >= std::max(1, options.min_evidence_frames));
   history->update(*frame.track_ids, checked ? ArrayView<FeatureLabel>(rp.labels) : nullptr,
                   checked ? ArrayView<T>(rp.residual_px) : nullptr, evaluated, options.static_history.max_residual_px,
                   still_frames);
@@ -116,10 +138,17 @@ void apply_static_history(const Frame& frame, const PipelineOptions<T>& options,
   r->static_history.reason += " feature(s) kept static by their history";
 }
 
+/// What the survivor guard reads: its options.
+struct SurvivorGuardSlice {
+  const SurvivorGuardOptions& guard;
+  template <class T>
+  SurvivorGuardSlice(const PipelineOptions<T>& o) : guard(o.guard) {}  // implicit: the pipeline passes its options
+};
+
 /// Minimum-survivor guard: below max(guard.min_fraction * n, guard.min_survivors) static features, first
 /// soften (restore the culls of single geometric stages and of candidates), then undo all culling.
 template <class T>
-void guard_survivors(const PipelineOptions<T>& options, PipelineResult<T>* r) {
+void guard_survivors(const NonDeduced<SurvivorGuardSlice>& options, PipelineResult<T>* r) {
   const std::size_t n = r->num_features;
   auto count_static = [&]() {
     std::size_t c = 0;

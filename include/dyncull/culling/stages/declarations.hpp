@@ -115,13 +115,11 @@ FrameInputs inputs_read(const PipelineOptions<T>& options, bool optional = false
 
 namespace detail {
 
-/// False, with the stage's report MissingInput and the first input it needs and the frame lacks named,
-/// when the stage cannot run; true when it has what it needs. (Given inputs have the keypoints' length:
-/// accept_inputs checked.)
-template <class T, class Frame>
-bool stage_has_inputs(const Frame& frame, const PipelineOptions<T>& options, ReportMember<T> report, PipelineResult<T>* r,
-                      bool keyframe_stored = true) {
-  return has_needed_inputs(frame, stage_of<T>(report).needs(options), &(r->*report), keyframe_stored);
+/// The frame inputs the stage reporting into `report` needs under `options` (its declaration above): a
+/// stage's options slice carries them to detail::has_needed_inputs (stages/stage.hpp).
+template <class T>
+FrameInputs needs_of(const PipelineOptions<T>& options, ReportMember<T> report) {
+  return stage_of<T>(report).needs(options);
 }
 
 }  // namespace detail

@@ -13,17 +13,33 @@
 namespace dyncull {
 namespace detail {
 
+/// What the geometric stages read: the epipolar and reprojection checks' options, the occlusion-edge
+/// discount, and the inputs each check needs (their declarations).
+template <class T>
+struct GeometricSlice {
+  const MovingConsistencyStageOptions<T>& moving_consistency;
+  const ReprojectionStageOptions<T>& reprojection;
+  const EdgeEvidenceOptions& edge_evidence;
+  FrameInputs moving_consistency_needs, reprojection_needs;
+  GeometricSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : moving_consistency(o.moving_consistency),
+        reprojection(o.reprojection),
+        edge_evidence(o.edge_evidence),
+        moving_consistency_needs(needs_of(o, &PipelineResult<T>::moving_consistency)),
+        reprojection_needs(needs_of(o, &PipelineResult<T>::reprojection)) {}
+};
+
 /// Geometric evidence of this frame (out->labels, valid when out->ok); reports into
 /// r.moving_consistency and r.reprojection.
 template <class T, class Frame>
-void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& options, const BoxRegions<T>& regions,
+void gather_geometric_evidence(const Frame& frame, const NonDeduced<GeometricSlice<T>>& options, const BoxRegions<T>& regions,
                                const SemanticEvidence<T>& semantic, GeometricEvidence<T>* out, PipelineResult<T>* r) {
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
   GeometricEvidence<T>& g = *out;
   const FlagView in_boxes = regions.dyn_boxes.empty() ? nullptr : FlagView(semantic.in_dyn_box);
   if (options.moving_consistency.enabled) {
-    if (stage_has_inputs(frame, options, &PipelineResult<T>::moving_consistency, r)) {
+    if (has_needed_inputs(frame, options.moving_consistency_needs, &r->moving_consistency)) {
       check_moving_consistency(*frame.prev_keypoints, kp, options.moving_consistency, &g.moving, frame.track_valid,
                                in_boxes);
       r->moving_consistency.status = g.moving.status;
@@ -36,7 +52,7 @@ void gather_geometric_evidence(const Frame& frame, const PipelineOptions<T>& opt
     g.source.assign(n, CullReason::Epipolar);
   }
   if (options.reprojection.enabled) {
-    if (stage_has_inputs(frame, options, &PipelineResult<T>::reprojection, r)) {
+    if (has_needed_inputs(frame, options.reprojection_needs, &r->reprojection)) {
       check_reprojection(*frame.points_3d, kp, frame.camera, options.reprojection, &g.reprojection, frame.track_valid,
                          in_boxes, frame.depth);
       r->reprojection.status = g.reprojection.status;

@@ -10,9 +10,19 @@
 namespace dyncull {
 namespace detail {
 
+/// What the probability reads: its options, the class levels, and the inputs it needs (its declaration).
+template <class T>
+struct ProbabilitySlice {
+  const ProbabilityStageOptions<T>& probability;
+  const MotionLevelTable& levels;
+  FrameInputs needs;
+  ProbabilitySlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : probability(o.probability), levels(o.levels), needs(needs_of(o, &PipelineResult<T>::probability)) {}
+};
+
 /// out->labels / reasons: the semantic labels with the probability's decisions (valid when out->ok).
 template <class T, class Frame>
-void score_probability(const Frame& frame, const PipelineOptions<T>& options, const BoxRegions<T>& regions,
+void score_probability(const Frame& frame, const NonDeduced<ProbabilitySlice<T>>& options, const BoxRegions<T>& regions,
                        const SemanticEvidence<T>& semantic, const GeometricEvidence<T>& geometric,
                        TrackStateStore* track_states, ProbabilityEvidence<T>* out, PipelineResult<T>* r) {
   ProbabilityEvidence<T>& p = *out;
@@ -20,7 +30,7 @@ void score_probability(const Frame& frame, const PipelineOptions<T>& options, co
   if (!options.probability.enabled) return;
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
-  if (!stage_has_inputs(frame, options, &PipelineResult<T>::probability, r)) return;
+  if (!has_needed_inputs(frame, options.needs, &r->probability)) return;
   const FlagView track_valid = frame.track_valid;  // accept_inputs checked its size
   p.levels.assign(n, MotionLevel::Ignore);
   p.prev.resize(n);

@@ -14,10 +14,21 @@
 namespace dyncull {
 namespace detail {
 
+/// What the region votes read: the sub-box refinement's and the coherent cells' options, and whether the
+/// box tracker runs (a tracked box's cells keep its last vote on too short a baseline).
+template <class T>
+struct RegionVotesSlice {
+  const SubBoxStageOptions<T>& subbox;
+  const CoherentMotionStageOptions<T>& coherent_motion;
+  bool boxes_tracked;
+  RegionVotesSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : subbox(o.subbox), coherent_motion(o.coherent_motion), boxes_tracked(o.tracker.enabled) {}
+};
+
 /// out->subbox: this frame's sub-box labels (valid when out->ok); out->evidence: the geometric labels with
 /// the coherent cells' features flagged (when out->coherent_ran). Reports into r.coherent_motion, r.subbox.
 template <class T, class Frame>
-void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::uint64_t frame_index,
+void vote_regions(const Frame& frame, const NonDeduced<RegionVotesSlice<T>>& options, std::uint64_t frame_index,
                   const BoxRegions<T>& regions, const SemanticEvidence<T>& semantic,
                   const std::vector<FeatureLabel>& semantic_labels, const GeometricEvidence<T>& geometric,
                   SubBoxMemory* last_votes, RegionVotes<T>* out, PipelineResult<T>* r) {
@@ -37,7 +48,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
   } else if (options.subbox.min_evidence_frames > 0 && frame.evidence_frames > 0 &&
              frame.evidence_frames < options.subbox.min_evidence_frames) {
     const std::size_t recalled =
-        options.subbox.short_baseline_keeps_last_vote && options.tracker.enabled && r->tracker.ran()
+        options.subbox.short_baseline_keeps_last_vote && options.boxes_tracked && r->tracker.ran()
             ? last_votes->recall_states(regions.dyn_box_track_id, options.subbox.grid, frame_index,
                                         options.subbox.min_evidence_frames, &v.remembered_cells)
             : 0;
@@ -83,7 +94,7 @@ void vote_regions(const Frame& frame, const PipelineOptions<T>& options, std::ui
     }
     refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits);
     if (options.subbox.short_baseline_keeps_last_vote && options.subbox.min_evidence_frames > 0 &&
-        options.tracker.enabled && r->tracker.ran() && v.subbox.ok())
+        options.boxes_tracked && r->tracker.ran() && v.subbox.ok())
       last_votes->remember_states(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,
                                   options.subbox.min_evidence_frames);
     r->subbox.status = v.subbox.status;

@@ -139,9 +139,25 @@ void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, 
 }  // namespace detail
 namespace detail {
 
+/// What the semantic stages read: the box rule's and the depth masks' options, the class levels, and the
+/// inputs each needs (their declarations).
+template <class T>
+struct SemanticSlice {
+  const BoxRuleStageOptions<T>& box_rule;
+  const DepthMaskStageOptions& depth_mask;
+  const MotionLevelTable& levels;
+  FrameInputs box_rule_needs, depth_mask_needs;
+  SemanticSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
+      : box_rule(o.box_rule),
+        depth_mask(o.depth_mask),
+        levels(o.levels),
+        box_rule_needs(needs_of(o, &PipelineResult<T>::box_rule)),
+        depth_mask_needs(needs_of(o, &PipelineResult<T>::depth_mask)) {}
+};
+
 /// Semantic evidence of this frame: the box rule's labels, then the depth masks (out->labels etc.).
 template <class T, class Frame>
-void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, const BoxRegions<T>& regions,
+void classify_by_boxes(const Frame& frame, const NonDeduced<SemanticSlice<T>>& options, const BoxRegions<T>& regions,
                        SemanticEvidence<T>* out, PipelineResult<T>* r) {
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
@@ -167,12 +183,12 @@ void classify_by_boxes(const Frame& frame, const PipelineOptions<T>& options, co
     }
     // Without the detection filter, the box rule is the stage that reads the detections. It still ran on
     // no boxes, so a non-finite keypoint is culled as on any frame.
-    stage_has_inputs(frame, options, &PipelineResult<T>::box_rule, r);
+    has_needed_inputs(frame, options.box_rule_needs, &r->box_rule);
   }
 
   // Inside dynamic-class boxes only the object's depth band is culled.
   if (!options.depth_mask.enabled) return;
-  if (!stage_has_inputs(frame, options, &PipelineResult<T>::depth_mask, r)) return;
+  if (!has_needed_inputs(frame, options.depth_mask_needs, &r->depth_mask)) return;
   DepthMaskResult& dm = s.mask;
   depth_mask(frame.depth, regions.dyn_boxes, kp, options.depth_mask, &dm, &s.mask_scratch);
   r->depth_mask.status = dm.status;
