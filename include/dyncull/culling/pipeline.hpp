@@ -34,7 +34,8 @@ namespace dyncull {
 /// Each stage reads the earlier stages' outputs and writes only its own (stages/context.hpp):
 ///   boxes -> semantic evidence (box rule, depth masks) -> geometric evidence (tracks, 3-D points)
 ///   -> probability (semantic labels in the masks) -> region votes (coherent cells, sub-boxes)
-///   -> evidence stages (stages/list.hpp: the multi-view check) -> combination -> static history -> survivor guard -> keyframe store.
+///   -> evidence stages (stages/list.hpp: the multi-view check) -> combination -> static history
+///   -> survivor guard -> keyframe store.
 template <class T, class Keypoints, class Prev, class Raw, class Points3>
 const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, Points3>& frame,
                                     const PipelineOptions<T>& options, PipelineState<T>* state) {

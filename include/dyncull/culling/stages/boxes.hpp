@@ -25,8 +25,8 @@ struct BoxesSlice {
 
 /// Fills `out` with this frame's boxes; reports into r.detections and r.tracker.
 template <class T, class Frame>
-void collect_boxes(const Frame& frame, const NonDeduced<BoxesSlice<T>>& options, BoxTracker<T>* tracker, BoxRegions<T>* out,
-                   PipelineResult<T>* r) {
+void collect_boxes(const Frame& frame, const NonDeduced<BoxesSlice<T>>& options, BoxTracker<T>* tracker,
+                   BoxRegions<T>* out, PipelineResult<T>* r) {
   const int W = frame.camera.width, H = frame.camera.height;
   BoxRegions<T>& s = *out;
   s.boxes.clear();

@@ -71,7 +71,7 @@ void combine_evidence(const CombineSlice& options, const PipelineWork<T>& w, Pip
     CullReason flag_reason = CullReason::None;
     if (evidence_flagged(w, i, &flag_reason)) {
       geo_flagged = true;
-      if (lab != FeatureLabel::Dynamic) {  // DynaSLAM: a multi-view flag culls wherever it is
+      if (lab != FeatureLabel::Dynamic) {  // a flag culls wherever it is (DynaSLAM's multi-view rule)
         lab = FeatureLabel::Dynamic;
         why = flag_reason;
       }
@@ -102,9 +102,10 @@ struct StaticHistorySlice {
 
 /// A track proven still over its last frames outweighs its region's cull (PipelineOptions::static_history).
 template <class T, class Frame>
-void apply_static_history(const Frame& frame, const NonDeduced<StaticHistorySlice<T>>& options, const GeometricEvidence<T>& geometric,
-                          StaticHistory* history, std::vector<std::uint16_t>* still_frames,
-                          std::vector<std::uint8_t>* kept, PipelineResult<T>* r) {
+void apply_static_history(const Frame& frame, const NonDeduced<StaticHistorySlice<T>>& options,
+                          const GeometricEvidence<T>& geometric, StaticHistory* history,
+                          std::vector<std::uint16_t>* still_frames, std::vector<std::uint8_t>* kept,
+                          PipelineResult<T>* r) {
   const std::size_t n = r->num_features;
   kept->assign(n, 0);
   if (!r->static_history.enabled) return;
@@ -148,7 +149,7 @@ struct SurvivorGuardSlice {
 /// Minimum-survivor guard: below max(guard.min_fraction * n, guard.min_survivors) static features, first
 /// soften (restore the culls of single geometric stages and of candidates), then undo all culling.
 template <class T>
-void guard_survivors(const NonDeduced<SurvivorGuardSlice>& options, PipelineResult<T>* r) {
+void guard_survivors(const SurvivorGuardSlice& options, PipelineResult<T>* r) {
   const std::size_t n = r->num_features;
   auto count_static = [&]() {
     std::size_t c = 0;

@@ -32,8 +32,9 @@ struct GeometricSlice {
 /// Geometric evidence of this frame (out->labels, valid when out->ok); reports into
 /// r.moving_consistency and r.reprojection.
 template <class T, class Frame>
-void gather_geometric_evidence(const Frame& frame, const NonDeduced<GeometricSlice<T>>& options, const BoxRegions<T>& regions,
-                               const SemanticEvidence<T>& semantic, GeometricEvidence<T>* out, PipelineResult<T>* r) {
+void gather_geometric_evidence(const Frame& frame, const NonDeduced<GeometricSlice<T>>& options,
+                               const BoxRegions<T>& regions, const SemanticEvidence<T>& semantic,
+                               GeometricEvidence<T>* out, PipelineResult<T>* r) {
   const auto& kp = *frame.keypoints;
   const std::size_t n = r->num_features;
   GeometricEvidence<T>& g = *out;
