@@ -123,7 +123,8 @@ template <class... Vectors>
 long compact(const std::vector<std::uint8_t>& keep, cv::Mat& descriptors, Vectors&... vectors) {
   if (descriptors.dims > 2) return -1;
   const std::size_t rows = static_cast<std::size_t>(descriptors.rows);
-  RowsView view(rows > 0 ? descriptors.ptr(0) : nullptr, static_cast<std::size_t>(descriptors.cols) * descriptors.elemSize(),
+  const std::size_t row_bytes = static_cast<std::size_t>(descriptors.cols) * descriptors.elemSize();
+  RowsView view(rows > 0 ? descriptors.ptr(0) : nullptr, row_bytes,
                 rows > 0 ? static_cast<std::size_t>(descriptors.step[0]) : 0, rows);
   const long kept = dyncull::compact(keep, view, vectors...);
   if (kept >= 0 && rows > 0) descriptors = descriptors.rowRange(0, static_cast<int>(kept));

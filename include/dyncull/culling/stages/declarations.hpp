@@ -32,11 +32,7 @@ using Opt = const PipelineOptions<T>&;
 /// A report as a member of PipelineResult<T>, T not deduced from it: an evidence stage's report is a
 /// member of its slot and converts.
 template <class T>
-struct ReportOf {
-  using type = StageReport PipelineResult<T>::*;
-};
-template <class T>
-using ReportMember = typename ReportOf<T>::type;
+using ReportMember = NonDeduced<StageReport PipelineResult<T>::*>;
 template <class T>
 constexpr FrameInputs reads_nothing(Opt<T>) {
   return 0;
@@ -93,6 +89,18 @@ constexpr std::array<StageDeclaration<T>, 10 + sizeof...(Evidence)> declare_stag
 
 template <class T>
 constexpr auto kStages = declare_stages<T>(EvidenceStages<T>{});
+
+namespace detail {
+/// Every entry of kStages filled: declare_stages's count of core stages matches its list (an entry left
+/// out would be value-initialised, with no name and no report).
+template <class T>
+constexpr bool every_stage_declared() {
+  for (const StageDeclaration<T>& s : kStages<T>)
+    if (s.name == nullptr || s.report == nullptr) return false;
+  return true;
+}
+static_assert(every_stage_declared<double>(), "declare_stages: the count of core stages and the list disagree");
+}  // namespace detail
 
 /// The declaration of the stage that reports into `report`.
 template <class T>
