@@ -49,6 +49,7 @@ struct Args {
   std::string tum, detections;  // tum: the --dataset folder (--tum is its older name)
   std::string camera;           // --camera: camera.txt, fx,fy,cx,cy[,k1,k2,p1,p2,k3] or a TUM name
   std::string detector;         // --detector CFG,WEIGHTS or MODEL.onnx: boxes found live (vo/live_detector.hpp)
+  std::string truth;            // --truth: a dyncull_motion_truth folder for --dataset
   std::vector<std::string> strategies;  // empty: no culling + every preset
   bool list = false;
   bool diagnose = false;
@@ -95,6 +96,9 @@ void usage(const char* argv0) {
       "                      lines (normalised coordinates). A malformed file or line is fatal (exit 1) and\n"
       "                      named as file:line: reason. Boxes that parse but are invalid (NaN, zero size,\n"
       "                      outside the image) are dropped by the detection filter\n"
+      "  --truth DIR         per-pixel motion truth for --dataset (dyncull_motion_truth --dataset DIR --out\n"
+      "                      TRUTH_DIR): adds each strategy's precision and recall of culling the features\n"
+      "                      on moving pixels (over features on pixels the truth knows) and runs the oracle\n"
       "%s"
       "  --strategies LIST   subset of strategies, comma separated (default: none + every preset + culler +\n"
       "                      oracle; --list). culler: the recommended preset through the stateful culler as a\n"
@@ -202,6 +206,8 @@ bool parse_args(int argc, char** argv, Args* a) {
       if (!value(&a->detections)) return false;
     } else if (arg == "--detector") {
       if (!value(&a->detector)) return false;
+    } else if (arg == "--truth") {
+      if (!value(&a->truth)) return false;
     } else if (arg == "--family") {
       if (!value(&v)) return false;
       a->families = split(v);
@@ -239,6 +245,10 @@ bool parse_args(int argc, char** argv, Args* a) {
   }
   if (!a->detector.empty() && (a->tum.empty() || !a->detections.empty())) {
     std::fprintf(stderr, "dynamic_vo: --detector runs on a recorded sequence (--dataset DIR) and replaces --detections\n");
+    return false;
+  }
+  if (!a->truth.empty() && a->tum.empty()) {
+    std::fprintf(stderr, "dynamic_vo: --truth scores a recorded sequence (--dataset DIR)\n");
     return false;
   }
   if (a->tum_trajectories.empty()) {
@@ -331,6 +341,7 @@ int run_dataset_command(const Args& args, const std::vector<vo::StrategySpec>& c
   o.dir = args.tum;
   o.detections = args.detections;
   o.camera = args.camera;
+  o.truth_dir = args.truth;
   o.strategies = chosen;
   if (args.seeds_set) o.pnp_seeds = args.seeds;
   if (!args.frames_set && !args.quick) ro.max_frames = std::numeric_limits<int>::max();  // the whole sequence

@@ -142,7 +142,7 @@ class Culler {
     if (!spec_.culls) return;
     if (spec_.oracle) {
       for (std::size_t i = 0; i < tracks.size(); ++i)
-        if (truth_at(frame, tracks.cur_px[i]) == 1) (*keep)[i] = 0;
+        if (truth_at(frame.moving, tracks.cur_px[i]) == 1) (*keep)[i] = 0;
       return;
     }
     if (frame_culler_) {
@@ -235,17 +235,10 @@ class Culler {
   void repair_by_truth(const SequenceFrame& frame, const Tracks& tracks, std::vector<std::uint8_t>* keep) const {
     const bool restore = spec_.truth_repair == TruthRepair::RestoreFalseCulls;
     for (std::size_t i = 0; i < tracks.size(); ++i) {
-      const int truth = truth_at(frame, tracks.cur_px[i]);
+      const int truth = truth_at(frame.moving, tracks.cur_px[i]);
       if (restore && truth == 0) (*keep)[i] = 1;
       if (!restore && truth == 1) (*keep)[i] = 0;
     }
-  }
-
-  /// The sim's motion truth at the pixel nearest p: 1 moving, 0 static, -1 none (no truth, outside).
-  static int truth_at(const SequenceFrame& frame, const cv::Point2f& p) {
-    const int u = cvRound(p.x), v = cvRound(p.y);
-    if (frame.moving.empty() || u < 0 || v < 0 || u >= frame.moving.cols || v >= frame.moving.rows) return -1;
-    return frame.moving.at<std::uint8_t>(v, u) != 0 ? 1 : 0;
   }
 
   /// Reads the per-feature trace of this frame (PipelineResult::trace): which stage left a kept track

@@ -44,6 +44,9 @@ struct DatasetOptions {
   eval::SequenceOptions sequence;
   int strip_frames = 4;  ///< annotated frames in the strip (evenly spaced, drawn with the recommended preset)
   LiveDetector* live_detector = nullptr;  ///< when set (and open), boxes come from it instead of files
+  /// A dyncull_motion_truth folder (index.txt, NNNNNN.png): per-pixel motion truth that scores every
+  /// strategy (precision, recall) and lets the oracle run. Empty: none.
+  std::string truth_dir;
   /// PnP-RANSAC seeds of the front end, one run of every strategy each (empty: runner.front_end.seed).
   /// A single run's ATE moves by centimetres with the seed alone, so rows report the median and range.
   std::vector<std::uint64_t> pnp_seeds;
@@ -81,7 +84,7 @@ class DatasetSource {
       detections_path_ = det;
       for (const std::string& n : detections_.notes.first) notes_.push_back(n);
     }
-    return true;
+    return options.truth_dir.empty() || open_truth(options.truth_dir, error);
   }
 
   int size() const { return static_cast<int>(index_.frames.size()); }
@@ -90,7 +93,7 @@ class DatasetSource {
   const eval::SequenceIndex& index() const { return index_; }
   bool has_detections() const { return has_detections_; }
   const std::string& detections_path() const { return detections_path_; }
-  bool has_truth_labels() const { return false; }
+  bool has_truth_labels() const { return !truth_files_.empty(); }
   /// What the reading noted (missing files, frames without depth or boxes), and what load() found.
   const std::vector<std::string>& notes() const { return notes_; }
   std::size_t frames_without_depth() const { return index_.frames_without_depth + unreadable_depth_; }
@@ -136,6 +139,7 @@ class DatasetSource {
     out->gray = gray_;
     out->depth_m = depth_;
     out->moving.release();
+    if (!truth_files_.empty() && !load_truth(index, &out->moving, error)) return false;
     out->instance.release();
     out->motion_m.release();
     out->detections.clear();
@@ -196,6 +200,63 @@ class DatasetSource {
     return true;
   }
 
+  /// Reads TRUTH_DIR/index.txt ("stamp file" lines) and pairs each frame with the label image of its
+  /// stamp (within 1 ms); frames without one are scored on no feature.
+  bool open_truth(const std::string& dir, std::string* error) {
+    std::vector<std::pair<double, std::string>> listed;
+    const std::string path = dir + "/index.txt";
+    std::string reason;
+    const Status st = eval::detail::for_each_line(path, 4096, &reason, [&](std::size_t number, std::string_view line,
+                                                                           std::string* why) {
+      const std::vector<std::string_view> f = eval::detail::fields_of(line);
+      if (f.empty() || f.front().front() == '#') return true;
+      double stamp = 0;
+      if (f.size() != 2 || !eval::detail::parse_number(f[0], &stamp) || f[1].find('/') != std::string_view::npos) {
+        *why = text::quote_path(path) + ":" + std::to_string(number) + ": expected 'stamp file'";
+        return false;
+      }
+      listed.emplace_back(stamp, std::string(f[1]));
+      return true;
+    });
+    if (st != Status::Ok) {
+      *error = "--truth: " + reason;
+      return false;
+    }
+    std::sort(listed.begin(), listed.end());
+    truth_files_.assign(index_.frames.size(), std::string());
+    std::size_t matched = 0;
+    for (std::size_t i = 0; i < index_.frames.size(); ++i) {
+      const double t = index_.frames[i].timestamp;
+      const auto it = std::lower_bound(listed.begin(), listed.end(), std::make_pair(t - 1e-3, std::string()));
+      if (it == listed.end() || std::abs(it->first - t) > 1e-3) continue;
+      truth_files_[i] = dir + "/" + it->second;
+      ++matched;
+    }
+    if (matched == 0) {
+      *error = "--truth: " + dir + "/index.txt lists no stamp of the sequence's frames";
+      return false;
+    }
+    if (matched < index_.frames.size())
+      notes_.push_back("--truth: " + std::to_string(index_.frames.size() - matched) + " frames have no truth image");
+    return true;
+  }
+
+  /// The frame's label image (0 static, 255 moving, 128 unknown) as SequenceFrame::moving.
+  bool load_truth(int index, cv::Mat* moving, std::string* error) const {
+    const std::string& path = truth_files_[static_cast<std::size_t>(index)];
+    if (path.empty()) return true;
+    const cv::Mat labels = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (labels.type() != CV_8UC1 || labels.cols != camera_.width || labels.rows != camera_.height) {
+      *error = path + ": not an 8-bit label image of " + std::to_string(camera_.width) + "x" + std::to_string(camera_.height);
+      return false;
+    }
+    moving->create(labels.size(), CV_8UC1);
+    moving->setTo(kTruthUnknown);
+    moving->setTo(0, labels == 0);
+    moving->setTo(1, labels == 255);
+    return true;
+  }
+
   /// Boxes of the distorted image moved to the undistorted one: the box around the undistorted corners
   /// and edge midpoints (a detector box is coarse; its shape is kept only approximately).
   std::vector<Detection<float>> undistorted(const std::vector<Detection<float>>& boxes) const {
@@ -228,6 +289,7 @@ class DatasetSource {
   std::string detections_path_;
   std::vector<std::string> notes_;
   std::size_t unreadable_depth_ = 0;
+  std::vector<std::string> truth_files_;  ///< per frame, empty without truth
   cv::Mat K_, dist_, map_x_, map_y_;
   cv::Mat gray_, depth_, bgr_;
 };
@@ -246,6 +308,8 @@ struct DatasetRow {
   double culled_in_other_boxes = std::numeric_limits<double>::quiet_NaN();  ///< boxes of other classes only
   double culled_outside_boxes = std::numeric_limits<double>::quiet_NaN();
   double cull_ms = 0, front_end_ms = 0;  ///< per frame
+  /// Of culling the features on moving pixels, over the features on pixels the truth knows (--truth).
+  double precision = std::numeric_limits<double>::quiet_NaN(), recall = std::numeric_limits<double>::quiet_NaN();
   /// ATE RMSE over the frames before the first person box: the front end's own error, which culling
   /// cannot lower (NaN when the sequence opens with a person or has no stored boxes).
   double ate_before_people_m = std::numeric_limits<double>::quiet_NaN();
@@ -270,7 +334,7 @@ inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
   std::ostringstream o;
   o << "strategy,frames,lost_frames,keyframes,ate_rmse_m,ate_pairs,rpe_trans_m,rpe_rot_deg,rpe_pairs,"
        "culled_in_person_boxes,culled_in_other_boxes,culled_outside_boxes,cull_ms,front_end_ms,cull_over_front_end,runs,ate_min_m,"
-       "ate_max_m,ate_before_people_m\n";
+       "ate_max_m,ate_before_people_m,precision,recall\n";
   auto num = [](double v, const char* f) { return std::isfinite(v) ? fmt(v, f) : std::string(); };
   for (const DatasetRow& r : rows) {
     o << r.strategy << "," << r.frames << "," << r.lost_frames << "," << r.keyframes << "," << num(r.ate_rmse_m, "%.6f")
@@ -281,7 +345,7 @@ inline std::string dataset_summary_csv(const std::vector<DatasetRow>& rows) {
       << num(r.front_end_ms, "%.3f") << ","
       << (r.culls && r.front_end_ms > 0 ? num(r.cull_ms / r.front_end_ms, "%.4f") : "") << "," << r.runs << ","
       << num(r.ate_min_m, "%.6f") << "," << num(r.ate_max_m, "%.6f") << "," << num(r.ate_before_people_m, "%.6f")
-      << "\n";
+      << "," << num(r.precision, "%.4f") << "," << num(r.recall, "%.4f") << "\n";
   }
   return o.str();
 }
@@ -314,8 +378,8 @@ inline std::string noise_floor_line(const DatasetRun& run) {
 inline std::string dataset_summary_md(const DatasetRun& run, const std::string& command, double seconds) {
   std::ostringstream o;
   o << "| strategy | ATE RMSE (cm) | RPE 1 s (cm) | RPE 1 s (deg) | lost frames | keyframes | culled in person boxes "
-       "| culled in other boxes | culled outside boxes | cull ms/frame | front end ms/frame | cull / front end | ATE before people (cm) |\n"
-       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "| culled in other boxes | culled outside boxes | cull ms/frame | front end ms/frame | cull / front end | ATE before people (cm) | precision | recall |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const DatasetRow& r : run.rows) {
     const std::string range = r.runs > 1 ? " (" + fmt(100 * r.ate_min_m, "%.2f") + "-" + fmt(100 * r.ate_max_m, "%.2f") + ")" : "";
     o << "| " << r.strategy << (r.recommended ? " (default)" : "") << " | " << fmt(100 * r.ate_rmse_m, "%.2f") << range << " | "
@@ -325,7 +389,9 @@ inline std::string dataset_summary_md(const DatasetRun& run, const std::string& 
       << (r.culls ? fmt(100 * r.culled_in_other_boxes, "%.1f %%") : "-") << " | "
       << (r.culls ? fmt(100 * r.culled_outside_boxes, "%.1f %%") : "-") << " | " << fmt(r.cull_ms, "%.2f") << " | "
       << fmt(r.front_end_ms, "%.1f") << " | " << (r.culls ? fmt(r.cull_ms / r.front_end_ms, "%.3f") : "-") << " | "
-      << (std::isfinite(r.ate_before_people_m) ? fmt(100 * r.ate_before_people_m, "%.2f") : "-") << " |\n";
+      << (std::isfinite(r.ate_before_people_m) ? fmt(100 * r.ate_before_people_m, "%.2f") : "-") << " | "
+      << (std::isfinite(r.precision) ? fmt(r.precision) : "-") << " | " << (std::isfinite(r.recall) ? fmt(r.recall) : "-")
+      << " |\n";
   }
   o << "\nATE: TUM evaluate_ate.py (0.02 s association, rigid SE(3) alignment, RMSE). RPE: evaluate_rpe.py "
        "--fixed_delta --delta 1 --delta_unit s, RMSE over every pair. Lost frames: PnP failed and the pose came from "
@@ -436,7 +502,8 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
   out->detections_path = source.has_detections() ? source.detections_path() : std::string();
   std::vector<StrategySpec> run;
   for (const StrategySpec& s : options.strategies) {
-    if (s.needs_truth()) out->skipped.push_back(s.name + " (needs the sim's per-pixel motion truth)");
+    if (s.needs_truth() && !source.has_truth_labels())
+      out->skipped.push_back(s.name + " (needs per-pixel motion truth: --truth)");
     else if (s.needs_detections && !source.has_detections()) out->skipped.push_back(s.name + " (needs detections)");
     else run.push_back(s);
   }
@@ -482,6 +549,10 @@ inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::str
     row.culled_in_person_boxes = r.box_culls.culled_in_person_boxes();
     row.culled_in_other_boxes = r.box_culls.culled_in_other_boxes();
     row.culled_outside_boxes = r.box_culls.culled_outside_boxes();
+    if (out->report.has_label_truth && r.spec.culls) {
+      row.precision = r.labels.precision();
+      row.recall = r.labels.recall();
+    }
     row.cull_ms = r.cull_ms_per_frame();
     row.front_end_ms = r.front_end_ms_per_frame();
     out->rows.push_back(row);

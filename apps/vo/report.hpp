@@ -9,6 +9,8 @@
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/sim/actors.hpp"
 
+#include "sources.hpp"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -58,15 +60,15 @@ struct LabelCounts {
   }
 };
 
-/// Adds one frame's features: `moving` is the per-pixel truth (CV_8UC1, non-zero = moving),
-/// keep[i] == 0 means culled. Features outside the image are not counted.
+/// Adds one frame's features: `moving` is the per-pixel truth (SequenceFrame::moving), keep[i] == 0
+/// means culled. Features outside the image or on pixels the truth cannot tell are not counted.
 inline void count_labels(const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep,
                          const cv::Mat& moving, const std::vector<Detection<float>>& detections, LabelCounts* out) {
   if (moving.empty() || moving.type() != CV_8UC1) return;
   for (std::size_t i = 0; i < px.size(); ++i) {
-    const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
-    if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
-    const bool is_moving = moving.at<std::uint8_t>(v, u) != 0;
+    const int truth = truth_at(moving, px[i]);
+    if (truth < 0) continue;
+    const bool is_moving = truth == 1;
     const bool culled = i < keep.size() && keep[i] == 0;
     if (culled && is_moving) ++out->true_positive;
     if (culled && !is_moving) ++out->false_positive;
@@ -299,13 +301,11 @@ inline bool draw_features(const std::string& path, const cv::Mat& bgr, const std
   }
   for (std::size_t i = 0; i < px.size(); ++i) {
     const bool culled = i < keep.size() && keep[i] == 0;
-    const int u = cvRound(px[i].x), v = cvRound(px[i].y);
-    const bool truth = !moving.empty();
-    const bool is_moving = truth && u >= 0 && v >= 0 && u < moving.cols && v < moving.rows && moving.at<std::uint8_t>(v, u);
-    const cv::Point c(u, v);
-    if (!culled && truth && is_moving) {
+    const int truth = truth_at(moving, px[i]);
+    const cv::Point c(cvRound(px[i].x), cvRound(px[i].y));
+    if (!culled && truth == 1) {
       cv::circle(img, c, 5, cv::Scalar(0, 230, 255), 2, cv::LINE_AA);
-    } else if (culled && truth && !is_moving) {
+    } else if (culled && truth == 0) {
       cv::drawMarker(img, c, cv::Scalar(0, 0, 255), cv::MARKER_CROSS, 8, 2);
     } else {
       cv::circle(img, c, 3, culled ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 200, 0), -1, cv::LINE_AA);

@@ -25,11 +25,23 @@ namespace vo {
 
 /// One frame as the demo consumes it. Mats may be headers over the source's buffers: valid until
 /// the next load() on the same source.
+/// SequenceFrame::moving where the truth of a real sequence says neither static nor moving.
+constexpr std::uint8_t kTruthUnknown = 2;
+
+/// The motion truth at the pixel nearest p: 1 moving, 0 static, -1 none (no truth, outside, unknown).
+inline int truth_at(const cv::Mat& moving, const cv::Point2f& p) {
+  const int u = cvRound(p.x), v = cvRound(p.y);
+  if (moving.empty() || u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) return -1;
+  const std::uint8_t m = moving.at<std::uint8_t>(v, u);
+  return m == kTruthUnknown ? -1 : (m != 0 ? 1 : 0);
+}
+
 struct SequenceFrame {
   double timestamp = 0;
   cv::Mat gray;     ///< CV_8UC1
   cv::Mat depth_m;  ///< CV_32FC1 metres, 0 = no measurement
-  cv::Mat moving;   ///< CV_8UC1, 1 where the surface moves; empty when there is no truth
+  cv::Mat moving;   ///< CV_8UC1, 1 where the surface moves, kTruthUnknown where a real sequence's truth
+                    ///< cannot tell (dyncull_motion_truth); empty when there is no truth
   cv::Mat instance; ///< CV_16UC1 sim instance ids (sim::SceneInstance); empty when there is no truth
   cv::Mat motion_m; ///< CV_32FC1 sim: metres the surface moved since the previous frame (sim::FrameData)
   std::vector<Detection<float>> detections;
