@@ -193,7 +193,8 @@ class MotionLabeller {
       out.note = "no neighbour with a pose";
       return out;
     }
-    decide(ref.depth_m, usable, detail::textured_pixels(ref.gray, options_), evidence, &out);
+    decide(ref.depth_m, usable, detail::textured_pixels(ref.gray, options_), evidence,
+           static_cast<int>(out.corrections.size()), &out);
     return out;
   }
 
@@ -309,14 +310,15 @@ class MotionLabeller {
     return c;
   }
 
+  /// Moving needs every neighbour: one direction's flow alone is wrong too often (glare, blur).
   void decide(const cv::Mat& depth, const cv::Mat& usable, const cv::Mat& textured, const detail::Evidence& e,
-              FrameTruth* out) const {
+              int neighbours, FrameTruth* out) const {
     for (int v = 0; v < depth.rows; ++v) {
       for (int u = 0; u < depth.cols; ++u) {
         if (depth.at<float>(v, u) > 0) ++out->with_depth;
         const std::uint8_t seen = e.seen.at<std::uint8_t>(v, u);
         if (!usable.at<std::uint8_t>(v, u) || seen == 0) continue;
-        const bool flow_moved = e.least.at<float>(v, u) > options_.moving_px;
+        const bool flow_moved = seen == neighbours && e.least.at<float>(v, u) > options_.moving_px;
         const bool depth_agrees = textured.at<std::uint8_t>(v, u) || e.depth_moved.at<std::uint8_t>(v, u) == seen;
         std::uint8_t& label = out->labels.at<std::uint8_t>(v, u);
         if (flow_moved && depth_agrees) label = kMoving;
