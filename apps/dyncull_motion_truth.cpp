@@ -245,7 +245,7 @@ int label_dataset(const Args& args) {
       strip.push_back({path, "frame " + std::to_string(i) + ": " + std::to_string(outside_by_frame[k].first) +
                                  " moving px outside person boxes (yellow)"});
     }
-    if (vo::write_frame_strip(args.out + "/outside_boxes_strip.png", strip, 400, 2, 256))
+    if (vo::write_frame_strip(args.out + "/outside_boxes_strip.png", strip, 360, 2, 16))
       md << "\n![moving pixels outside person boxes](outside_boxes_strip.png)\n";
   }
   std::ofstream(args.out + "/summary.md") << md.str();

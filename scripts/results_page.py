@@ -127,8 +127,8 @@ def num(value, fmt):
 def real_table(rows):
     out = ["| strategy | ATE RMSE (cm) | ATE before people (cm) | RPE 1 s (cm) | RPE 1 s (deg) | lost frames "
            "| keyframes | culled in person boxes | culled in other boxes | culled outside boxes | cull ms/frame "
-           "| front end ms/frame | cull / front end |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "| front end ms/frame | cull / front end | precision | recall |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         culls = r["strategy"] != "none"
         ate = cm(r['ate_rmse_m'])
@@ -140,7 +140,8 @@ def real_table(rows):
                    f"{cm(r.get('culled_in_other_boxes'), '{:.1f} %') if culls else '-'} | "
                    f"{cm(r['culled_outside_boxes'], '{:.1f} %') if culls else '-'} | "
                    f"{float(r['cull_ms']):.2f} | {float(r['front_end_ms']):.1f} | "
-                   f"{num(r['cull_over_front_end'], '{:.3f}')} |")
+                   f"{num(r['cull_over_front_end'], '{:.3f}')} | {num(r.get('precision'), '{:.3f}')} | "
+                   f"{num(r.get('recall'), '{:.3f}')} |")
     return "\n".join(out)
 
 
@@ -220,6 +221,41 @@ def disagreements(rows):
     return text
 
 
+def truth_section(real):
+    """The labeller's own accuracy and what it found on the real sequence (dyncull_motion_truth)."""
+    summary, families = os.path.join(real, "truth", "summary.md"), os.path.join(real, "truth_families", "sim_accuracy.md")
+    if not os.path.exists(summary):
+        return ""
+    found = [line for line in read(summary).splitlines() if line.startswith("- ")]
+    accuracy = table_lines(read(families)) if os.path.exists(families) else "(not run)"
+    return f"""
+### Per-feature truth
+
+Precision and recall above score each strategy's culls against a per-pixel motion truth that
+`dyncull_motion_truth` computes from the sequence's own ground-truth poses and depth, with no detector boxes
+([how it decides](motion_truth.md)): culling a feature on a pixel labelled moving is right, culling one on a
+pixel labelled static is wrong; features on pixels it cannot tell are not counted. `oracle` culls exactly the
+features on moving pixels. On this sequence:
+
+{chr(10).join(found)}
+
+{run_info(os.path.join(real, "truth"))}
+
+Its accuracy where every pixel is known (the scene families, 40 frames each, ground-truth poses disturbed
+by the error measured here, the families' depth noise): precision and recall of "moving" on the pixels it
+labels known, and the share of pixels with depth it labels.
+
+{accuracy}
+
+{run_info(os.path.join(real, "truth_families"))}
+
+Where the known pixels outside every person box are labelled moving (yellow; red: moving inside a person
+box; green: static; white: person boxes): mostly people the detector missed or cut short.
+
+![Motion truth outside the person boxes](images/bonn_crowd_part1_motion_truth.png)
+"""
+
+
 def real_section(real, real_ablation):
     if not real:
         return ("## Real sequence\n\nNot run here: `scripts/results.sh` runs it when `DYNCULL_DATA_DIR` holds "
@@ -246,9 +282,9 @@ Behley, Lottes, Giguère and Stachniss, IROS 2019): a hand-held RGB-D camera in 
 walk through the view, covering 38 % of the image on average when present (a person from frame 57 on, in
 269 of the 464 frames). Grey frames, 16-bit depth, motion-capture ground truth converted to camera poses
 with the dataset's calibration, and the boxes of a real COCO-80 detector on every frame (Yolo-Fastest-1.1-XL
-run by OpenCV DNN on the RGB frames). The same front end as the suite below runs on it with every strategy
-that needs no per-pixel truth (`oracle` cannot run on real data). The data is not in the repository; it is
-read from `$DYNCULL_DATA_DIR/bonn/crowd_part1`.
+run by OpenCV DNN on the RGB frames). The same front end as the suite below runs on it with every strategy,
+the oracle included (below: per-feature truth). The data is not in the repository; it is read from
+`$DYNCULL_DATA_DIR/bonn/crowd_part1`.
 
 {run_info(real)}
 
@@ -258,8 +294,8 @@ ATE: TUM `evaluate_ate.py` (0.02 s association, rigid alignment, RMSE) against t
 truth; RPE: `evaluate_rpe.py --fixed_delta --delta 1 --delta_unit s`, RMSE over every pair. Lost frames:
 PnP failed and the pose came from the constant-velocity prior. Culled in person boxes / in other boxes /
 outside boxes: the share of the tracked features inside a person box / inside boxes of other classes only /
-outside every box that the strategy culled (no per-pixel truth here: a cull outside every box is static
-background lost, unless a geometric check caught a mover the detector missed). ATE before people: over the
+outside every box that the strategy culled. Precision and recall: of culling the features on moving
+pixels, over the features on pixels the motion truth knows (below). ATE before people: over the
 frames before the first person box. Times: wall clock per frame on the machine above; the ORB descriptors
 the culler needs at the front end's tracks count as front-end time, since an ORB-based host has them.
 
@@ -287,9 +323,13 @@ Evenly spaced frames with the recommended preset (green: kept; red: culled; blue
 their COCO class id):
 
 ![Annotated real frames](images/bonn_crowd_part1_frame_strip.png)
-{ablation}
+
+With the truth, a red cross is a static feature culled and a yellow ring a moving feature kept: the
+strategy's errors.
+{truth_section(real)}{ablation}
 To reproduce: `scripts/results.sh --real-only` (this section alone), or
-`dynamic_vo --dataset $DYNCULL_DATA_DIR/bonn/crowd_part1 --out DIR` and
+`dyncull_motion_truth --dataset $DYNCULL_DATA_DIR/bonn/crowd_part1 --out TRUTH_DIR`,
+`dynamic_vo --dataset $DYNCULL_DATA_DIR/bonn/crowd_part1 --truth TRUTH_DIR --seeds 7,8,9 --out DIR` and
 `scripts/ablation.sh --dataset $DYNCULL_DATA_DIR/bonn/crowd_part1`.
 """
 
