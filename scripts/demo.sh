@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds dynamic_vo (apps/, Release) and runs the main demo: dynamic_vo on the synthetic dynamic RGB-D
+# Builds dynamic_vo and dyncull_motion_truth (apps/, Release) and runs the main demo: dynamic_vo on the synthetic dynamic RGB-D
 # sequences, every culling preset against no culling. Without arguments it runs the scene-family suite
 # (dynamic_vo --suite: every family x static,xyz,rpy,halfsphere x seeds 1,2,3, 150 frames each, on
 # DYNCULL_JOBS threads, default all cores) and prints one summary table, a row per family; it also writes
@@ -11,7 +11,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build="${DYNCULL_DEMO_BUILD:-$root/build/demo}"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_BUILD_TESTS=OFF \
   -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=ON >/dev/null
-cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dynamic_vo
+# dyncull_motion_truth beside it: scripts/results.sh labels the real sequence with it first.
+cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dynamic_vo dyncull_motion_truth
 if (($# == 0)); then
   set -- --suite --jobs "${DYNCULL_JOBS:-$(nproc)}"
 fi

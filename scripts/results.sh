@@ -63,7 +63,7 @@ if [[ -n "${DYNCULL_DATA_DIR:-}" && -d "$dataset" ]]; then
     real="$out/real"
     # The per-pixel motion truth first (ground-truth poses and depth, no boxes), and the labeller's own
     # accuracy on the scene families; then every strategy scored against it.
-    cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dyncull_motion_truth >/dev/null
+    "$root/scripts/demo.sh" --list >/dev/null  # builds both programs
     run_recorded "$real/truth" "dyncull_motion_truth --dataset \$DYNCULL_DATA_DIR/bonn/crowd_part1 --out TRUTH_DIR" \
       "$build/apps/dyncull_motion_truth" --dataset "$dataset" --out "$real/truth"
     run_recorded "$real/truth_families" "dyncull_motion_truth --families all --out DIR" \
