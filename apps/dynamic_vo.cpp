@@ -113,7 +113,7 @@ void usage(const char* argv0) {
       "  --depth-edge-radius N  front end: no new corner within N px of a depth step above 5 %% (default 1;\n"
       "                      larger N drops corners whose LK window straddles an occlusion edge)\n"
       "  --diagnose          also print, per strategy, where its labels come from (sim instance, truth,\n"
-      "                      decision, deciding stage)\n"
+      "                      decision, deciding stage; on --dataset with --truth: truth, decision, stage)\n"
       "  --family LIST       scene families, comma separated (default walking; see below). Each runs with\n"
       "                      every sequence and seed; with several, a per-family summary table is printed\n"
       "                      and written (family_summary.md, family_summary.csv)\n"
@@ -372,6 +372,11 @@ int run_dataset_command(const Args& args, const std::vector<vo::StrategySpec>& c
   std::printf("\n%s", md.c_str());
   std::ofstream(args.out + "/dataset_summary.md") << md;
   std::ofstream(args.out + "/results.md") << vo::format_table({run.report}, cmd.str(), seconds);
+  if (args.diagnose)
+    for (const auto& r : run.report.runs)
+      if (r.spec.culls)
+        std::printf("\n%s: truth decision reason count (features on pixels the truth knows)\n%s", r.spec.name.c_str(),
+                    r.breakdown.format().c_str());
   std::printf("\nwrote %s/dataset_summary.md\nwrote %s/results.md\n", args.out.c_str(), args.out.c_str());
   for (const std::string& f : run.files) std::printf("wrote %s\n", f.c_str());
   return 0;

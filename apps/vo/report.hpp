@@ -126,15 +126,17 @@ struct LabelBreakdown {
   void add(const std::vector<cv::Point2f>& px, const std::vector<std::uint8_t>& keep,
            const std::vector<CullReason>& reasons, const std::vector<KeptWhy>& kept_why, const cv::Mat& moving,
            const cv::Mat& instance) {
-    if (moving.empty() || instance.empty() || instance.type() != CV_16UC1) return;
+    // A real sequence's truth has no instances: its features count as "other".
+    if (moving.empty() || (!instance.empty() && instance.type() != CV_16UC1)) return;
     for (std::size_t i = 0; i < px.size(); ++i) {
-      const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
-      if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
+      const int truth = truth_at(moving, px[i]);
+      if (truth < 0) continue;
+      const int u = cvRound(px[i].x), v = cvRound(px[i].y);
       const CullReason why = i < reasons.size() ? reasons[i] : CullReason::None;
       int cell = std::min(static_cast<int>(why), kReasons - 1);
       if (why == CullReason::None && i < kept_why.size() && kept_why[i] != KeptWhy::NotExplained)
         cell = kReasons + static_cast<int>(kept_why[i]);
-      ++at(instance.at<std::uint16_t>(v, u), moving.at<std::uint8_t>(v, u) != 0, i < keep.size() && keep[i] == 0, cell);
+      ++at(instance.empty() ? -1 : instance.at<std::uint16_t>(v, u), truth == 1, i < keep.size() && keep[i] == 0, cell);
     }
   }
   /// Name of a sim instance id (sim::SceneInstance order; ids past the table are "other").
