@@ -17,6 +17,8 @@ import csv
 import os
 import sys
 
+TARGET_PRECISION, TARGET_RECALL = 0.85, 0.90  # of the motion truth's moving features, on the real sequence
+TARGET_REAL_VS_ORACLE = 1.2                    # ATE against the real oracle's
 TARGET_RATIO = 1.15   # recommended ATE at most this times the oracle's, on every family
 TARGET_LABELS = 0.9   # dynamic-label precision and recall, pooled per family
 TARGET_COST = 0.1     # culling time over the front end's
@@ -174,6 +176,17 @@ def real_targets(rows):
                f"{worst['strategy']} {100 * share:.1f} % ({'met' if share <= TARGET_LOST else 'not met'}) |")
     for name in ("recommended", "culler"):
         r = by.get(name)
+        if r and r.get("precision") and r.get("recall"):
+            p, rc = float(r["precision"]), float(r["recall"])
+            ok = "met" if p >= TARGET_PRECISION and rc >= TARGET_RECALL else "not met"
+            out.append(f"| {name}: recall >= {TARGET_RECALL} at precision >= {TARGET_PRECISION} of the truth's "
+                       f"moving features | recall {rc:.3f}, precision {p:.3f} ({ok}) |")
+        o = ate("oracle")
+        if o and ate(name):
+            ok = "met" if ate(name) <= TARGET_REAL_VS_ORACLE * o else "not met"
+            out.append(f"| {name}: ATE <= {TARGET_REAL_VS_ORACLE}x the oracle's | {ate(name) / o:.2f}x ({ok}) |")
+    for name in ("recommended", "culler"):
+        r = by.get(name)
         if r and r["cull_over_front_end"]:
             q = float(r["cull_over_front_end"])
             out.append(f"| {name}: culling <= {TARGET_COST:g} of the front end's time | {q:.3f} "
@@ -235,7 +248,9 @@ Precision and recall above score each strategy's culls against a per-pixel motio
 `dyncull_motion_truth` computes from the sequence's own ground-truth poses and depth, with no detector boxes
 ([how it decides](motion_truth.md)): culling a feature on a pixel labelled moving is right, culling one on a
 pixel labelled static is wrong; features on pixels it cannot tell are not counted. `oracle` culls exactly the
-features on moving pixels. On this sequence:
+features on moving pixels; it keeps the features on the pixels the truth cannot tell, a large part of each
+walking person (between the thresholds, untextured, near depth steps), so it is no ceiling for the ATE here.
+On this sequence:
 
 {chr(10).join(found)}
 
