@@ -92,16 +92,16 @@ launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 log() { echo "orbslam2.sh: $*" >&2; }
 
-# --- dyncull: the culler library and dyncull_eval, installed into a prefix ORB-SLAM2's CMake finds ---------
+# --- dyncull: the culler and host libraries and dyncull_eval, installed into a prefix ORB-SLAM2's CMake finds ---------
 install_dyncull() {
   if [[ -n "$dyncull_prefix" ]]; then return; fi
   dyncull_prefix="$work/dyncull-install"
   local build="$work/dyncull-build"
-  log "building dyncull's culler and dyncull_eval in $build"
+  log "building dyncull's culler, its host harness and dyncull_eval in $build"
   cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" -DDYNCULL_BUILD_TESTS=OFF \
     -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_DOCS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=ON -DDYNCULL_INSTALL=ON \
     -DCMAKE_INSTALL_PREFIX="$dyncull_prefix" >"$work/dyncull-configure.log"
-  cmake --build "$build" --target dyncull_culler dyncull_pipeline dyncull_eval -j "$jobs" >"$work/dyncull-build.log"
+  cmake --build "$build" --target dyncull_culler dyncull_host dyncull_pipeline dyncull_eval -j "$jobs" >"$work/dyncull-build.log"
   cmake --install "$build" >"$work/dyncull-install.log"
 }
 
@@ -223,7 +223,7 @@ compile_check() {
   fi
   local symbols
   symbols=$(nm -C "$work/compile-check/Tracking.o")
-  grep -q 'U dyncull::cv_adapter::HostCuller::cull' <<<"$symbols" ||
+  grep -q 'U dyncull::host::HostCuller::cull' <<<"$symbols" ||
     { echo "orbslam2.sh: Tracking.o does not call the culler: the patch did not apply as expected" >&2; exit 1; }
   log "compile check passed: patched src/Tracking.cc compiles with -std=c++11 -O3 against $dyncull_prefix ($(($(date +%s) - start)) s)"
 }
