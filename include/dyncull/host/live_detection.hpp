@@ -3,7 +3,8 @@
 /// tracker, never waiting, gets the newest finished boxes carried to its frame (shifted by each box's
 /// velocity between the last two detections, grown with their age), with that age in frames; or, in the
 /// synchronous form, each frame's own boxes. C++11 header (standard library and opencv2/core.hpp);
-/// compiled into dyncull::host.
+/// compiled into dyncull::host. (Not culling/box_tracker.hpp's tracker: it takes an update's boxes as the
+/// current frame's, so boxes that finish k frames late would stay k frames behind.)
 ///
 /// API:
 ///   dyncull::host::LiveDetection live(dyncull::host::open_yolo_detector(spec, &reason), options);
