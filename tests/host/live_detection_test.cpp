@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -290,14 +291,23 @@ TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
       {(dir / "model.onnx").string(), "model.onnx"},
       {"only.cfg,", "expected CFG,WEIGHTS"},
   };
-  for (const auto& c : cases) {
+  std::vector<std::pair<std::string, std::string>> all;
+  for (const auto& c : cases) all.emplace_back(c.spec, c.expected);
+  // Unreadable weights beside the real cfg (when the data is there): empty, and a directory.
+  const fs::path cfg = fs::path(data_dir()) / "models" / "yolo-fastest-1.1-xl" / "yolo-fastest-1.1-xl.cfg";
+  if (!data_dir().empty() && fs::exists(cfg)) {
+    fs::create_directories(dir / "folder.weights");
+    all.emplace_back(cfg.string() + "," + (dir / "empty.weights").string(), "cannot read the model");
+    all.emplace_back(cfg.string() + "," + (dir / "folder.weights").string(), "cannot read the model");
+  }
+  for (const auto& c : all) {
     host::HostSettings s;
     s.mode = host::Mode::Culler;
-    s.detector = c.spec;
+    s.detector = c.first;
     host::HostCuller culler(s);
-    EXPECT_FALSE(culler.ok()) << c.spec;
+    EXPECT_FALSE(culler.ok()) << c.first;
     EXPECT_EQ(culler.reason().rfind("DYNCULL_DETECTOR=", 0), 0u) << culler.reason();
-    EXPECT_NE(culler.reason().find(c.expected), std::string::npos) << culler.reason();
+    EXPECT_NE(culler.reason().find(c.second), std::string::npos) << culler.reason();
   }
   fs::remove_all(dir);
 }
