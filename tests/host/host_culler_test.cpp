@@ -498,6 +498,68 @@ TEST(HostCullerFrame, EachBadInputPassesTheFrameUncutWithItsReason) {
   EXPECT_EQ(g.mvDepth.size(), static_cast<std::size_t>(g.N));
 }
 
+// Random bad inputs through cull_orb_slam_frame in every mode: K, distortion, image, depth and pose of
+// random shapes, types and values (NaN, Inf, huge, tiny), descriptors of other types, keypoints with NaN,
+// arrays of other lengths. Whatever comes in, the Frame's arrays agree with N afterwards, nothing is
+// added, and the log has one line of nine fields per frame.
+TEST(HostCullerFrame, RandomBadInputsNeverLeaveTheFrameInconsistent) {
+  TempDir dir("random_inputs");
+  write_two_frames(dir);
+  cv::RNG rng(20261128);
+  const double specials[] = {0.0, -1.0, 1e-300, 1e300, NAN, INFINITY, -INFINITY, 540.0, 320.0, 1.0};
+  const auto value = [&]() { return rng.uniform(0, 3) == 0 ? specials[rng.uniform(0, 10)] : rng.uniform(-1000.0, 1000.0); };
+  const int types[] = {CV_8UC1, CV_8UC3, CV_16UC1, CV_32FC1, CV_64FC1, CV_32FC2};
+  const auto random_mat = [&](int max_side) {
+    if (rng.uniform(0, 4) == 0) return cv::Mat();
+    cv::Mat m(rng.uniform(1, max_side + 1), rng.uniform(1, max_side + 1), types[rng.uniform(0, 6)]);
+    cv::Mat d;
+    m.convertTo(d, CV_64F);
+    for (int r = 0; r < m.rows; ++r)
+      for (int c = 0; c < m.cols * m.channels(); ++c) d.ptr<double>(r)[c] = value();
+    d.convertTo(m, m.type());
+    return rng.uniform(0, 3) == 0 && m.cols > 1 ? cv::Mat(m.col(0)) : m;  // sometimes a view
+  };
+  for (Mode mode : {Mode::Culler, Mode::BoxOnly, Mode::Stock}) {
+    HostSettings s = settings_for(mode, dir);
+    s.log_path = dir.file("frames.csv");
+    std::size_t frames = 0;
+    {
+      HostCuller culler(s);
+      ASSERT_TRUE(culler.ok()) << culler.reason();
+      for (int trial = 0; trial < 150; ++trial) {
+        FakeFrame f = three_key_frame();
+        f.mnId = static_cast<unsigned long>(trial);
+        if (rng.uniform(0, 4) == 0) f.mvKeys[rng.uniform(0, 3)].pt.x = static_cast<float>(value());
+        if (rng.uniform(0, 6) == 0) f.mvuRight.pop_back();
+        if (rng.uniform(0, 6) == 0) f.mDescriptors.convertTo(f.mDescriptors, CV_32F);
+        // The culler's camera is made at the first frame: a good K there, so later frames reach the culler.
+        const cv::Mat K = trial > 0 && rng.uniform(0, 3) == 0 ? random_mat(4) : camera_K();
+        const cv::Mat dist = trial > 0 ? random_mat(5) : cv::Mat();
+        cv::Mat depth = rng.uniform(0, 2) ? random_mat(8) : cv::Mat();
+        if (rng.uniform(0, 2) == 0) depth = cv::Mat(480, 640, rng.uniform(0, 2) ? CV_32FC1 : CV_16UC1, cv::Scalar(value()));
+        const cv::Mat pose = rng.uniform(0, 2) ? random_mat(4) : cv::Mat();
+        const cv::Mat image = rng.uniform(0, 4) == 0 ? random_mat(6) : kGrey;
+        const int n = host::cull_orb_slam_frame(culler, f, image, depth, K, dist, pose);
+        ++frames;
+        ASSERT_EQ(n, f.N);
+        ASSERT_LE(f.mvKeys.size(), 3u);
+        if (f.mvuRight.size() == f.mvKeys.size()) {  // the arrays agreed: they still do
+          EXPECT_EQ(f.mvKeysUn.size(), f.mvKeys.size());
+          EXPECT_EQ(f.mvDepth.size(), f.mvKeys.size());
+          EXPECT_EQ(static_cast<std::size_t>(f.mDescriptors.rows), f.mvKeys.size());
+          EXPECT_EQ(static_cast<std::size_t>(f.N), f.mvKeys.size());
+        } else {
+          EXPECT_EQ(f.N, 3);  // disagreeing arrays: untouched
+        }
+      }
+      EXPECT_EQ(culler.stats().frames, frames);
+    }
+    const std::vector<std::string> log = lines_of(s.log_path);
+    ASSERT_EQ(log.size(), frames + 1) << to_string(mode);
+    for (const std::string& line : log) EXPECT_EQ(fields_of(line), 9u) << line;
+  }
+}
+
 // The OpenCV camera reads distortion from any layout, also a column view of a larger matrix.
 TEST(HostCullerFrame, CullerCameraReadsADistortionView) {
   cv::Mat wide(5, 3, CV_64F, cv::Scalar(0));
