@@ -7,7 +7,9 @@
 #include "dyncull/opencv/yolo_detector.hpp"
 #endif
 
+#include <cstdint>
 #include <exception>
+#include <filesystem>
 #include <utility>
 
 namespace dyncull {
@@ -42,6 +44,31 @@ class YoloFrameDetector : public FrameDetector {
 }  // namespace
 #endif
 
+namespace {
+
+// A model file the detector may open: a regular, non-empty file (checked by its status, without opening
+// it: a FIFO would block the open, a device never ends). The detector checks what the file holds.
+bool usable_file(const std::string& path, std::string* reason) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) {
+    *reason = path + ": no such file";
+    return false;
+  }
+  if (!std::filesystem::is_regular_file(st)) {
+    *reason = path + ": not a regular file";
+    return false;
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size == 0) {
+    *reason = path + ": empty file";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 std::unique_ptr<FrameDetector> open_yolo_detector(const std::string& spec, std::string* reason) {
   const std::size_t comma = spec.find(',');
   const std::string model = spec.substr(0, comma);
@@ -50,6 +77,7 @@ std::unique_ptr<FrameDetector> open_yolo_detector(const std::string& spec, std::
     *reason = "expected CFG,WEIGHTS (Darknet) or MODEL.onnx";
     return nullptr;
   }
+  if (!usable_file(model, reason) || (!weights.empty() && !usable_file(weights, reason))) return nullptr;
 #if defined(DYNCULL_HAS_OPENCV_DNN)
   try {
     std::unique_ptr<YoloFrameDetector> d(new YoloFrameDetector);

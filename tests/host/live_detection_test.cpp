@@ -283,12 +283,14 @@ TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
   fs::create_directories(dir);
   std::ofstream(dir / "not_a_model.cfg") << "this is not a Darknet cfg\n";
   std::ofstream(dir / "empty.weights") << "";
+  std::ofstream(dir / "junk.weights") << std::string(4096, 'x');
   const struct {
     std::string spec, expected;
   } cases[] = {
-      {(dir / "missing.cfg").string() + "," + (dir / "missing.weights").string(), "missing.cfg"},
-      {(dir / "not_a_model.cfg").string() + "," + (dir / "empty.weights").string(), "not_a_model.cfg"},
-      {(dir / "model.onnx").string(), "model.onnx"},
+      {(dir / "missing.cfg").string() + "," + (dir / "missing.weights").string(), "missing.cfg: no such file"},
+      {"/dev/zero", "/dev/zero: not a regular file"},
+      {(dir / "not_a_model.cfg").string() + "," + (dir / "junk.weights").string(), "not_a_model.cfg: "},
+      {(dir / "model.onnx").string(), "model.onnx: no such file"},
       {"only.cfg,", "expected CFG,WEIGHTS"},
   };
   std::vector<std::pair<std::string, std::string>> all;
@@ -297,8 +299,9 @@ TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
   const fs::path cfg = fs::path(data_dir()) / "models" / "yolo-fastest-1.1-xl" / "yolo-fastest-1.1-xl.cfg";
   if (!data_dir().empty() && fs::exists(cfg)) {
     fs::create_directories(dir / "folder.weights");
-    all.emplace_back(cfg.string() + "," + (dir / "empty.weights").string(), "cannot read the model");
-    all.emplace_back(cfg.string() + "," + (dir / "folder.weights").string(), "cannot read the model");
+    all.emplace_back(cfg.string() + "," + (dir / "empty.weights").string(), "empty.weights: empty file");
+    all.emplace_back(cfg.string() + "," + (dir / "folder.weights").string(), "folder.weights: not a regular file");
+    all.emplace_back(cfg.string() + "," + (dir / "missing.weights").string(), "missing.weights: no such file");
   }
   for (const auto& c : all) {
     host::HostSettings s;
