@@ -101,6 +101,21 @@ TEST(HostCullerSettings, ReadsEveryVariable) {
   EXPECT_EQ(s.box_only_classes, (std::vector<int>{0, 2}));
   EXPECT_EQ(s.preset, "dld_slam");
   EXPECT_EQ(s.log_path, "frames.csv");
+  EXPECT_TRUE(s.ok()) << s.reason;
+  EXPECT_TRUE(s.detector.empty());
+  EXPECT_FALSE(s.detector_sync);
+  EXPECT_FALSE(s.frames_rgb);
+}
+
+TEST(HostCullerSettings, ADetectorMeansCullerAndItsFlagsAreRead) {
+  Env mode("DYNCULL_MODE", nullptr), dir("DYNCULL_DETECTIONS", nullptr), detector("DYNCULL_DETECTOR", "yolo.cfg,yolo.weights"),
+      sync("DYNCULL_DETECTOR_SYNC", "1"), rgb("DYNCULL_FRAMES_RGB", "1");
+  const HostSettings s = HostSettings::from_environment();
+  EXPECT_TRUE(s.ok()) << s.reason;
+  EXPECT_EQ(s.mode, Mode::Culler);
+  EXPECT_EQ(s.detector, "yolo.cfg,yolo.weights");
+  EXPECT_TRUE(s.detector_sync);
+  EXPECT_TRUE(s.frames_rgb);
 }
 
 TEST(HostCullerSettings, BadValuesAreNamed) {
