@@ -318,6 +318,10 @@ struct HostCuller::Impl {
                  std::size_t kept, const std::string& boxes_field, const std::string& age_field, double ms);
   void warn_once(bool* warned, const char* what, const std::string& why);
   bool boxes_for(const HostFrame& f, std::string* why, std::string* boxes_field, std::string* age_field);
+  void note_frame_id(unsigned long frame_id);
+  void keep_outside_boxes(const std::vector<cv::KeyPoint>& keys);
+  bool run_culler(const HostFrame& f, const std::vector<cv::KeyPoint>& keys, std::string* why, const char** status_name,
+                  Status* refusal);
   const std::vector<std::uint8_t>* cull(const HostFrame& f);
   void pass(double stamp, std::size_t n, Status s, const std::string& why, double ms);
 };
@@ -403,6 +407,47 @@ bool HostCuller::Impl::boxes_for(const HostFrame& f, std::string* why, std::stri
   return found;
 }
 
+// A frame id not above the last one: the host restarted its map, and the keyframe belongs to the old one.
+void HostCuller::Impl::note_frame_id(unsigned long frame_id) {
+  if (has_frame && frame_id <= last_frame_id && culler) {
+    culler->reset();
+    ++stats.restarts;
+  }
+  has_frame = true;
+  last_frame_id = frame_id;
+}
+
+void HostCuller::Impl::keep_outside_boxes(const std::vector<cv::KeyPoint>& keys) {
+  keep.assign(keys.size(), 1);
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (inside_any(keys[i], boxes, settings.box_only_classes)) keep[i] = 0;
+}
+
+// The culler's keep mask into `keep` (the culler made at the first frame from its K, image size and
+// distortion). False when the culler refused the frame: `refusal` and `why` then say why; nothing is culled.
+bool HostCuller::Impl::run_culler(const HostFrame& f, const std::vector<cv::KeyPoint>& keys, std::string* why,
+                                  const char** status_name, Status* refusal) {
+  static const cv::Mat kNoMat;
+  if (!culler) {
+    const cv::Size size = f.image ? f.image->size() : cv::Size();
+    culler.reset(new Culler(cv_adapter::culler_camera(f.K ? *f.K : kNoMat, size, f.distortion ? *f.distortion : kNoMat),
+                            CullerOptions(settings.preset)));
+  }
+  const cv::Mat* pose = f.predicted_Tcw && !f.predicted_Tcw->empty() ? f.predicted_Tcw : nullptr;
+  const std::vector<cv::KeyPoint>* undistorted = f.keys_un && !f.keys_un->empty() ? f.keys_un : nullptr;
+  const CullerResult& r = cv_adapter::cull(*culler, keys, f.descriptors ? *f.descriptors : kNoMat,
+                                           f.depth ? *f.depth : kNoMat, boxes, pose, undistorted);
+  if (!r.ok()) *why = why->empty() ? r.reason : *why + "; " + r.reason;
+  if (r.refused || r.keep.size() != keys.size()) {
+    *refusal = r.refused ? r.status : Status::InvalidInput;
+    return false;
+  }
+  keep = r.keep;
+  *status_name = dyncull::to_string(r.status);
+  if (!r.ok()) ++stats.frames_not_ok;
+  return true;
+}
+
 const std::vector<std::uint8_t>* HostCuller::Impl::cull(const HostFrame& f) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed_ms = [&start] {
@@ -410,7 +455,6 @@ const std::vector<std::uint8_t>* HostCuller::Impl::cull(const HostFrame& f) {
   };
   ++stats.frames;
   static const std::vector<cv::KeyPoint> kNoKeys;
-  static const cv::Mat kNoMat;
   const std::vector<cv::KeyPoint>& keys = f.keys ? *f.keys : kNoKeys;
   const std::size_t n = keys.size();
   stats.features_in += static_cast<double>(n);
@@ -423,45 +467,19 @@ const std::vector<std::uint8_t>* HostCuller::Impl::cull(const HostFrame& f) {
     log_frame(f.stamp, dyncull::to_string(Status::Ok), "", n, n, "", "", elapsed_ms());
     return nullptr;
   }
-  if (has_frame && f.frame_id <= last_frame_id && culler) {
-    culler->reset();  // the host restarted its map: the keyframe belongs to the old one
-    ++stats.restarts;
-  }
-  has_frame = true;
-  last_frame_id = f.frame_id;
-
+  note_frame_id(f.frame_id);
   std::string why, boxes_field, age_field;
   if (!boxes_for(f, &why, &boxes_field, &age_field)) {
     ++stats.frames_without_detections;
     warn_once(&warned_missing, "a frame without boxes is culled without them", why);
   }
   const char* status_name = dyncull::to_string(Status::Ok);
+  Status refusal = Status::Ok;
   if (settings.mode == Mode::BoxOnly) {
-    keep.assign(n, 1);
-    for (std::size_t i = 0; i < n; ++i)
-      if (inside_any(keys[i], boxes, settings.box_only_classes)) keep[i] = 0;
-  } else {
-    const cv::Mat& image = f.image ? *f.image : kNoMat;
-    if (!culler) {
-      culler.reset(new Culler(cv_adapter::culler_camera(f.K ? *f.K : kNoMat, image.size(),
-                                                        f.distortion ? *f.distortion : kNoMat),
-                              CullerOptions(settings.preset)));
-    }
-    const cv::Mat* pose = f.predicted_Tcw && !f.predicted_Tcw->empty() ? f.predicted_Tcw : nullptr;
-    const std::vector<cv::KeyPoint>* undistorted = f.keys_un && !f.keys_un->empty() ? f.keys_un : nullptr;
-    const CullerResult& r = cv_adapter::cull(*culler, keys, f.descriptors ? *f.descriptors : kNoMat,
-                                             f.depth ? *f.depth : kNoMat, boxes, pose, undistorted);
-    if (r.refused || r.keep.size() != n) {  // nothing culled: the frame passes as it came
-      pass(f.stamp, n, r.refused ? r.status : Status::InvalidInput,
-           why.empty() ? r.reason : why + "; " + r.reason, elapsed_ms());
-      return nullptr;
-    }
-    keep = r.keep;
-    status_name = dyncull::to_string(r.status);
-    if (!r.ok()) {
-      ++stats.frames_not_ok;
-      why = why.empty() ? r.reason : why + "; " + r.reason;
-    }
+    keep_outside_boxes(keys);
+  } else if (!run_culler(f, keys, &why, &status_name, &refusal)) {
+    pass(f.stamp, n, refusal, why, elapsed_ms());  // nothing culled: the frame passes as it came
+    return nullptr;
   }
   const double ms = elapsed_ms();
   stats.cull_ms += ms;
