@@ -61,6 +61,16 @@ bool flag_from_text(const std::string& value, bool* flag) {
   return true;
 }
 
+bool threads_from_text(const std::string& value, int* out) {
+  if (value.empty()) return true;
+  double n = 0;
+  long long whole = 0;
+  if (text::parse_python_float(value, &n) != text::NumberStatus::Ok || !text::integer_in_range(n, 1, 64, &whole))
+    return false;
+  *out = static_cast<int>(whole);
+  return true;
+}
+
 bool seconds_from_text(const std::string& value, double* out) {
   if (value.empty()) return true;
   double s = 0;
@@ -281,6 +291,9 @@ HostSettings HostSettings::from_environment() {
   if (!flag_from_text(sync, &s.detector_sync)) bad(bad_variable("DYNCULL_DETECTOR_SYNC", sync, "0 or 1"));
   const std::string rgb = environment("DYNCULL_FRAMES_RGB");
   if (!flag_from_text(rgb, &s.frames_rgb)) bad(bad_variable("DYNCULL_FRAMES_RGB", rgb, "0 or 1"));
+  const std::string threads = environment("DYNCULL_OPENCV_THREADS");
+  if (!threads_from_text(threads, &s.opencv_threads))
+    bad(bad_variable("DYNCULL_OPENCV_THREADS", threads, "a number of threads from 1 to 64"));
   const std::string preset = environment("DYNCULL_PRESET");
   if (!preset.empty()) s.preset = preset;
   const std::string tolerance = environment("DYNCULL_STAMP_TOLERANCE");
@@ -354,6 +367,10 @@ bool HostCuller::Impl::open(std::unique_ptr<FrameDetector> detector) {
     }
   }
   if (!s.log_path.empty() && !log.open(s.log_path, &why)) return refuse(why);
+  if (s.opencv_threads < 0 || s.opencv_threads > 64) return refuse("DYNCULL_OPENCV_THREADS: must be 1 to 64 (0: unchanged)");
+  // OpenCV's thread pool serves the whole process (the detector's network and the host's own OpenCV
+  // calls): on a machine of few cores, a smaller pool leaves cores to the tracking thread.
+  if (s.opencv_threads > 0) cv::setNumThreads(s.opencv_threads);
   return true;
 }
 

@@ -118,6 +118,21 @@ TEST(HostCullerSettings, ADetectorMeansCullerAndItsFlagsAreRead) {
   EXPECT_TRUE(s.frames_rgb);
 }
 
+// DYNCULL_OPENCV_THREADS sizes OpenCV's pool for the process when the host starts.
+TEST(HostCullerSettings, OpenCvThreadsAreSetAtStart) {
+  const int before = cv::getNumThreads();
+  Env threads("DYNCULL_OPENCV_THREADS", "1");
+  const HostSettings s = HostSettings::from_environment();
+  ASSERT_TRUE(s.ok()) << s.reason;
+  EXPECT_EQ(s.opencv_threads, 1);
+  {
+    HostCuller culler(s);
+    ASSERT_TRUE(culler.ok()) << culler.reason();
+    EXPECT_EQ(cv::getNumThreads(), 1);
+  }
+  cv::setNumThreads(before);
+}
+
 TEST(HostCullerSettings, BadValuesAreNamed) {
   const struct {
     const char *name, *value, *expected;
@@ -128,6 +143,8 @@ TEST(HostCullerSettings, BadValuesAreNamed) {
       {"DYNCULL_BOX_CLASSES", "0,,person", "DYNCULL_BOX_CLASSES='0,,person'"},
       {"DYNCULL_DETECTOR_SYNC", "yes", "DYNCULL_DETECTOR_SYNC='yes': expected 0 or 1"},
       {"DYNCULL_FRAMES_RGB", "2", "DYNCULL_FRAMES_RGB='2': expected 0 or 1"},
+      {"DYNCULL_OPENCV_THREADS", "0", "DYNCULL_OPENCV_THREADS='0': expected a number of threads from 1 to 64"},
+      {"DYNCULL_OPENCV_THREADS", "2.5", "DYNCULL_OPENCV_THREADS='2.5'"},
   };
   for (const auto& c : cases) {
     Env e(c.name, c.value);

@@ -42,17 +42,19 @@ struct HostSettings {
   std::string detector;               ///< live detector: "CFG,WEIGHTS" (Darknet) or "MODEL.onnx"; empty: none
   bool detector_sync;                 ///< wait for each frame's own boxes (true) or use the newest finished ones
   bool frames_rgb;                    ///< colour frames arrive in RGB order (false: BGR, as cv::imread gives)
+  int opencv_threads;                 ///< > 0: cv::setNumThreads(n) at start, for the whole process; 0: unchanged
   Status status;                      ///< Ok, or InvalidInput with `reason` naming the variable
   std::string reason;
 
   HostSettings()
       : mode(Mode::Stock), preset("recommended"), stamp_tolerance_s(0.005), box_only_classes(1, 0),
-        detector_sync(false), frames_rgb(false), status(Status::Ok) {}
+        detector_sync(false), frames_rgb(false), opencv_threads(0), status(Status::Ok) {}
   bool ok() const { return status == Status::Ok; }
 
   /// DYNCULL_MODE (stock, box_only or culler; unset: culler when DYNCULL_DETECTIONS or DYNCULL_DETECTOR is
   /// set, else stock), DYNCULL_DETECTIONS, DYNCULL_DETECTOR, DYNCULL_DETECTOR_SYNC (0 or 1),
-  /// DYNCULL_FRAMES_RGB (0 or 1), DYNCULL_PRESET, DYNCULL_STAMP_TOLERANCE (seconds), DYNCULL_LOG,
+  /// DYNCULL_FRAMES_RGB (0 or 1), DYNCULL_OPENCV_THREADS (1 to 64), DYNCULL_PRESET, DYNCULL_STAMP_TOLERANCE
+  /// (seconds), DYNCULL_LOG,
   /// DYNCULL_BOX_CLASSES (comma-separated class ids). The first unreadable one sets status and reason.
   static HostSettings from_environment();
 };
