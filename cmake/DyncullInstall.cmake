@@ -2,7 +2,8 @@ include(CMakePackageConfigHelpers)
 
 # One export set per component, so that a host loads only what it asks for and needs only that part's
 # dependencies: core (dyncull, pipeline) Eigen; opencv the OpenCV modules; opencv_dnn those and dnn;
-# culler OpenCV core (and calib3d at link time); ceres Ceres.
+# culler OpenCV core (and calib3d at link time); host the culler, OpenCV core, imgproc and dnn (at link time)
+# and threads; ceres Ceres.
 set(DYNCULL_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/dyncull)
 set(DYNCULL_CORE_TARGETS dyncull)
 if(DYNCULL_MASTER_PROJECT)  # otherwise dyncull_pipeline is built only when a target links it
@@ -11,7 +12,7 @@ endif()
 install(TARGETS ${DYNCULL_CORE_TARGETS} EXPORT dyncullTargets)
 install(EXPORT dyncullTargets NAMESPACE dyncull:: DESTINATION ${DYNCULL_CMAKE_DIR})
 set(DYNCULL_COMPONENTS "")
-foreach(_comp opencv opencv_dnn culler ceres)
+foreach(_comp opencv opencv_dnn culler host ceres)
   if(TARGET dyncull_${_comp})
     list(APPEND DYNCULL_COMPONENTS ${_comp})
     install(TARGETS dyncull_${_comp} EXPORT dyncull-${_comp}Targets)

@@ -36,7 +36,7 @@ fi
 headers=()
 while IFS= read -r h; do
   case "$h" in
-    */opencv/*) ((opencv_ok)) || continue ;;
+    */opencv/*|*/host/*) ((opencv_ok)) || continue ;;
     */ceres/*) ((ceres_ok)) || continue ;;
   esac
   headers+=("$h")
@@ -46,7 +46,7 @@ jobs_max=${DYNCULL_JOBS:-$(nproc)}
 check_one() {  # compiler header -> writes $tmp/<n>.fail with the errors on failure
   local c=$1 h=$2 n=$3
   local extra=()
-  [[ "$h" == */opencv/* ]] && extra=(-isystem /usr/include/opencv4)
+  [[ "$h" == */opencv/* || "$h" == */host/* ]] && extra=(-isystem /usr/include/opencv4)
   if ! echo "#include \"${h#include/}\"" | "$c" "${flags[@]}" "${extra[@]}" -x c++ - 2>"$tmp/$n.err"; then
     { echo "FAIL [$c] $h"; sed 's/^/    /' "$tmp/$n.err" | head -30; } >"$tmp/$n.fail"
   fi

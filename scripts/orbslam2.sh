@@ -5,6 +5,7 @@
 # culler: the recommended preset).
 #
 #   scripts/orbslam2.sh --sequence DIR --out DIR [--runs N] [--variants stock,box_only,culler] [--page FILE]
+#       [--detector CFG,WEIGHTS|MODEL.onnx]
 #       copies ORB-SLAM2, applies the patches, builds (Pangolin headless too unless --pangolin-prefix), trains
 #       a vocabulary when ORBvoc.txt is absent, runs rgbd_tum (viewer off) once per variant and run in its own
 #       folder, evaluates the ATE with dyncull_eval and writes OUT/orbslam2_summary.csv; with --page, writes
@@ -17,7 +18,13 @@
 #   scripts/orbslam2.sh --compile-check    applies the patches to a copy of ORB-SLAM2 and compiles the
 #       translation unit the culler patch changes (src/Tracking.cc) with ORB-SLAM2's flags against dyncull's
 #       install: no Pangolin build (its headers are configured only), no ORB-SLAM2 build, no run.
+# Variants: stock, box_only, culler (boxes from the sequence's detections folder), culler_live (the culler
+# with a YOLO detector running beside the tracker, DYNCULL_DETECTOR=--detector), culler_live_sync (the
+# same detector waited for on every frame, DYNCULL_DETECTOR_SYNC=1). The live variants track on the colour
+# frames (associations_color.txt, from the sequence's rgb_color.txt) when the sequence has them, so that the
+# detector sees colour; the others on rgb.txt's images.
 # Options:
+#   --detector SPEC        the live variants' model: CFG,WEIGHTS (Darknet) or MODEL.onnx
 #   --thirdparty DIR       ORB_SLAM2/ and Pangolin/ (default: ../shared/thirdparty beside the checkout)
 #   --work DIR             build trees and the vocabulary (default: $XDG_CACHE_HOME or ~/.cache, /dyncull-orbslam2)
 #   --dyncull-prefix DIR   an installed dyncull with the culler (default: built and installed under --work)
@@ -46,6 +53,7 @@ page=""
 jobs=2
 mode=run
 install_deps=""
+detector=""
 while (($#)); do
   case "$1" in
     --thirdparty) thirdparty=$2; shift 2 ;;
@@ -61,6 +69,7 @@ while (($#)); do
     --motions) motions=$2; shift 2 ;;
     --frames) frames=$2; shift 2 ;;
     --page) page=$2; shift 2 ;;
+    --detector) detector=$2; shift 2 ;;
     --jobs) jobs=$2; shift 2 ;;
     --build-only) mode=build; shift ;;
     --compile-check) mode=compile_check; shift ;;
@@ -75,6 +84,13 @@ mkdir -p "$work"
 work=$(cd "$work" && pwd)
 absolute() { [[ -z "$1" ]] || (cd "$1" && pwd) || { echo "orbslam2.sh: no folder $1" >&2; exit 1; }; }
 dyncull_prefix=$(absolute "$dyncull_prefix")
+if [[ -n "$detector" ]]; then  # the runs start in their own folders: the model's paths made absolute
+  IFS=',' read -r -a detector_files <<<"$detector"
+  for i in "${!detector_files[@]}"; do
+    [[ "${detector_files[i]}" == /* ]] || detector_files[i]="$PWD/${detector_files[i]}"
+  done
+  detector=$(IFS=','; echo "${detector_files[*]}")
+fi
 pangolin_prefix=$(absolute "$pangolin_prefix")
 if [[ "$mode" == run ]]; then
   [[ (-n "$sequence" || -n "$families") && -n "$out" ]] ||
@@ -92,16 +108,16 @@ launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 log() { echo "orbslam2.sh: $*" >&2; }
 
-# --- dyncull: the culler library and dyncull_eval, installed into a prefix ORB-SLAM2's CMake finds ---------
+# --- dyncull: the culler and host libraries and dyncull_eval, installed into a prefix ORB-SLAM2's CMake finds ---------
 install_dyncull() {
   if [[ -n "$dyncull_prefix" ]]; then return; fi
   dyncull_prefix="$work/dyncull-install"
   local build="$work/dyncull-build"
-  log "building dyncull's culler and dyncull_eval in $build"
+  log "building dyncull's culler, its host harness and dyncull_eval in $build"
   cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" -DDYNCULL_BUILD_TESTS=OFF \
     -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_DOCS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=ON -DDYNCULL_INSTALL=ON \
     -DCMAKE_INSTALL_PREFIX="$dyncull_prefix" >"$work/dyncull-configure.log"
-  cmake --build "$build" --target dyncull_culler dyncull_pipeline dyncull_eval -j "$jobs" >"$work/dyncull-build.log"
+  cmake --build "$build" --target dyncull_culler dyncull_host dyncull_pipeline dyncull_eval -j "$jobs" >"$work/dyncull-build.log"
   cmake --install "$build" >"$work/dyncull-install.log"
 }
 
@@ -223,7 +239,7 @@ compile_check() {
   fi
   local symbols
   symbols=$(nm -C "$work/compile-check/Tracking.o")
-  grep -q 'U dyncull::cv_adapter::HostCuller::cull' <<<"$symbols" ||
+  grep -q 'U dyncull::host::HostCuller::cull' <<<"$symbols" ||
     { echo "orbslam2.sh: Tracking.o does not call the culler: the patch did not apply as expected" >&2; exit 1; }
   log "compile check passed: patched src/Tracking.cc compiles with -std=c++11 -O3 against $dyncull_prefix ($(($(date +%s) - start)) s)"
 }
@@ -245,19 +261,34 @@ detections_of() {
   if compgen -G "$1/detections/*.json" >/dev/null; then echo "$1/detections"; else echo "$1/detections_json"; fi
 }
 
+# The DYNCULL_* settings of a variant (one per line, for env), given the detections folder.
+variant_environment() {
+  local variant=$1 detections=$2
+  case "$variant" in
+    stock|box_only|culler) printf 'DYNCULL_MODE=%s\nDYNCULL_DETECTIONS=%s\n' "$variant" "$detections" ;;
+    culler_live) printf 'DYNCULL_MODE=culler\nDYNCULL_DETECTOR=%s\n' "$detector" ;;
+    culler_live_sync) printf 'DYNCULL_MODE=culler\nDYNCULL_DETECTOR=%s\nDYNCULL_DETECTOR_SYNC=1\n' "$detector" ;;
+  esac
+}
+
 run_sequence() {
-  local seq=$1 dest=$2 variant run dir detections
+  local seq=$1 dest=$2 variant run dir detections associations settings=()
   mkdir -p "$dest"
   python3 "$root/scripts/orbslam2_sequence.py" prepare "$seq" "$dest"
   detections=$(detections_of "$seq")
   for variant in "${variant_list[@]}"; do
+    associations="$dest/associations.txt"
+    if [[ "$variant" == culler_live* && -f "$dest/associations_color.txt" ]]; then
+      associations="$dest/associations_color.txt"
+    fi
+    mapfile -t settings < <(variant_environment "$variant" "$detections")
     for ((run = 1; run <= runs; run++)); do
       dir="$dest/runs/$variant/run$run"
       rm -rf "$dir"
       mkdir -p "$dir"
-      log "$(basename "$seq"): $variant run $run of $runs"
-      (cd "$dir" && DYNCULL_MODE=$variant DYNCULL_DETECTIONS="$detections" DYNCULL_LOG="$dir/culler_frames.csv" \
-        "$rgbd_tum" "$vocabulary" "$dest/orbslam2_settings.yaml" "$seq" "$dest/associations.txt" \
+      log "$(basename "$seq"): $variant run $run of $runs ($(basename "$associations"))"
+      (cd "$dir" && env "${settings[@]}" DYNCULL_LOG="$dir/culler_frames.csv" \
+        "$rgbd_tum" "$vocabulary" "$dest/orbslam2_settings.yaml" "$seq" "$associations" \
         >"$dir/rgbd_tum.log" 2>&1) || log "$variant run $run: rgbd_tum exited with status $? (see $dir/rgbd_tum.log)"
       "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" --json \
         >"$dir/ate.json" 2>"$dir/ate.err" || true
@@ -282,7 +313,12 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 IFS=',' read -r -a variant_list <<<"$variants"
 for variant in "${variant_list[@]}"; do
-  case "$variant" in stock|box_only|culler) ;; *) echo "orbslam2.sh: unknown variant '$variant'" >&2; exit 2 ;; esac
+  case "$variant" in
+    stock|box_only|culler) ;;
+    culler_live|culler_live_sync)
+      [[ -n "$detector" ]] || { echo "orbslam2.sh: variant '$variant' needs --detector CFG,WEIGHTS or MODEL.onnx" >&2; exit 2; } ;;
+    *) echo "orbslam2.sh: unknown variant '$variant' (stock, box_only, culler, culler_live, culler_live_sync)" >&2; exit 2 ;;
+  esac
 done
 if [[ -n "$sequence" ]]; then
   run_sequence "$sequence" "$out"

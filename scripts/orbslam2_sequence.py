@@ -4,7 +4,8 @@
   orbslam2_sequence.py prepare SEQUENCE OUT
       OUT/orbslam2_settings.yaml (ORB-SLAM2's settings, written from SEQUENCE/camera.txt) and
       OUT/associations.txt (rgb and depth paired as the TUM benchmark's associate.py: |dt| < 0.02 s,
-      closest pairs first, each stamp once).
+      closest pairs first, each stamp once); when SEQUENCE has rgb_color.txt (colour frames of the same
+      stamps, for a live detector), OUT/associations_color.txt pairs those with depth the same way.
   orbslam2_sequence.py summarise SEQUENCE OUT [--vocabulary FILE] [--command TEXT] [--page FILE]
       reads OUT/runs/VARIANT/runN/ (rgbd_tum.log, CameraTrajectory.txt, ate.json), writes
       OUT/orbslam2_summary.csv (a row per variant and run) and prints the table; with --page, replaces
@@ -29,7 +30,9 @@ import subprocess
 import sys
 
 MAX_DIFFERENCE_S = 0.02
-VARIANTS = ["stock", "box_only", "culler"]
+# culler: boxes from the detections folder; culler_live: a detector running beside the tracker (newest
+# finished boxes); culler_live_sync: the detector waited for on every frame.
+VARIANTS = ["stock", "box_only", "culler", "culler_live", "culler_live_sync"]
 
 
 def read_list(path):
@@ -154,6 +157,14 @@ def prepare(sequence, out):
             f.write("%s %s %s %s\n" % p)
     print("orbslam2_sequence.py: %d rgb frames, %d with a depth partner (associations.txt), %dx%d"
           % (len(rgb), len(pairs), width, height), file=sys.stderr)
+    colour_list = os.path.join(sequence, "rgb_color.txt")
+    if os.path.exists(colour_list):
+        colour_pairs = associate(read_list(colour_list), depth)
+        with open(os.path.join(out, "associations_color.txt"), "w") as f:
+            for p in colour_pairs:
+                f.write("%s %s %s %s\n" % p)
+        print("orbslam2_sequence.py: %d colour frames with a depth partner (associations_color.txt)"
+              % len(colour_pairs), file=sys.stderr)
 
 
 def count_lines(path):
@@ -165,7 +176,7 @@ def count_lines(path):
 
 def read_run(directory, frames):
     row = {"ate_rmse_m": "", "ate_pairs": "", "track_ms": "", "track_median_ms": "", "cull_ms": "", "features": "",
-           "features_kept": "", "note": ""}
+           "features_kept": "", "note": "", "fps": "", "track_ms_p95": "", "detector_ms": "", "box_age_frames": ""}
     poses = count_lines(os.path.join(directory, "CameraTrajectory.txt"))
     row["lost_frames"] = frames - poses
     log_path = os.path.join(directory, "rgbd_tum.log")
@@ -183,6 +194,9 @@ def read_run(directory, frames):
     m = re.search(r"([0-9.]+) ms per frame culling", text)
     if m:
         row["cull_ms"] = m.group(1)
+    m = re.search(r"live detector[^:]*: ([0-9.]+) ms per detection, box age ([0-9.]+) frames", text)
+    if m:
+        row["detector_ms"], row["box_age_frames"] = m.group(1), m.group(2)
     try:
         with open(os.path.join(directory, "ate.json")) as f:
             report = json.load(f)
@@ -211,8 +225,11 @@ def fewest_kept(path):
     return min(kept) if kept else ""
 
 
+# fps and track_ms_p95 stay empty until the example reports its per-frame times; detector_ms and
+# box_age_frames come from the host's summary line (live variants only).
 COLUMNS = ["variant", "run", "ate_rmse_m", "ate_pairs", "lost_frames", "frames", "track_ms", "track_median_ms",
-           "cull_ms", "features", "features_kept", "fewest_kept", "note"]
+           "track_ms_p95", "fps", "cull_ms", "detector_ms", "box_age_frames", "features", "features_kept",
+           "fewest_kept", "note"]
 
 
 def median_range(values, scale=1.0, digits=2):

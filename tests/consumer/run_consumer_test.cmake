@@ -65,6 +65,26 @@ if(EXPECT_CULLER)
   endif()
 endif()
 
+# The host harness alone (as the ORB-SLAM2 patch asks for it), with Eigen and Ceres hidden.
+if(EXPECT_CULLER)
+  execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}/host" -B "${SCRATCH_DIR}/build_host"
+                          -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+                          -DCMAKE_DISABLE_FIND_PACKAGE_Ceres=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON
+                          -DHOST_SOURCE=${CONSUMER_SOURCE_DIR}/../host/orb_slam_host.cpp
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "configuring a host-harness consumer with Eigen and Ceres hidden failed (${rc})")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_host" RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "building the host-harness consumer failed (${rc})")
+  endif()
+  execute_process(COMMAND "${SCRATCH_DIR}/build_host/host_consumer" RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the host-harness consumer ran but returned ${rc}")
+  endif()
+endif()
+
 # The same consumer with dyncull vendored through add_subdirectory (no install step).
 execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${SCRATCH_DIR}/build_subdir"
                         -DCONSUMER_USE_SUBDIRECTORY=ON -DDYNCULL_SOURCE_DIR=${DYNCULL_SOURCE_DIR}

@@ -2,11 +2,10 @@
 // overloads (opencv/culler.hpp), as ORB-SLAM2/3 compile: built twice (CXX_STANDARD 11 and 14, -Wall
 // -Wextra -Wpedantic -Werror) against dyncull::culler, then run. It culls a few frames of grid keypoints
 // through the cv::KeyPoint and cv::Point2f overloads and through plain views, checks the statuses and
-// compacts; then the ORB-SLAM glue (host_culler.hpp) on a Frame-like struct in stock mode; exit code 0
-// when all is as the headers say.
+// compacts; exit code 0 when all is as the headers say. (The host harness, dyncull::host, has its own
+// C++11 program: tests/host/orb_slam_host.cpp.)
 #include <dyncull/culling/culler.hpp>
 #include <dyncull/opencv/culler.hpp>
-#include <dyncull/opencv/host_culler.hpp>
 
 #include <opencv2/core.hpp>
 
@@ -24,24 +23,6 @@ void expect(bool condition, const char* what) {
     ++failures;
   }
 }
-
-// The members of ORB-SLAM2's Frame that cull_orb_slam_frame touches.
-struct Frame {
-  double mTimeStamp;
-  unsigned long mnId;
-  int N;
-  std::vector<cv::KeyPoint> mvKeys, mvKeysUn;
-  cv::Mat mDescriptors;
-  std::vector<float> mvuRight, mvDepth;
-  std::vector<int*> mvpMapPoints;
-  std::vector<bool> mvbOutlier;
-  std::vector<std::size_t> mGrid[4][3];
-  bool PosInGrid(const cv::KeyPoint&, int& x, int& y) const {
-    x = 0;
-    y = 0;
-    return true;
-  }
-};
 
 }  // namespace
 
@@ -108,16 +89,6 @@ int main() {
   culler.reset();
   expect(culler.keyframe_size() == 0, "reset forgets the keyframe");
 
-  dyncull::cv_adapter::HostCuller stock((dyncull::cv_adapter::HostCuller::Settings()));
-  Frame frame;
-  frame.mTimeStamp = 1.0;
-  frame.mnId = 0;
-  frame.mvKeys = frame.mvKeysUn = keys;
-  frame.mDescriptors = descriptors;
-  frame.N = static_cast<int>(keys.size());
-  expect(dyncull::cv_adapter::cull_orb_slam_frame(stock, frame, cv::Size(640, 480), depth, K, cv::Mat(), cv::Mat()) ==
-             frame.N && frame.mvKeys.size() == keys.size(),
-         "stock mode leaves an ORB-SLAM frame as it is");
   std::printf("compiled_culler_host: %zu culled, %ld kept, %d failures\n", culled, n, failures);
   return failures == 0 ? 0 : 1;
 }

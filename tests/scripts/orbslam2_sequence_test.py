@@ -88,6 +88,27 @@ class Sequence(unittest.TestCase):
                          ("culler", "1", "0.01230", "1", "2", "32.50", "1.500", "800.5"))
         self.assertEqual((rows[1]["run"], rows[1]["ate_rmse_m"], rows[1]["lost_frames"]), ("2", "", "2"))
         self.assertIn("no trajectory", rows[1]["note"])
+        self.assertEqual((rows[0]["detector_ms"], rows[0]["box_age_frames"]), ("", ""))
+
+    def test_live_variant_reads_detector_time_and_box_age(self):
+        with open(os.path.join(self.dir, "rgb_color.txt"), "w") as f:
+            f.write("# colour\n1.000000 rgb_color/1.000000.jpg\n1.066667 rgb_color/1.066667.jpg\n")
+        seq.prepare(self.dir, self.dir)
+        self.assertEqual(seq.count_lines(os.path.join(self.dir, "associations_color.txt")), 2)
+        run = os.path.join(self.dir, "runs", "culler_live", "run1")
+        os.makedirs(run)
+        with open(os.path.join(run, "rgbd_tum.log"), "w") as f:
+            f.write("mean tracking time: 0.030\n"
+                    "dyncull: mode culler, 2 frames (1 without boxes, 1 not Ok, 0 restarts), features 1000.0 -> 900.0 "
+                    "per frame, 1.200 ms per frame culling; live detector: 41.5 ms per detection, box age 1.50 "
+                    "frames, 0 failed frames\n")
+        seq.summarise(self.dir, self.dir, "", "cmd", "")
+        lines = open(os.path.join(self.dir, "orbslam2_summary.csv")).read().splitlines()
+        header = lines[0].split(",")
+        for column in ("fps", "track_ms_p95", "detector_ms", "box_age_frames"):
+            self.assertIn(column, header)
+        row = dict(zip(header, lines[1].split(",")))
+        self.assertEqual((row["variant"], row["detector_ms"], row["box_age_frames"]), ("culler_live", "41.5", "1.50"))
 
 
 class Alignment(unittest.TestCase):

@@ -26,8 +26,8 @@ namespace dyncull {
 namespace cv_adapter {
 
 /// The culler's camera from a 3x3 K (CV_32F / CV_64F), the image size and OpenCV's distortion
-/// coefficients (empty: none). A K that is not 3x3 floating point gives a camera without intrinsics,
-/// which the culler refuses with its reason.
+/// coefficients (empty: none; any layout, also a view into a larger matrix). A K that is not 3x3 floating
+/// point gives a camera without intrinsics, which the culler refuses with its reason.
 inline CullerCamera culler_camera(const cv::Mat& K, cv::Size image_size, const cv::Mat& distortion = cv::Mat()) {
   CullerCamera c;
   c.width = image_size.width;
@@ -40,10 +40,15 @@ inline CullerCamera culler_camera(const cv::Mat& K, cv::Size image_size, const c
     c.cx = k.at<double>(0, 2);
     c.cy = k.at<double>(1, 2);
   }
-  if (!distortion.empty()) {
+  if (!distortion.empty() && distortion.dims == 2) {
+    // convertTo writes a new continuous matrix, so a view (a column of a larger Mat) reads as well; every
+    // value in row-major order, so a count the model does not have is refused by the culler, named.
     cv::Mat d;
-    distortion.reshape(1, 1).convertTo(d, CV_64F);
-    c.distortion.assign(d.ptr<double>(0), d.ptr<double>(0) + d.cols);
+    distortion.convertTo(d, CV_64F);
+    const double* p = d.ptr<double>(0);
+    c.distortion.assign(p, p + d.total() * static_cast<std::size_t>(d.channels()));
+  } else if (!distortion.empty()) {
+    c.distortion.assign(9, 0.0);  // not a 2-D matrix: a count no model has, refused with its reason
   }
   return c;
 }
