@@ -20,6 +20,7 @@
 /// and ids is cull_frame (culling/pipeline.hpp).
 #pragma once
 
+#include "dyncull/core/camera_bounds.hpp"
 #include "dyncull/core/compact.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/status.hpp"
@@ -53,6 +54,15 @@ struct CullerCamera {
     return false;
   }
 };
+
+/// The camera check of core/camera_bounds.hpp on a CullerCamera and a depth scale (raw units per metre;
+/// 1 when the host has no depth): what the culler refuses a camera for, for a host to check its settings
+/// once at start-up. Ok, or InvalidInput with the first reason.
+inline Status check_camera(const CullerCamera& camera, double depth_units_per_metre, std::string* reason = nullptr) {
+  return check_camera(camera.fx, camera.fy, camera.cx, camera.cy, camera.width, camera.height,
+                      camera.distortion.empty() ? nullptr : &camera.distortion[0],
+                      camera.distortion.size(), depth_units_per_metre, reason);
+}
 
 /// Who decides when the current frame becomes the reference keyframe.
 enum class KeyframePolicy : std::uint8_t {
