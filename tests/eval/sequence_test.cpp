@@ -266,6 +266,37 @@ TEST_F(SequenceFolder, CameraFilesFollowTheFileOpeningRule) {
   EXPECT_EQ(c.status, Status::IoError);
 }
 
+// A detections folder holding more files than the sequence needs: the files are read in name order
+// until every frame has its file (the later ones here are not even JSON), nothing is called missing, and
+// the files not read are counted in a note. More files than max_frames is refused, not cut.
+TEST_F(SequenceFolder, JsonDetectionsFolderIsReadOnlyAsFarAsTheFramesNeed) {
+  lists({"10.000", "10.033", "10.066"}, {"10.001", "10.034", "10.067"});
+  fs::create_directories(path("det"));
+  const char* stamps[] = {"10.000", "10.033", "10.066", "10.100"};
+  for (int k = 0; k < 4; ++k)
+    write("det/00000" + std::to_string(k) + ".json",
+          std::string("{\"frame_id\": ") + std::to_string(k) + ", \"timestamp\": " + stamps[k] +
+              ", \"image_path\": \"x.png\", \"detections\": []}");
+  for (int k = 4; k < 30; ++k) write("det/0000" + std::string(k < 10 ? "0" : "") + std::to_string(k) + ".json", "later");
+  const eval::SequenceIndex s = eval::read_sequence(dir_.string());
+  ASSERT_TRUE(s.ok()) << s.reason;
+  const eval::SequenceDetections d = eval::read_sequence_detections(path("det"), s, 640, 480);
+  ASSERT_TRUE(d.ok()) << d.reason;
+  EXPECT_EQ(d.has_file, (std::vector<std::uint8_t>{1, 1, 1}));
+  EXPECT_EQ(d.frames_with_file, 3u);
+  EXPECT_EQ(d.files_unmatched, 1u);  // 10.100, read to see the frames were done
+  std::string all;
+  for (const std::string& n : d.notes.first) all += n + "\n";
+  EXPECT_NE(all.find("26 files after 000003.json not read: every frame has its detections file"), std::string::npos)
+      << all;
+  EXPECT_EQ(all.find("have no detections file"), std::string::npos) << all;
+  eval::SequenceOptions few;
+  few.max_frames = 10;
+  const eval::SequenceDetections capped = eval::read_sequence_detections(path("det"), s, 640, 480, few);
+  EXPECT_EQ(capped.status, Status::ParseError);
+  EXPECT_NE(capped.reason.find("more than 10 detection files"), std::string::npos) << capped.reason;
+}
+
 TEST_F(SequenceFolder, JsonDetectionsMatchFramesByTimestamp) {
   lists({"10.000", "10.033", "10.066"}, {"10.001", "10.034", "10.067"});
   fs::create_directories(path("det"));

@@ -471,49 +471,87 @@ inline void keep_filtered(const std::vector<Detection<float>>& boxes, int width,
   out->insert(out->end(), f.detections.begin(), f.detections.end());
 }
 
-/// A folder of per-frame JSON (yolo_json.hpp) matched to the frames by stamp.
-inline void read_json_folder(const std::string& dir, const SequenceIndex& s, int width, int height,
-                             const SequenceOptions& options, SequenceDetections* d) {
-  std::vector<std::string> files;
+/// A folder's *.json names (not starting with '_'), sorted; ParseError past max_frames of them (the
+/// reader's frame limit: a folder with more files than a sequence may have frames is refused, never cut
+/// in directory order), IoError when the folder cannot be listed.
+inline Status list_json_files(const std::string& dir, const SequenceOptions& options, std::vector<std::string>* files,
+                              std::string* reason) {
   std::error_code ec;
   for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::filesystem::path& p = it->path();
-    if (p.extension() == ".json" && p.filename().string().front() != '_') files.push_back(p.string());
-    if (files.size() > options.max_frames) break;
+    if (p.extension() != ".json" || p.filename().string().front() == '_') continue;
+    if (files->size() >= options.max_frames) {
+      *reason = text::quote_path(dir) + ": more than " + std::to_string(options.max_frames) +
+                " detection files (SequenceOptions::max_frames)";
+      return Status::ParseError;
+    }
+    files->push_back(p.string());
   }
   if (ec) {
-    d->status = Status::IoError;
-    d->reason = dir + ": " + ec.message();
-    return;
+    *reason = text::quote_path(dir) + ": " + ec.message();
+    return Status::IoError;
   }
-  std::sort(files.begin(), files.end());
+  std::sort(files->begin(), files->end());
+  return Status::Ok;
+}
+
+/// A folder of per-frame JSON (yolo_json.hpp) matched to the frames by stamp. Files are read in name
+/// order, and reading stops once every frame has a file within detection_max_difference_s and the last
+/// file read lies past the last frame: the files after it are not read, and a note says how many.
+inline void read_json_folder(const std::string& dir, const SequenceIndex& s, int width, int height,
+                             const SequenceOptions& options, SequenceDetections* d) {
+  std::vector<std::string> files;
+  d->status = list_json_files(dir, options, &files, &d->reason);
+  if (!d->ok()) return;
   std::vector<double> frame_t, file_t;
   std::vector<YoloJsonFrame<float>> parsed;
   for (const SequenceFrame& f : s.frames) frame_t.push_back(f.timestamp);
-  for (const std::string& file : files) {
-    YoloJsonFrame<float> j = read_yolo_json<float>(file);
+  const double tolerance = options.detection_max_difference_s;
+  const double last_frame = frame_t.empty() ? 0.0 : *std::max_element(frame_t.begin(), frame_t.end());
+  std::vector<std::uint8_t> covered(frame_t.size(), 0);
+  std::size_t frames_covered = 0;
+  const bool can_stop = !frame_t.empty() && std::is_sorted(frame_t.begin(), frame_t.end());
+  std::size_t read = 0;
+  for (; read < files.size(); ++read) {
+    if (can_stop && frames_covered == frame_t.size() && !file_t.empty() && file_t.back() > last_frame + tolerance)
+      break;
+    YoloJsonFrame<float> j = read_yolo_json<float>(files[read]);
     if (!j.ok()) {
       d->status = j.status;
       d->reason = j.reason;
       return;
     }
+    // Frames within the window of this stamp (frame stamps sorted): a cover, not the final pairing.
+    if (can_stop) {
+      const auto lo = std::lower_bound(frame_t.begin(), frame_t.end(), j.timestamp - tolerance);
+      for (auto it = lo; it != frame_t.end() && *it <= j.timestamp + tolerance; ++it) {
+        const std::size_t i = static_cast<std::size_t>(it - frame_t.begin());
+        frames_covered += covered[i] == 0;
+        covered[i] = 1;
+      }
+    }
     file_t.push_back(j.timestamp);
     parsed.push_back(std::move(j));
   }
+  if (read < files.size())
+    d->notes.add(text::quote_path(dir) + ": " + std::to_string(files.size() - read) + " files after " +
+                     text::quote_path(std::filesystem::path(files[read - 1]).filename().string()) +
+                     " not read: every frame has its detections file",
+                 options.max_notes);
   AssociationOptions ao;
-  ao.max_difference_s = options.detection_max_difference_s;
+  ao.max_difference_s = tolerance;
   const AssociationResult m = associate(frame_t, file_t, ao);
-  std::vector<std::uint8_t> file_used(files.size(), 0);
+  std::vector<std::uint8_t> file_used(file_t.size(), 0);
   for (std::size_t k = 0; k < m.size(); ++k) {
     const std::size_t i = m.first[k], j = m.second[k];
     d->has_file[i] = 1;
     file_used[j] = 1;
     keep_filtered(parsed[j].detections, width, height, options, d, &d->per_frame[i]);
   }
-  for (std::size_t j = 0; j < files.size(); ++j) {
+  for (std::size_t j = 0; j < file_t.size(); ++j) {
     if (file_used[j]) continue;
     ++d->files_unmatched;
-    d->notes.add(files[j] + ": timestamp matches no frame", options.max_notes);
+    d->notes.add(text::quote_path(files[j]) + ": timestamp matches no frame", options.max_notes);
   }
 }
 
