@@ -4,6 +4,7 @@
 /// and frames with kept / culled features drawn (PNG through OpenCV).
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
@@ -64,8 +65,8 @@ inline void count_labels(const std::vector<cv::Point2f>& px, const std::vector<s
                          const cv::Mat& moving, const std::vector<Detection<float>>& detections, LabelCounts* out) {
   if (moving.empty() || moving.type() != CV_8UC1) return;
   for (std::size_t i = 0; i < px.size(); ++i) {
-    const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
-    if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
+    int u = 0, v = 0;
+    if (!pixel_of(px[i].x, px[i].y, moving.cols, moving.rows, &u, &v)) continue;
     const bool is_moving = moving.at<std::uint8_t>(v, u) != 0;
     const bool culled = i < keep.size() && keep[i] == 0;
     if (culled && is_moving) ++out->true_positive;
@@ -126,8 +127,8 @@ struct LabelBreakdown {
            const cv::Mat& instance) {
     if (moving.empty() || instance.empty() || instance.type() != CV_16UC1) return;
     for (std::size_t i = 0; i < px.size(); ++i) {
-      const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
-      if (u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) continue;
+      int u = 0, v = 0;
+      if (!pixel_of(px[i].x, px[i].y, moving.cols, moving.rows, &u, &v)) continue;
       const CullReason why = i < reasons.size() ? reasons[i] : CullReason::None;
       int cell = std::min(static_cast<int>(why), kReasons - 1);
       if (why == CullReason::None && i < kept_why.size() && kept_why[i] != KeptWhy::NotExplained)
@@ -175,8 +176,8 @@ struct RecallBySpeed {
            const cv::Mat& motion_m, const cv::Mat& instance) {
     if (is_moving.empty() || motion_m.empty() || motion_m.type() != CV_32FC1 || instance.type() != CV_16UC1) return;
     for (std::size_t i = 0; i < px.size(); ++i) {
-      const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
-      if (u < 0 || v < 0 || u >= is_moving.cols || v >= is_moving.rows || !is_moving.at<std::uint8_t>(v, u)) continue;
+      int u = 0, v = 0;
+      if (!pixel_of(px[i].x, px[i].y, is_moving.cols, is_moving.rows, &u, &v) || !is_moving.at<std::uint8_t>(v, u)) continue;
       const float mm = 1000.f * motion_m.at<float>(v, u);
       int band = 0;
       while (band < kBands - 1 && !(mm < kUpperMm[band])) ++band;
@@ -257,8 +258,9 @@ inline bool plot_trajectories(const std::string& path, const std::string& title,
   const double scale = (size - 2 * margin) / span;
   const double ca = 0.5 * (lo[a] + hi[a]), cb = 0.5 * (lo[b] + hi[b]);
   auto to_px = [&](const Vec3<double>& p) {
-    return cv::Point(static_cast<int>(std::lround(size / 2 + (p[a] - ca) * scale)),
-                     static_cast<int>(std::lround(size / 2 - (p[b] - cb) * scale)));
+    constexpr int kFar = 1 << 20;  // far outside any plot: cv::line clips it
+    return cv::Point(clamped_int(std::round(size / 2 + (p[a] - ca) * scale), -kFar, kFar),
+                     clamped_int(std::round(size / 2 - (p[b] - cb) * scale), -kFar, kFar));
   };
   auto draw = [&](const std::vector<Vec3<double>>& pts, const cv::Scalar& colour, int thickness) {
     for (std::size_t i = 1; i < pts.size(); ++i) {
