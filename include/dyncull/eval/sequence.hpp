@@ -417,7 +417,8 @@ inline SequenceIndex read_sequence(const std::string& dir, const SequenceOptions
         kept.push_back(e);
       } else {
         ++*count;
-        s.notes.add(file + ":" + std::to_string(e.line) + ": " + e.path + " does not exist", options.max_notes);
+        s.notes.add(file + ":" + std::to_string(e.line) + ": " + text::quote_path(e.path) + " does not exist",
+                    options.max_notes);
       }
     }
     return kept;
@@ -451,8 +452,8 @@ inline SequenceIndex read_sequence(const std::string& dir, const SequenceOptions
       ++s.frames_without_depth;
       char dt[32];
       std::snprintf(dt, sizeof dt, "%g", options.max_difference_s);
-      s.notes.add(rgb_file + ":" + std::to_string(rgb[i].line) + ": frame " + std::to_string(i) + " (" + rgb[i].path +
-                      ") has no depth within " + dt + " s: it runs without depth",
+      s.notes.add(rgb_file + ":" + std::to_string(rgb[i].line) + ": frame " + std::to_string(i) + " (" +
+                      text::quote_path(rgb[i].path) + ") has no depth within " + dt + " s: it runs without depth",
                   options.max_notes);
     }
     s.frames.push_back(std::move(f));
