@@ -101,8 +101,10 @@ inline Status check_distortion(const double* coefficients, std::size_t count, st
     const double v = coefficients[i];
     const bool tangential = i == 2 || i == 3 || (i >= 8 && i < 12);
     const bool tilt = i >= 12;
-    const double bound = tilt ? CameraBounds::kMaxTiltRad
-                              : (tangential ? CameraBounds::kMaxTangentialDistortion : CameraBounds::kMaxRadialDistortion);
+    // Assigned, not chosen by ?: (an lvalue there would odr-use the constants, which C++11 must define).
+    double bound = CameraBounds::kMaxRadialDistortion;
+    if (tangential) bound = CameraBounds::kMaxTangentialDistortion;
+    if (tilt) bound = CameraBounds::kMaxTiltRad;
     if (!std::isfinite(v))
       return detail::camera_refused(reason, std::string("distortion ") + distortion_name(i) + " is NaN or Inf");
     if (!(std::abs(v) <= bound))
