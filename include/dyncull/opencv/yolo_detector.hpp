@@ -356,9 +356,14 @@ inline void decode_yolo_outputs(const std::vector<cv::Mat>& outputs, YoloHead he
 class YoloDetector {
  public:
   /// Loads the network and runs it once on a blank input to check its outputs are a YOLO head (and to
-  /// allocate its buffers). Any failure leaves the detector closed, with the reason: IoError for a
-  /// missing file, InvalidInput for bad options, a cfg without weights, an unknown model extension or
-  /// outputs that are not a YOLO head, ParseError when OpenCV cannot read the model.
+  /// allocate its buffers). The files are read under the file-opening rule of core/text_file.hpp
+  /// (regular files, not the kernel's, never waited on; cfg at most kMaxYoloCfgBytes, weights and ONNX at
+  /// most kMaxYoloModelBytes) and OpenCV parses the bytes. A Darknet cfg is followed layer by layer
+  /// (darknet_layout.hpp): the weights must have exactly the size its layers need. Any failure leaves
+  /// the detector closed, with the reason: IoError for a file that is missing, not regular, the kernel's
+  /// or over its cap; InvalidInput for bad options, a cfg without weights, an unknown model extension,
+  /// weights of another size than the cfg's layers need, or outputs that are not its YOLO heads;
+  /// ParseError for a cfg whose layers cannot be followed or a model OpenCV cannot read.
   YoloOpenResult open(const YoloDetectorOptions& options) {
     opened_ = YoloOpenResult{};
     net_ = cv::dnn::Net();
