@@ -9,6 +9,7 @@
 /// API:
 /// @code
 ///   dyncull::CullerCamera camera(fx, fy, cx, cy, 640, 480);        // plus distortion when the lens has it
+///   dyncull::check_camera(camera, 5000.0, &why);                     // at start-up: the culler's camera check
 ///   dyncull::Culler culler(camera, dyncull::CullerOptions("recommended"));   // culler.ok(), culler.reason()
 ///   dyncull::CullerFrame f;
 ///   f.keypoints = dyncull::points_view(keys);  f.descriptors = ...;  f.depth_m = ...;  // each optional:
