@@ -4,6 +4,7 @@
 /// per family. Small PNGs, so that docs/images can hold them. No paper equation.
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "report.hpp"
 #include "runner.hpp"
 
@@ -40,7 +41,7 @@ inline bool plot_family_summary(const std::string& path, const std::vector<Famil
   cv::Mat img(top + plot_h + 40 + 18 * legend_rows, std::max(width, 560), CV_8UC3, cv::Scalar(255, 255, 255));
   auto y_of = [&](double cm) {
     const double t = (std::log10(cm) - log_lo) / std::max(log_hi - log_lo, 1.0);
-    return top + plot_h - static_cast<int>(std::lround(t * plot_h));
+    return top + plot_h - clamped_int(std::round(t * plot_h), -plot_h, 2 * plot_h);  // NaN (cm <= 0): the top
   };
   const cv::Scalar ink(0, 0, 0), grid(215, 215, 215);
   for (double e = log_lo; e <= log_hi; ++e) {
