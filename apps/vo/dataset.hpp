@@ -420,7 +420,8 @@ inline std::vector<StripFrame> dataset_strip(const SequenceReport& report, const
     const std::size_t at = f.rfind("_frame");
     if (at == std::string::npos || f.size() < 4 || f.compare(f.size() - 4, 4, ".png") != 0) continue;
     const int frame = std::atoi(f.c_str() + at + 6);
-    out.push_back({f, "frame " + std::to_string(frame) + ", " + strategy + ": green kept, red culled"});
+    out.push_back({f, "frame " + std::to_string(frame) + ", " + strategy + ": green kept, red culled" +
+                          (report.has_label_truth ? "; x culled static, ring kept moving" : "")});
   }
   return out;
 }
