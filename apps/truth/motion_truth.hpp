@@ -166,14 +166,23 @@ class MotionLabeller {
 
   const MotionTruthOptions& options() const { return options_; }
 
-  /// Labels frame `t` of `frames` (all of the sequence's frames that are loaded; missing neighbours
-  /// are skipped). Frames must stay the same objects between calls for the flow cache to hold.
+  /// Labels frame `t` of `frames` (all of the sequence's frames that are loaded; neighbours without a
+  /// pose or of another image size are skipped). Frames must stay the same objects between calls for
+  /// the flow cache to hold. A frame that cannot be labelled is all unknown, and `note` says why.
   FrameTruth label(const std::vector<TruthFrame>& frames, int t, const PinholeCamera<double>& camera) {
     FrameTruth out;
+    if (t < 0 || t >= static_cast<int>(frames.size()) || frames[static_cast<std::size_t>(t)].gray.type() != CV_8UC1) {
+      out.note = "no grey frame " + std::to_string(t);
+      return out;
+    }
     const TruthFrame& ref = frames[static_cast<std::size_t>(t)];
     out.labels = cv::Mat(ref.gray.size(), CV_8UC1, cv::Scalar(kUnknown));
     if (ref.depth_m.empty() || !ref.has_pose) {
       out.note = ref.depth_m.empty() ? "no depth" : "no ground-truth pose";
+      return out;
+    }
+    if (ref.depth_m.type() != CV_32FC1 || ref.depth_m.size() != ref.gray.size()) {
+      out.note = "depth is not CV_32F metres of the grey frame's size";
       return out;
     }
     const cv::Mat usable = detail::usable_pixels(ref.depth_m, options_);
@@ -182,7 +191,9 @@ class MotionLabeller {
     for (int s : {t - k, t + k}) {
       if (s < 0 || s >= static_cast<int>(frames.size())) continue;
       const TruthFrame& other = frames[static_cast<std::size_t>(s)];
-      if (other.gray.empty() || !other.has_pose) continue;
+      if (!other.has_pose || other.gray.type() != CV_8UC1 || other.gray.size() != ref.gray.size()) continue;
+      if (!other.depth_m.empty() && (other.depth_m.type() != CV_32FC1 || other.depth_m.size() != ref.gray.size()))
+        continue;
       const detail::FlowPair& f = flows(frames, std::min(t, s), std::max(t, s));
       const cv::Mat& ts = t < s ? f.forward : f.backward;
       const cv::Mat& st = t < s ? f.backward : f.forward;
@@ -190,6 +201,7 @@ class MotionLabeller {
     }
     evict_before(t - k);
     if (out.corrections.empty()) {
+      out.with_depth = static_cast<std::size_t>(cv::countNonZero(ref.depth_m > 0));
       out.note = "no neighbour with a pose";
       return out;
     }

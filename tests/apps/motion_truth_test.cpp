@@ -146,6 +146,11 @@ TEST(MotionTruth, FrameWithoutDepthOrPoseIsUnknownWithItsReason) {
   const truth::FrameTruth alone = labeller.label(s.frames, 1, s.camera);
   EXPECT_EQ(alone.note, "no neighbour with a pose");
   EXPECT_EQ(cv::countNonZero(alone.labels != truth::kUnknown), 0);
+  EXPECT_EQ(alone.with_depth, static_cast<std::size_t>(s.camera.width * s.camera.height));
+  // A frame index outside the sequence, and depth of another size, are named, not read.
+  EXPECT_EQ(labeller.label(s.frames, 9, s.camera).note, "no grey frame 9");
+  s.frames[7].depth_m = cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.f));
+  EXPECT_EQ(labeller.label(s.frames, 7, s.camera).note, "depth is not CV_32F metres of the grey frame's size");
 }
 
 // At the sequence's ends one neighbour is enough.
