@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Installs dyncull's build, test and benchmark dependencies from Debian 12 packages.
+# Installs dyncull's build, test, benchmark and figure dependencies from Debian 12 packages.
 # Idempotent: installs only what is missing, so CI and repeated runs cost a few seconds.
 #   scripts/install-deps.sh [--orbslam2]   --orbslam2: also what Pangolin needs for scripts/orbslam2.sh
 set -euo pipefail
 
 packages=(g++ clang cmake make pkg-config libeigen3-dev libopencv-dev libceres-dev doxygen graphviz
-          libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev locales)
+          libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev locales
+          python3 python3-matplotlib)  # python3-matplotlib: scripts/figures.py draws the docs' plots
 # Open3D is an optional benchmark peer (ICP); set DYNCULL_WITH_OPEN3D=1 to install it.
 if [[ "${DYNCULL_WITH_OPEN3D:-0}" == 1 ]]; then packages+=(libopen3d-dev); fi
 # ORB-SLAM2 (scripts/orbslam2.sh) links Pangolin, which needs OpenGL, GLEW and EGL (headless backend).

@@ -291,6 +291,7 @@ run_sequence() {
         "$rgbd_tum" "$vocabulary" "$dest/orbslam2_settings.yaml" "$seq" "$associations" \
         >"$dir/rgbd_tum.log" 2>&1) || log "$variant run $run: rgbd_tum exited with status $? (see $dir/rgbd_tum.log)"
       "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" --json \
+        --poses-csv "$dir/poses.csv" \
         >"$dir/ate.json" 2>"$dir/ate.err" || true
     done
   done

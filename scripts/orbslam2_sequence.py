@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Sequence side of scripts/orbslam2.sh (standard library only).
+"""Sequence side of scripts/orbslam2.sh (standard library; the trajectory figure needs matplotlib).
 
   orbslam2_sequence.py prepare SEQUENCE OUT
       OUT/orbslam2_settings.yaml (ORB-SLAM2's settings, written from SEQUENCE/camera.txt) and
@@ -323,122 +323,31 @@ def timing_note(rows):
     return ("; ".join(parts) + ".") if parts else ""
 
 
-def read_tum(path):
-    """stamp -> (x, y, z) of a TUM trajectory file."""
-    out = {}
-    if not os.path.exists(path):
-        return out
-    with open(path) as f:
-        for line in f:
-            fields = line.split()
-            if len(fields) >= 8 and not fields[0].startswith("#"):
-                out[float(fields[0])] = tuple(float(v) for v in fields[1:4])
-    return out
-
-
-def pair_positions(truth, estimate):
-    """(truth, estimate) positions paired as associate.py: closest stamps first, each once."""
-    stamps = sorted(truth)
-    candidates = []
-    for t in estimate:
-        lo, hi = 0, len(stamps)
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if stamps[mid] < t - MAX_DIFFERENCE_S:
-                lo = mid + 1
-            else:
-                hi = mid
-        k = lo
-        while k < len(stamps) and stamps[k] < t + MAX_DIFFERENCE_S:
-            candidates.append((abs(stamps[k] - t), stamps[k], t))
-            k += 1
-    candidates.sort()
-    used_t, used_e, pairs = set(), set(), []
-    for _, g, e in candidates:
-        if g in used_t or e in used_e:
-            continue
-        used_t.add(g)
-        used_e.add(e)
-        pairs.append((e, truth[g], estimate[e]))
-    pairs.sort()
-    return [(g, e) for _, g, e in pairs]
-
-
-def horn_alignment(pairs):
-    """Rotation R and translation t with R * estimate + t closest to truth (Horn 1987, unit quaternions)."""
-    n = float(len(pairs))
-    cg = [sum(p[0][i] for p in pairs) / n for i in range(3)]
-    ce = [sum(p[1][i] for p in pairs) / n for i in range(3)]
-    S = [[sum((p[1][i] - ce[i]) * (p[0][j] - cg[j]) for p in pairs) for j in range(3)] for i in range(3)]
-    (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = S
-    N = [[xx + yy + zz, yz - zy, zx - xz, xy - yx],
-         [yz - zy, xx - yy - zz, xy + yx, zx + xz],
-         [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
-         [xy - yx, zx + xz, yz + zy, -xx - yy + zz]]
-    shift = sum(abs(v) for row in N for v in row) + 1.0  # N + shift I is positive definite: power iteration
-    q = [1.0, 0.0, 0.0, 0.0]                            # finds N's largest eigenvalue's vector
-    for _ in range(500):
-        q = [sum(N[i][j] * q[j] for j in range(4)) + shift * q[i] for i in range(4)]
-        norm = sum(v * v for v in q) ** 0.5
-        q = [v / norm for v in q]
-    w, x, y, z = q
-    R = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-    t = [cg[i] - sum(R[i][j] * ce[j] for j in range(3)) for i in range(3)]
-    return R, t
-
-
-COLOURS = {"truth": "#000000", "stock": "#d62728", "box_only": "#ff7f0e", "culler": "#1f77b4"}
-
-
-def plot_trajectories(sequence, out, rows, svg_path):
-    """Top view (the two axes of largest ground-truth extent) of the ground truth and, per variant, the
-    run with the median ATE, aligned as the ATE aligns it. Returns the runs drawn."""
-    truth = read_tum(os.path.join(sequence, "groundtruth.txt"))
-    curves, drawn = {}, []
+def median_runs(out, rows):
+    """Per variant, the run with the median ATE that has dyncull_eval's poses.csv (its pairs, aligned as the
+    ATE aligns them): [(variant, run, ate_m, poses path)]."""
+    chosen = []
     for variant in VARIANTS:
-        mine = sorted((float(r["ate_rmse_m"]), r["run"]) for r in rows if r["variant"] == variant and r["ate_rmse_m"])
+        mine = sorted((float(r["ate_rmse_m"]), int(r["run"])) for r in rows if r["variant"] == variant and r["ate_rmse_m"])
         if not mine:
             continue
         ate, run = mine[(len(mine) - 1) // 2]
-        pairs = pair_positions(truth, read_tum(os.path.join(out, "runs", variant, "run%d" % run, "CameraTrajectory.txt")))
-        if len(pairs) < 3:
-            continue
-        R, t = horn_alignment(pairs)
-        curves[variant] = [[sum(R[i][j] * e[j] for j in range(3)) + t[i] for i in range(3)] for _, e in pairs]
-        drawn.append((variant, run, ate))
-    if not curves:
-        return drawn
-    stamps = sorted(truth)
-    gt = [truth[s] for s in stamps]
-    extent = [max(p[i] for p in gt) - min(p[i] for p in gt) for i in range(3)]
-    a, b = sorted(range(3), key=lambda i: -extent[i])[:2]
-    everything = gt + [p for c in curves.values() for p in c]
-    lo_a, hi_a = min(p[a] for p in everything), max(p[a] for p in everything)
-    lo_b, hi_b = min(p[b] for p in everything), max(p[b] for p in everything)
-    size, margin = 520.0, 40.0
-    scale = (size - 2 * margin) / max(hi_a - lo_a, hi_b - lo_b, 1e-6)
-    def xy(p):
-        return "%.1f,%.1f" % (margin + (p[a] - lo_a) * scale, size - margin - (p[b] - lo_b) * scale)
-    legend = [("ground truth", "truth")] + [("%s (run %d, ATE %.1f cm)" % (v, r, 100 * e), v) for v, r, e in drawn]
-    lines = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" font-size="12">'
-             % (size, size + 18 * len(legend)), '<rect width="100%" height="100%" fill="white"/>']
-    for name, points, width in [("truth", gt, 2.5)] + [(v, curves[v], 1.5) for v in VARIANTS if v in curves]:
-        lines.append('<polyline fill="none" stroke="%s" stroke-width="%.1f" points="%s"/>'
-                     % (COLOURS[name], width, " ".join(xy(p) for p in points)))
-    for k, (label, key) in enumerate(legend):
-        y = size + 18 * k
-        lines.append('<line x1="%d" y1="%d" x2="%d" y2="%d" stroke="%s" stroke-width="3"/>' % (margin, y, margin + 20, y, COLOURS[key]))
-        lines.append('<text x="%d" y="%d">%s</text>' % (margin + 26, y + 4, label))
-    scale_bar = 0.5 * scale
-    lines.append('<line x1="%.1f" y1="20" x2="%.1f" y2="20" stroke="black" stroke-width="2"/>' % (size - margin - scale_bar, size - margin))
-    lines.append('<text x="%.1f" y="14">0.5 m</text>' % (size - margin - scale_bar))
-    lines.append('<text x="10" y="16">top view, axes %s-%s of the ground truth</text>' % ("xyz"[a], "xyz"[b]))
-    lines.append("</svg>")
-    with open(svg_path, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    return drawn
+        poses = os.path.join(out, "runs", variant, "run%d" % run, "poses.csv")
+        if os.path.exists(poses):
+            chosen.append((variant, run, ate, poses))
+    return chosen
+
+
+def plot_trajectories(name, out, rows, path):
+    """scripts/figures.py's trajectory panels (matplotlib) of each variant's median run. Returns the runs drawn."""
+    chosen = median_runs(out, rows)
+    if chosen:
+        import figures  # matplotlib: only when there is something to draw
+        runs = {}
+        for variant, run, _, poses in chosen:
+            runs.update(figures.read_poses(poses, "%s (run %d)" % (variant, run)))
+        figures.plot_trajectories(runs, "ORB-SLAM2 on %s" % name, path)
+    return chosen
 
 
 def machine():
@@ -457,7 +366,7 @@ def write_page(page, table, rows, sequence, out, vocabulary, command):
     trained = "synthetic" in voc
     image = "images/orbslam2_%s_trajectories.svg" % name
     os.makedirs(os.path.join(os.path.dirname(os.path.abspath(page)), "images"), exist_ok=True)
-    drawn = plot_trajectories(sequence, out, rows, os.path.join(os.path.dirname(os.path.abspath(page)), image))
+    drawn = plot_trajectories(name, out, rows, os.path.join(os.path.dirname(os.path.abspath(page)), image))
     section = "\n".join([
         "## In ORB-SLAM2",
         "",

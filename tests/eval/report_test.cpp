@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <clocale>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -84,6 +86,35 @@ TEST(EvalRun, MalformedFileGivesFileAndLine) {
   args.estimate_path = dir + "/does_not_exist.txt";
   EXPECT_EQ(run_eval(args).status, Status::IoError);
   EXPECT_NE(format_report_json(run_eval(args)).find("\"status\": \"i/o error\""), std::string::npos);
+}
+
+// --poses-csv: one row per pair in stamp order; an estimate that is the truth moved rigidly comes back
+// onto the truth after the alignment, with zero error.
+TEST(EvalRun, PosesCsvHoldsEachPairAligned) {
+  const std::string dir = ::testing::TempDir();
+  const std::string truth = dir + "/dyncull_eval_poses_truth.txt";
+  const std::string moved = dir + "/dyncull_eval_poses_moved.txt";
+  std::ofstream(truth) << "1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n3 1 1 0 0 0 0 1\n4 0 1 1 0 0 0 1\n";
+  std::ofstream(moved) << "1 5 0 0 0 0 0 1\n2 5 1 0 0 0 0 1\n3 4 1 0 0 0 0 1\n4 4 0 1 0 0 0 1\n";  // turned 90 deg, shifted
+  const ParseArgsResult parsed = parse({truth.c_str(), moved.c_str(), "--poses-csv", "poses.csv"});
+  ASSERT_TRUE(parsed.ok()) << parsed.reason;
+  EXPECT_EQ(parsed.args.poses_csv, "poses.csv");
+  EXPECT_FALSE(parse({truth.c_str(), moved.c_str(), "--poses-csv"}).ok());
+  const std::string csv = format_poses_csv(run_eval(parsed.args));
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "stamp,gt_x,gt_y,gt_z,x,y,z,error_m");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
+  std::istringstream rows(csv.substr(csv.find('\n') + 1));
+  std::string row;
+  double expected_stamp = 1.0;
+  while (std::getline(rows, row)) {
+    std::vector<double> v;
+    std::istringstream fields(row);
+    for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+    ASSERT_EQ(v.size(), 8u) << row;
+    EXPECT_DOUBLE_EQ(v[0], expected_stamp++);
+    for (int k = 1; k <= 3; ++k) EXPECT_NEAR(v[k + 3], v[k], 1e-6) << row;
+    EXPECT_NEAR(v[7], 0.0, 1e-6) << row;
+  }
 }
 
 TEST(EvalRun, RealDataPrintsTheTumScriptsLines) {

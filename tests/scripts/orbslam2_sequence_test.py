@@ -1,11 +1,10 @@
 #!/usr/bin/env python3
 """Tests of scripts/orbslam2_sequence.py (run by ctest): rgb and depth paired as associate.py (closest
 first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
-Horn's alignment recovers a known rotation and translation; a run's lost frames are counted against the
+the trajectory figure takes each variant's median run as dyncull_eval aligned it; a run's lost frames are counted against the
 associations (ORB-SLAM2 leaves them out of its trajectory); the summary has a row per variant and run with
 the required columns, and a run without a trajectory is reported, not dropped."""
 import json
-import math
 import os
 import shutil
 import struct
@@ -111,19 +110,38 @@ class Sequence(unittest.TestCase):
         self.assertEqual((row["variant"], row["detector_ms"], row["box_age_frames"]), ("culler_live", "41.5", "1.50"))
 
 
-class Alignment(unittest.TestCase):
-    def test_horn_recovers_a_rotation_and_translation(self):
-        angle = 0.7
-        c, s = math.cos(angle), math.sin(angle)
-        R = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-        t = [0.5, -1.0, 2.0]
-        estimate = [(0.0, 0.0, 0.0), (1.0, 0.2, 0.0), (0.3, 1.5, 0.4), (-0.7, 0.1, 1.2), (0.2, -0.9, -0.5)]
-        truth = [tuple(sum(R[i][j] * p[j] for j in range(3)) + t[i] for i in range(3)) for p in estimate]
-        R_fit, t_fit = seq.horn_alignment(list(zip(truth, estimate)))
-        for i in range(3):
-            self.assertAlmostEqual(t_fit[i], t[i], places=9)
-            for j in range(3):
-                self.assertAlmostEqual(R_fit[i][j], R[i][j], places=9)
+class Trajectories(unittest.TestCase):
+    """The trajectory figure shows each variant's median-ATE run as dyncull_eval aligned it (its poses.csv)."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="dyncull_orbslam2_plot_test_")
+        self.rows = [{"variant": "stock", "run": str(k), "ate_rmse_m": ate} for k, ate in ((1, "0.30"), (2, "0.10"), (3, "0.20"))]
+        self.rows.append({"variant": "culler", "run": "1", "ate_rmse_m": "0.02"})
+        self.rows.append({"variant": "box_only", "run": "1", "ate_rmse_m": ""})  # no trajectory
+        for variant, run in (("stock", 1), ("stock", 2), ("stock", 3), ("culler", 1)):
+            run_dir = os.path.join(self.dir, "runs", variant, "run%d" % run)
+            os.makedirs(run_dir)
+            with open(os.path.join(run_dir, "poses.csv"), "w") as f:
+                f.write("stamp,gt_x,gt_y,gt_z,x,y,z,error_m\n")
+                for i in range(5):
+                    f.write("%d.0,%d,0,%d,%d,0.01,%d,0.01\n" % (i, i, i % 2, i, i % 2))
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def test_median_run_of_each_variant(self):
+        chosen = seq.median_runs(self.dir, self.rows)
+        self.assertEqual([(v, r, a) for v, r, a, _ in chosen], [("stock", 3, 0.2), ("culler", 1, 0.02)])
+        self.assertTrue(chosen[0][3].endswith(os.path.join("runs", "stock", "run3", "poses.csv")))
+
+    def test_figure_is_drawn_from_the_poses(self):
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            self.skipTest("python3-matplotlib is not installed (scripts/install-deps.sh installs it)")
+        path = os.path.join(self.dir, "trajectories.svg")
+        self.assertEqual(len(seq.plot_trajectories("seq", self.dir, self.rows, path)), 2)
+        self.assertIn("<svg", open(path).read())
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ struct EvalCommandLine {
   double max_difference_s = 0.02;            ///< --max-difference S
   double offset_s = 0.0;                     ///< --offset S (added to the estimate's stamps)
   bool json = false;                         ///< --json
+  std::string poses_csv;                     ///< --poses-csv FILE: each pair, aligned, for plots
   bool help = false;                         ///< -h / --help
 };
 
@@ -50,12 +51,13 @@ struct EvalReport {
   AteResult<double> ate;
   RpeResult<double> rpe;  ///< computed when args.rpe
   double rpe_scale = 1.0; ///< fixed scale applied to the estimate's relative motions (ATE scale with --scale)
+  Trajectory<double> groundtruth, estimate;  ///< as read, for format_poses_csv
 };
 
 inline std::string eval_usage(const std::string& program = "dyncull_eval") {
   return "usage: " + program +
          " GROUNDTRUTH ESTIMATE [--rpe] [--delta N] [--delta-unit frames|seconds|metres|degrees|radians]\n"
-         "       [--scale] [--max-difference S] [--offset S] [--json]\n"
+         "       [--scale] [--max-difference S] [--offset S] [--json] [--poses-csv FILE]\n"
          "\n"
          "Evaluates an estimated trajectory against ground truth, both TUM files\n"
          "(timestamp tx ty tz qx qy qz qw; '#' comments). Numbers equal the TUM benchmark scripts'.\n"
@@ -74,6 +76,8 @@ inline std::string eval_usage(const std::string& program = "dyncull_eval") {
          "  --max-difference S association window in seconds (default 0.02)\n"
          "  --offset S         time offset added to the estimate's stamps (default 0)\n"
          "  --json             machine-readable output\n"
+         "  --poses-csv FILE   also write each associated pair (stamp, ground-truth position, aligned estimate\n"
+         "                     position, error) as CSV: the data of trajectory and error-over-time plots\n"
          "  -h, --help         this text\n"
          "\n"
          "Exit status: 0 ok, 1 evaluation failed (bad file: the message gives file:line), 2 bad arguments.\n";
@@ -194,6 +198,8 @@ inline ParseArgsResult parse_eval_args(int argc, const char* const* argv) {
       if (!value(&v) || !detail::parse_number_arg(v, &a.max_difference_s) || !(a.max_difference_s > 0)) {
         return fail("--max-difference needs a positive number of seconds");
       }
+    } else if (arg == "--poses-csv") {
+      if (!value(&a.poses_csv) || a.poses_csv.empty()) return fail("--poses-csv needs a file name");
     } else if (arg == "--offset") {
       if (!value(&v) || !detail::parse_number_arg(v, &a.offset_s)) return fail("--offset needs a number of seconds");
     } else if (arg.size() > 1 && arg[0] == '-') {
@@ -231,6 +237,8 @@ inline EvalReport run_eval(const EvalCommandLine& args) {
   report.estimate_poses = est.trajectory.size();
   report.groundtruth_skipped = gt.num_skipped;
   report.estimate_skipped = est.num_skipped;
+  report.groundtruth = gt.trajectory;
+  report.estimate = est.trajectory;
 
   AteOptions ate_options;
   ate_options.association.max_difference_s = args.max_difference_s;
@@ -256,6 +264,24 @@ inline EvalReport run_eval(const EvalCommandLine& args) {
     }
   }
   return report;
+}
+
+/// The ATE's pairs in ground-truth stamp order as CSV, `stamp,gt_x,gt_y,gt_z,x,y,z,error_m`: the
+/// ground truth's stamp and position, the estimate's position after the ATE's alignment, and the
+/// distance between them (metres, %.6f). A report without an ATE gives the header alone.
+inline std::string format_poses_csv(const EvalReport& r) {
+  std::string out = "stamp,gt_x,gt_y,gt_z,x,y,z,error_m\n";
+  if (!r.ate.ok()) return out;
+  char line[256];
+  for (std::size_t k = 0; k < r.ate.groundtruth_index.size(); ++k) {
+    const std::size_t g = r.ate.groundtruth_index[k], e = r.ate.estimate_index[k];
+    const Vec3<double> truth = r.groundtruth.poses[g].t;
+    const Vec3<double> aligned = r.ate.groundtruth_from_estimate.apply(r.estimate.poses[e].t);
+    std::snprintf(line, sizeof(line), "%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", r.groundtruth.stamps[g], truth.x(),
+                  truth.y(), truth.z(), aligned.x(), aligned.y(), aligned.z(), (aligned - truth).norm());
+    out += line;
+  }
+  return out;
 }
 
 /// TUM-script lines (evaluate_ate.py / evaluate_rpe.py --verbose names and %f format), preceded by
