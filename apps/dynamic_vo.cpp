@@ -544,7 +544,6 @@ int main(int argc, char** argv) try {
                " frames a sequence)\n";
     std::ofstream(args.out + "/family_summary.md") << summary;
     std::ofstream(args.out + "/family_summary.csv") << vo::family_summary_csv(rows);
-    if (vo::plot_family_summary(args.out + "/family_summary.png", rows)) figures.push_back("family_summary.png");
     if (vo::write_frame_strip(args.out + "/frame_strip.png", family_frames(reports))) figures.push_back("frame_strip.png");
     table = summary + "\n" + table;
   }

@@ -57,8 +57,15 @@ def rmse(values):
 
 
 def grid_shape(n):
-    cols = min(n, 4)
+    """Columns for n panels: 3 up to 9 panels, 4 beyond, so few panels stay large."""
+    cols = min(n, 3 if n <= 9 else 4)
     return (n + cols - 1) // cols, cols
+
+
+def limits(values):
+    lo, hi = min(values), max(values)
+    pad = 0.05 * max(hi - lo, 1e-3)
+    return lo - pad, hi + pad
 
 
 def plot_trajectories(runs, name, path):
@@ -67,9 +74,13 @@ def plot_trajectories(runs, name, path):
     a, b = top_view_axes(truth)
     errors = sorted(e for r in runs.values() for e in r["error"])
     vmax = max(errors[int(0.95 * (len(errors) - 1))], 1e-3)  # the 95th percentile: one outlier keeps the scale
+    points = truth + [p for r in runs.values() for p in r["est"]]
+    xlim, ylim = limits([p[a] for p in points]), limits([p[b] for p in points])
+    aspect = (ylim[1] - ylim[0]) / (xlim[1] - xlim[0])  # panel height over width at equal scale
     rows, cols = grid_shape(len(runs))
-    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 3.2 * rows + 0.6), sharex=True, sharey=True,
-                             squeeze=False, constrained_layout=True)
+    panel = 3.6  # inches per panel's width
+    fig, axes = plt.subplots(rows, cols, figsize=(panel * cols + 1.2, (panel * min(aspect, 1.5) + 0.5) * rows + 0.5),
+                             sharex=True, sharey=True, squeeze=False, constrained_layout=True)
     for ax, (strategy, run) in zip(axes.flat, runs.items()):
         ax.plot([p[a] for p in truth], [p[b] for p in truth], color="0.6", lw=2.5, label="ground truth")
         xy = [(p[a], p[b]) for p in run["est"]]
@@ -80,10 +91,8 @@ def plot_trajectories(runs, name, path):
         ax.set_title("%s: ATE %.1f cm" % (strategy, 100 * rmse(run["error"])), fontsize=9)
         ax.set_aspect("equal", adjustable="box")
         ax.grid(True, color="0.9")
-    points = truth + [p for r in runs.values() for p in r["est"]]
-    for axis, setter in ((a, axes[0, 0].set_xlim), (b, axes[0, 0].set_ylim)):
-        lo, hi = min(p[axis] for p in points), max(p[axis] for p in points)
-        setter(lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))  # shared: every panel gets these limits
+    axes[0, 0].set_xlim(*xlim)  # shared: every panel gets these limits
+    axes[0, 0].set_ylim(*ylim)
     for ax in axes.flat[len(runs):]:
         ax.axis("off")
     for ax in axes[-1]:
