@@ -38,9 +38,24 @@ def met_text(ok):
     return "not measured" if ok is None else ("**yes**" if ok else "**no**")
 
 
-def run_info(directory, script):
+def run_info(directory, script="scripts/results.sh"):
     """run_info.txt (machine, compiler, libraries, commit, command) as a Markdown list."""
     path = os.path.join(directory, "run_info.txt")
     if not os.path.exists(path):
         return "- (run_info.txt not found: run %s to record machine, compiler and commit)" % script
     return "\n".join("- " + line for line in read(path).strip().splitlines())
+
+
+def table_lines(markdown):
+    """The first Markdown table of a file and the paragraph that follows it (its legend)."""
+    lines, out, in_table = markdown.splitlines(), [], False
+    for i, line in enumerate(lines):
+        if line.startswith("|"):
+            in_table = True
+            out.append(line)
+        elif in_table:
+            rest = [l for l in lines[i:] if l.strip()]
+            if rest and not rest[0].startswith("Command"):
+                out += ["", rest[0]]
+            break
+    return "\n".join(out)
