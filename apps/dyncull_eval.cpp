@@ -1,6 +1,7 @@
 // dyncull_eval: TUM-exact ATE / RPE of an estimated trajectory against ground truth.
 //   dyncull_eval GROUNDTRUTH ESTIMATE [--rpe] [--delta N] [--delta-unit frames|seconds] [--scale]
 //                [--max-difference S] [--json] [--poses-csv FILE]
+//   dyncull_eval --associate FIRST_LIST SECOND_LIST [--max-difference S]   (rgb.txt / depth.txt pairs)
 // The logic lives in dyncull/eval/report.hpp (tested there); this file only wires it to stdio.
 #include "dyncull/eval/report.hpp"
 
@@ -26,6 +27,15 @@ int main(int argc, char** argv) {
   }
   if (parsed.args.help) {
     std::fputs(eval_usage(program).c_str(), stdout);
+    return 0;
+  }
+  if (parsed.args.associate_lists) {
+    const ListAssociation pairs = associate_lists(parsed.args);
+    if (!pairs.ok()) {
+      std::fprintf(stderr, "%s: %s\n", program.c_str(), pairs.reason.c_str());
+      return 1;
+    }
+    std::fputs(pairs.text.c_str(), stdout);
     return 0;
   }
   const EvalReport report = run_eval(parsed.args);

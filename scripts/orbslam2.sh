@@ -274,7 +274,7 @@ variant_environment() {
 run_sequence() {
   local seq=$1 dest=$2 variant run dir detections associations settings=()
   mkdir -p "$dest"
-  python3 "$root/scripts/orbslam2_sequence.py" prepare "$seq" "$dest"
+  python3 "$root/scripts/orbslam2_sequence.py" prepare "$seq" "$dest" --dyncull-eval "$dyncull_prefix/bin/dyncull_eval"
   detections=$(detections_of "$seq")
   for variant in "${variant_list[@]}"; do
     associations="$dest/associations.txt"

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Sequence side of scripts/orbslam2.sh (standard library; the trajectory figure needs matplotlib).
 
-  orbslam2_sequence.py prepare SEQUENCE OUT
+  orbslam2_sequence.py prepare SEQUENCE OUT [--dyncull-eval PATH]
       OUT/orbslam2_settings.yaml (ORB-SLAM2's settings, written from SEQUENCE/camera.txt) and
-      OUT/associations.txt (rgb and depth paired as the TUM benchmark's associate.py: |dt| < 0.02 s,
-      closest pairs first, each stamp once); when SEQUENCE has rgb_color.txt (colour frames of the same
+      OUT/associations.txt (rgb and depth paired by `dyncull_eval --associate` as the TUM benchmark's
+      associate.py: |dt| < 0.02 s, closest pairs first, each stamp once); when SEQUENCE has rgb_color.txt (colour frames of the same
       stamps, for a live detector), OUT/associations_color.txt pairs those with depth the same way.
   orbslam2_sequence.py summarise SEQUENCE OUT [--vocabulary FILE] [--command TEXT] [--page FILE]
       reads OUT/runs/VARIANT/runN/ (rgbd_tum.log, CameraTrajectory.txt, ate.json), writes
@@ -29,7 +29,6 @@ import struct
 import subprocess
 import sys
 
-MAX_DIFFERENCE_S = 0.02
 # culler: boxes from the detections folder; culler_live: a detector running beside the tracker (newest
 # finished boxes); culler_live_sync: the detector waited for on every frame.
 VARIANTS = ["stock", "box_only", "culler", "culler_live", "culler_live_sync"]
@@ -46,25 +45,18 @@ def read_list(path):
     return out
 
 
-def associate(rgb, depth):
-    """associate.py's greedy pairing: candidate pairs under the window, closest first, each stamp once."""
-    candidates = []
-    depth_stamps = [float(s) for s, _ in depth]
-    for i, (stamp, _) in enumerate(rgb):
-        t = float(stamp)
-        for j, d in enumerate(depth_stamps):
-            if abs(d - t) < MAX_DIFFERENCE_S:
-                candidates.append((abs(d - t), i, j))
-    candidates.sort()
-    used_rgb, used_depth, pairs = set(), set(), []
-    for _, i, j in candidates:
-        if i in used_rgb or j in used_depth:
-            continue
-        used_rgb.add(i)
-        used_depth.add(j)
-        pairs.append((i, j))
-    pairs.sort()
-    return [(rgb[i][0], rgb[i][1], depth[j][0], depth[j][1]) for i, j in pairs]
+def associate(dyncull_eval, first, second):
+    """Lines "stamp file stamp file" of two lists paired as the TUM benchmark's associate.py (|dt| < 0.02 s,
+    closest pairs first, each stamp once), by `dyncull_eval --associate`."""
+    done = subprocess.run([dyncull_eval, "--associate", first, second], capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit("orbslam2_sequence.py: %s --associate: %s" % (dyncull_eval, done.stderr.strip()))
+    return done.stdout.splitlines()
+
+
+def write_lines(path, lines):
+    with open(path, "w") as f:
+        f.write("".join(line + "\n" for line in lines))
 
 
 def read_camera(path):
@@ -138,7 +130,7 @@ Viewer.ViewpointF: 500
 """
 
 
-def prepare(sequence, out):
+def prepare(sequence, out, dyncull_eval):
     camera = read_camera(os.path.join(sequence, "camera.txt"))
     rgb = read_list(os.path.join(sequence, "rgb.txt"))
     depth = read_list(os.path.join(sequence, "depth.txt"))
@@ -151,18 +143,15 @@ def prepare(sequence, out):
         **{k: camera.get(k, 0.0) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")})
     with open(os.path.join(out, "orbslam2_settings.yaml"), "w") as f:
         f.write(settings)
-    pairs = associate(rgb, depth)
-    with open(os.path.join(out, "associations.txt"), "w") as f:
-        for p in pairs:
-            f.write("%s %s %s %s\n" % p)
+    depth_list = os.path.join(sequence, "depth.txt")
+    pairs = associate(dyncull_eval, os.path.join(sequence, "rgb.txt"), depth_list)
+    write_lines(os.path.join(out, "associations.txt"), pairs)
     print("orbslam2_sequence.py: %d rgb frames, %d with a depth partner (associations.txt), %dx%d"
           % (len(rgb), len(pairs), width, height), file=sys.stderr)
     colour_list = os.path.join(sequence, "rgb_color.txt")
     if os.path.exists(colour_list):
-        colour_pairs = associate(read_list(colour_list), depth)
-        with open(os.path.join(out, "associations_color.txt"), "w") as f:
-            for p in colour_pairs:
-                f.write("%s %s %s %s\n" % p)
+        colour_pairs = associate(dyncull_eval, colour_list, depth_list)
+        write_lines(os.path.join(out, "associations_color.txt"), colour_pairs)
         print("orbslam2_sequence.py: %d colour frames with a depth partner (associations_color.txt)"
               % len(colour_pairs), file=sys.stderr)
 
@@ -501,11 +490,13 @@ def main():
     parser.add_argument("--vocabulary", default="")
     parser.add_argument("--command", default="scripts/orbslam2.sh")
     parser.add_argument("--page", default="")
+    parser.add_argument("--dyncull-eval", default=os.environ.get("DYNCULL_EVAL", "dyncull_eval"),
+                        help="the dyncull_eval program (default: $DYNCULL_EVAL, else dyncull_eval on the PATH)")
     a = parser.parse_args()
     if a.action == "families":
         families(a.sequence, a.command, a.page)
     elif a.action == "prepare":
-        prepare(a.sequence, a.out)
+        prepare(a.sequence, a.out, a.dyncull_eval)
     else:
         summarise(a.sequence, a.out, a.vocabulary, a.command, a.page)
 

@@ -117,6 +117,24 @@ TEST(EvalRun, PosesCsvHoldsEachPairAligned) {
   }
 }
 
+// --associate: rgb.txt and depth.txt pairs as associate.py makes them: depth 1.052 is within the window of rgb
+// 1.033 (0.019 s) and rgb 1.067 (0.015 s), the closer one gets it; rgb 1.100 has no depth within 0.02 s.
+TEST(EvalRun, AssociateListsPairsClosestFirstEachStampOnce) {
+  const std::string dir = ::testing::TempDir();
+  const std::string rgb = dir + "/dyncull_eval_rgb.txt", depth = dir + "/dyncull_eval_depth.txt";
+  std::ofstream(rgb) << "# color images\n1.000000 rgb/1.png\n1.033333 rgb/2.png\n1.066667 rgb/3.png\n1.100000 rgb/4.png\n";
+  std::ofstream(depth) << "# depth maps\n1.010000 depth/a.png\n1.052000 depth/b.png\n1.130000 depth/c.png\n";
+  const ParseArgsResult parsed = parse({"--associate", rgb.c_str(), depth.c_str()});
+  ASSERT_TRUE(parsed.ok()) << parsed.reason;
+  const ListAssociation pairs = associate_lists(parsed.args);
+  ASSERT_TRUE(pairs.ok()) << pairs.reason;
+  EXPECT_EQ(pairs.text, "1.000000 rgb/1.png 1.010000 depth/a.png\n1.066667 rgb/3.png 1.052000 depth/b.png\n");
+  std::ofstream(depth) << "1.000000\n";  // a line without its file
+  const ListAssociation bad = associate_lists(parsed.args);
+  EXPECT_EQ(bad.status, Status::ParseError);
+  EXPECT_EQ(bad.reason.rfind(depth + ":1: ", 0), 0u) << bad.reason;
+}
+
 TEST(EvalRun, RealDataPrintsTheTumScriptsLines) {
   const char* root = std::getenv("DYNCULL_DATA_DIR");
   if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Tests of scripts/orbslam2_sequence.py (run by ctest): rgb and depth paired as associate.py (closest
-first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
+"""Tests of scripts/orbslam2_sequence.py (run by ctest): rgb and depth paired by dyncull_eval --associate as
+associate.py (closest first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
 the trajectory figure takes each variant's median run as dyncull_eval aligned it; a run's lost frames are counted against the
 associations (ORB-SLAM2 leaves them out of its trajectory); the summary has a row per variant and run with
 the required columns, and a run without a trajectory is reported, not dropped."""
@@ -27,6 +27,11 @@ def write_png(path, width, height):
                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
+# The pairing is dyncull_eval's (ctest passes the built program in DYNCULL_EVAL).
+DYNCULL_EVAL = os.environ.get("DYNCULL_EVAL", "")
+
+
+@unittest.skipUnless(DYNCULL_EVAL and os.access(DYNCULL_EVAL, os.X_OK), "DYNCULL_EVAL names no dyncull_eval program")
 class Sequence(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.mkdtemp(prefix="dyncull_orbslam2_test_")
@@ -46,14 +51,13 @@ class Sequence(unittest.TestCase):
         shutil.rmtree(self.dir)
 
     def test_pairs_closest_first_each_stamp_once(self):
-        pairs = seq.associate(seq.read_list(os.path.join(self.dir, "rgb.txt")),
-                              seq.read_list(os.path.join(self.dir, "depth.txt")))
-        self.assertEqual([(p[0], p[1], p[2], p[3]) for p in pairs],
-                         [("1.000000", "rgb/1.000000.png", "1.010000", "depth/a.png"),
-                          ("1.066667", "rgb/1.066667.png", "1.052000", "depth/b.png")])
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
+        self.assertEqual(open(os.path.join(self.dir, "associations.txt")).read().splitlines(),
+                         ["1.000000 rgb/1.000000.png 1.010000 depth/a.png",
+                          "1.066667 rgb/1.066667.png 1.052000 depth/b.png"])
 
     def test_settings_from_camera_and_image_size(self):
-        seq.prepare(self.dir, self.dir)
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
         text = open(os.path.join(self.dir, "orbslam2_settings.yaml")).read()
         self.assertTrue(text.startswith("%YAML:1.0\n"))
         for line in ("Camera.fx: 542.8", "Camera.cy: 237.7", "Camera.k1: 0.0", "Camera.width: 64",
@@ -62,7 +66,7 @@ class Sequence(unittest.TestCase):
         self.assertEqual(seq.count_lines(os.path.join(self.dir, "associations.txt")), 2)
 
     def test_lost_frames_and_summary_rows(self):
-        seq.prepare(self.dir, self.dir)
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
         good = os.path.join(self.dir, "runs", "culler", "run1")
         empty = os.path.join(self.dir, "runs", "culler", "run2")
         os.makedirs(good)
@@ -92,7 +96,7 @@ class Sequence(unittest.TestCase):
     def test_live_variant_reads_detector_time_and_box_age(self):
         with open(os.path.join(self.dir, "rgb_color.txt"), "w") as f:
             f.write("# colour\n1.000000 rgb_color/1.000000.jpg\n1.066667 rgb_color/1.066667.jpg\n")
-        seq.prepare(self.dir, self.dir)
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
         self.assertEqual(seq.count_lines(os.path.join(self.dir, "associations_color.txt")), 2)
         run = os.path.join(self.dir, "runs", "culler_live", "run1")
         os.makedirs(run)
