@@ -24,6 +24,7 @@ import matplotlib
 matplotlib.use("Agg")  # files only, no display
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 PEOPLE_SHADE = "#f3d9a4"
 
@@ -148,14 +149,16 @@ def plot_family_summary(rows, path):
     strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     ate = {(r["family"], r["strategy"]): 100 * float(r["median_ate_m"]) for r in rows}
     width = 0.8 / len(strategies)
-    colours = plt.get_cmap("tab20")
+    colours = plt.get_cmap("tab10" if len(strategies) <= 10 else "tab20")
     fig, ax = plt.subplots(figsize=(max(7, 1.1 * len(families) + 3), 4.2), constrained_layout=True)
     for s, strategy in enumerate(strategies):
         xs = [f + (s - (len(strategies) - 1) / 2) * width for f, family in enumerate(families)
               if (family, strategy) in ate]
         ys = [ate[(family, strategy)] for family in families if (family, strategy) in ate]
-        ax.bar(xs, ys, width, color=colours(s % 20), label=strategy)
+        ax.bar(xs, ys, width, color=colours(s % colours.N), label=strategy)
     ax.set_yscale("log")
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))  # 1, 10 rather than 10^0, 10^1
+    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: "%g" % v if str(v)[0] in "25" else ""))
     ax.set_xticks(range(len(families)))
     ax.set_xticklabels(families, rotation=20, ha="right", fontsize=8)
     ax.set_ylabel("median ATE RMSE (cm, log scale)")
