@@ -1,7 +1,7 @@
 /// @file report.hpp
 /// Outputs of the dynamic_vo demo: per-feature label counts against the sim's per-pixel motion truth
-/// (precision / recall of the dynamic labels, DLD-SLAM eq. 6-7 style tables), a top-view trajectory plot
-/// and frames with kept / culled features drawn (PNG through OpenCV).
+/// (precision / recall of the dynamic labels, DLD-SLAM eq. 6-7 style tables) and frames with kept / culled
+/// features drawn (PNG through OpenCV).
 #pragma once
 
 #include "dyncull/core/box.hpp"
