@@ -9,7 +9,8 @@
   orbslam2_sequence.py summarise SEQUENCE OUT [--vocabulary FILE] [--command TEXT] [--page FILE]
       reads OUT/runs/VARIANT/runN/ (rgbd_tum.log, CameraTrajectory.txt, ate.json), writes
       OUT/orbslam2_summary.csv (a row per variant and run) and prints the table; with --page, replaces
-      (or appends) the page's "## In ORB-SLAM2" section.
+      (or appends) the page's "## In ORB-SLAM2" section, with the trajectory figure of each variant's
+      median run drawn by scripts/figures.py from that run's poses.csv (dyncull_eval --poses-csv).
 
   orbslam2_sequence.py families OUT [--command TEXT] [--page FILE]
       reads OUT/families/NAME/orbslam2_summary.csv (one folder per family and camera motion), writes
