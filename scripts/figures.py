@@ -19,7 +19,10 @@ import math
 import os
 import sys
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError:
+    sys.exit("figures.py: needs matplotlib (Debian's python3-matplotlib, which scripts/install-deps.sh installs)")
 
 matplotlib.use("Agg")  # files only, no display
 import matplotlib.pyplot as plt  # noqa: E402

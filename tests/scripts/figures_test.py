@@ -10,6 +10,7 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
 try:
+    import matplotlib  # noqa: F401
     import figures  # noqa: E402
 except ImportError:
     figures = None
