@@ -115,7 +115,7 @@ if [[ -z "$real_only" ]]; then
   done
 fi
 if [[ -n "$real" ]]; then
-  python3 "$root/scripts/figures.py" "$real"
+  if compgen -G "$real/*_poses.csv" >/dev/null; then python3 "$root/scripts/figures.py" "$real"; fi
   for f in trajectories.png ate_over_time.png frame_strip.png; do
     [[ -f "$real/crowd_part1_$f" ]] && cp "$real/crowd_part1_$f" "$root/docs/images/bonn_crowd_part1_$f"
   done
