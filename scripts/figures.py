@@ -143,6 +143,10 @@ def plot_ate_over_time(runs, frames, name, path):
     plt.close(fig)
 
 
+def leading_digit(v):
+    return round(v / 10 ** math.floor(math.log10(v))) if v > 0 else 0
+
+
 def plot_family_summary(rows, path):
     """Grouped bars, log axis: no culling is often ten times worse than the rest."""
     rows = [r for r in rows if r["motion"] == "all" and r["median_ate_m"] and float(r["median_ate_m"]) > 0]
@@ -161,7 +165,7 @@ def plot_family_summary(rows, path):
         ax.bar(xs, ys, width, color=colours(s % colours.N), label=strategy)
     ax.set_yscale("log")
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))  # 1, 10 rather than 10^0, 10^1
-    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: "%g" % v if str(v)[0] in "25" else ""))
+    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: "%g" % v if leading_digit(v) in (2, 5) else ""))
     ax.set_xticks(range(len(families)))
     ax.set_xticklabels(families, rotation=20, ha="right", fontsize=8)
     ax.set_ylabel("median ATE RMSE (cm, log scale)")
