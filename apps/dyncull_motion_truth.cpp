@@ -43,7 +43,7 @@ struct Args {
 
 constexpr int kSimFrames = 40;
 
-int usage(const char* why) {
+int usage(const char* why, int exit_code = 2) {
   std::fprintf(stderr,
                "dyncull_motion_truth: %s\n"
                "usage: dyncull_motion_truth --dataset DIR --out TRUTH_DIR [--frames N] [--window K]\n"
@@ -53,7 +53,7 @@ int usage(const char* why) {
                "  --static-px X   static below X px of residual in every neighbour (default 2)\n"
                "  --moving-px X   moving above X px in every neighbour that sees the pixel (default 4)\n",
                why);
-  return 2;
+  return exit_code;
 }
 
 bool parse_number(const std::string& s, double lo, double hi, double* out) {
@@ -64,27 +64,43 @@ bool parse_number(const std::string& s, double lo, double hi, double* out) {
   return true;
 }
 
+bool parse_int(const std::string& s, long lo, long hi, int* out) {
+  char* end = nullptr;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  if (end == s.c_str() || *end != '\0' || v < lo || v > hi) return false;
+  *out = static_cast<int>(v);
+  return true;
+}
+
+/// --families NAME,NAME or all.
+void add_families(const std::string& list, std::vector<std::string>* out) {
+  std::stringstream ss(list);
+  for (std::string f; std::getline(ss, f, ',');) {
+    if (f == "all")
+      for (const sim::SceneFamily& s : sim::scene_families()) out->push_back(s.name);
+    else if (!f.empty())
+      out->push_back(f);
+  }
+}
+
 int parse_args(int argc, char** argv, Args* a) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") return usage("per-pixel motion truth of a real RGB-D sequence", -1);
     if (i + 1 >= argc) return usage((arg + " needs a value").c_str());
     const std::string v = argv[++i];
-    double x = 0;
+    bool ok = true;
     if (arg == "--dataset") a->dataset = v;
     else if (arg == "--out") a->out = v;
-    else if (arg == "--families") {
-      std::stringstream ss(v);
-      for (std::string f; std::getline(ss, f, ',');)
-        if (f == "all")
-          for (const sim::SceneFamily& s : sim::scene_families()) a->families.push_back(s.name);
-        else if (!f.empty()) a->families.push_back(f);
-    } else if (arg == "--frames" && parse_number(v, 2, 100000, &x)) a->frames = static_cast<int>(x);
-    else if (arg == "--window" && parse_number(v, 1, 30, &x)) a->labeller.window_frames = static_cast<int>(x);
-    else if (arg == "--static-px" && parse_number(v, 0.1, 100, &x)) a->labeller.static_px = x;
-    else if (arg == "--moving-px" && parse_number(v, 0.1, 100, &x)) a->labeller.moving_px = x;
-    else if (arg == "--jitter-mm" && parse_number(v, 0, 100, &x)) a->jitter_mm = x;
-    else if (arg == "--jitter-deg" && parse_number(v, 0, 10, &x)) a->jitter_deg = x;
-    else return usage(("unknown option or bad value: " + text::quote_token(arg) + " " + text::quote_token(v)).c_str());
+    else if (arg == "--families") add_families(v, &a->families);
+    else if (arg == "--frames") ok = parse_int(v, 2, 100000, &a->frames);
+    else if (arg == "--window") ok = parse_int(v, 1, 30, &a->labeller.window_frames);
+    else if (arg == "--static-px") ok = parse_number(v, 0.1, 100, &a->labeller.static_px);
+    else if (arg == "--moving-px") ok = parse_number(v, 0.1, 100, &a->labeller.moving_px);
+    else if (arg == "--jitter-mm") ok = parse_number(v, 0, 100, &a->jitter_mm);
+    else if (arg == "--jitter-deg") ok = parse_number(v, 0, 10, &a->jitter_deg);
+    else ok = false;
+    if (!ok) return usage(("unknown option or bad value: " + text::quote_token(arg) + " " + text::quote_token(v)).c_str());
   }
   if (a->out.empty()) return usage("--out is required");
   if (a->dataset.empty() == a->families.empty()) return usage("give either --dataset or --families");
@@ -337,6 +353,6 @@ int score_families(const Args& args) {
 
 int main(int argc, char** argv) {
   Args args;
-  if (const int bad = parse_args(argc, argv, &args)) return bad;
+  if (const int stop = parse_args(argc, argv, &args)) return stop < 0 ? 0 : stop;
   return args.dataset.empty() ? score_families(args) : label_dataset(args);
 }

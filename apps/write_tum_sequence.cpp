@@ -9,6 +9,7 @@
 //
 // Usage: write_tum_sequence OUTDIR [--family NAME] [--motion static|xyz|rpy|halfsphere] [--frames N]
 //                                  [--seed S] [--clean-depth]
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/sim/families.hpp"
 #include "dyncull/sim/scene.hpp"
 
@@ -160,7 +161,8 @@ int main(int argc, char** argv) {
       for (int u = 0; u < f.width; ++u) {
         const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(f.width) + static_cast<std::size_t>(u);
         const double units = std::round(static_cast<double>(f.depth_m[i]) * 5000.0);
-        drow[u] = static_cast<std::uint16_t>(units > 65535.0 ? 0.0 : units);  // beyond 13.1 m: no measurement
+        int raw = 0;  // beyond 13.1 m, negative or NaN: no measurement
+        drow[u] = dyncull::checked_int(units, 0, 65535, &raw) ? static_cast<std::uint16_t>(raw) : std::uint16_t(0);
         mrow[u] = f.moving[i] ? 255 : 0;
       }
     }

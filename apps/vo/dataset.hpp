@@ -190,6 +190,10 @@ class DatasetSource {
     }
     seq_camera_.width = image.cols;
     seq_camera_.height = image.rows;
+    if (seq_camera_.validate(error) != Status::Ok) {  // again, for the image's size
+      *error = seq_camera_.source + ": " + *error;
+      return false;
+    }
     camera_ = PinholeCamera<double>{seq_camera_.fx, seq_camera_.fy, seq_camera_.cx, seq_camera_.cy, image.cols, image.rows};
     if (seq_camera_.has_distortion()) {
       K_ = (cv::Mat_<double>(3, 3) << camera_.fx, 0, camera_.cx, 0, camera_.fy, camera_.cy, 0, 0, 1);
@@ -416,7 +420,8 @@ inline std::vector<StripFrame> dataset_strip(const SequenceReport& report, const
     const std::size_t at = f.rfind("_frame");
     if (at == std::string::npos || f.size() < 4 || f.compare(f.size() - 4, 4, ".png") != 0) continue;
     const int frame = std::atoi(f.c_str() + at + 6);
-    out.push_back({f, "frame " + std::to_string(frame) + ", " + strategy + ": green kept, red culled"});
+    out.push_back({f, "frame " + std::to_string(frame) + ", " + strategy + ": green kept, red culled" +
+                          (report.has_label_truth ? "; x culled static, ring kept moving" : "")});
   }
   return out;
 }

@@ -4,6 +4,7 @@
 /// equation.
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "report.hpp"
 #include "runner.hpp"
 

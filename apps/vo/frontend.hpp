@@ -4,6 +4,7 @@
 /// features the culling kept (Zhu et al. 2024 §2), motion-only refinement on the inliers, constant-velocity fallback.
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/camera.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/status.hpp"
@@ -278,8 +279,9 @@ class FrontEnd {
  private:
   /// Metric depth at a corner, or 0 when missing, out of range or near a depth edge.
   float usable_depth(float u, float v) const {
-    const int x = static_cast<int>(std::lround(u)), y = static_cast<int>(std::lround(v));
     const cv::Mat& d = frame_.depth_m;
+    int x = 0, y = 0;
+    if (!pixel_of(u, v, d.cols, d.rows, &x, &y)) return 0.f;
     const int r = std::max(1, options_.depth_edge_radius_px);
     if (x < r || y < r || x >= d.cols - r || y >= d.rows - r) return 0.f;
     const float z = d.at<float>(y, x);
@@ -353,8 +355,8 @@ class FrontEnd {
     const int per_cell = std::max(1, (budget + cells - 1) / cells);
     cell_points_.assign(static_cast<std::size_t>(cells), {});
     for (const cv::KeyPoint& k : keypoints_) {
-      const int c = std::min(options_.grid_cols - 1, static_cast<int>(k.pt.x * options_.grid_cols / gray.cols));
-      const int r = std::min(options_.grid_rows - 1, static_cast<int>(k.pt.y * options_.grid_rows / gray.rows));
+      const int c = clamped_int(k.pt.x * options_.grid_cols / gray.cols, 0, options_.grid_cols - 1);
+      const int r = clamped_int(k.pt.y * options_.grid_rows / gray.rows, 0, options_.grid_rows - 1);
       cell_points_[static_cast<std::size_t>(r * options_.grid_cols + c)].push_back(k);
     }
     int added = 0;

@@ -4,6 +4,7 @@
 /// features drawn (PNG through OpenCV).
 #pragma once
 
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/labels.hpp"
@@ -130,8 +131,8 @@ struct LabelBreakdown {
     if (moving.empty() || (!instance.empty() && instance.type() != CV_16UC1)) return;
     for (std::size_t i = 0; i < px.size(); ++i) {
       const int truth = truth_at(moving, px[i]);
-      if (truth < 0) continue;
-      const int u = cvRound(px[i].x), v = cvRound(px[i].y);
+      int u = 0, v = 0;
+      if (truth < 0 || !pixel_of(px[i].x, px[i].y, moving.cols, moving.rows, &u, &v)) continue;
       const CullReason why = i < reasons.size() ? reasons[i] : CullReason::None;
       int cell = std::min(static_cast<int>(why), kReasons - 1);
       if (why == CullReason::None && i < kept_why.size() && kept_why[i] != KeptWhy::NotExplained)
@@ -179,8 +180,8 @@ struct RecallBySpeed {
            const cv::Mat& motion_m, const cv::Mat& instance) {
     if (is_moving.empty() || motion_m.empty() || motion_m.type() != CV_32FC1 || instance.type() != CV_16UC1) return;
     for (std::size_t i = 0; i < px.size(); ++i) {
-      const int u = static_cast<int>(std::lround(px[i].x)), v = static_cast<int>(std::lround(px[i].y));
-      if (u < 0 || v < 0 || u >= is_moving.cols || v >= is_moving.rows || !is_moving.at<std::uint8_t>(v, u)) continue;
+      int u = 0, v = 0;
+      if (!pixel_of(px[i].x, px[i].y, is_moving.cols, is_moving.rows, &u, &v) || !is_moving.at<std::uint8_t>(v, u)) continue;
       const float mm = 1000.f * motion_m.at<float>(v, u);
       int band = 0;
       while (band < kBands - 1 && !(mm < kUpperMm[band])) ++band;

@@ -6,6 +6,7 @@
 
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/camera.hpp"
+#include "dyncull/core/pixel.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/culling/detections.hpp"
 #include "dyncull/sim/scene.hpp"
@@ -30,8 +31,8 @@ constexpr std::uint8_t kTruthUnknown = 2;
 
 /// The motion truth at the pixel nearest p: 1 moving, 0 static, -1 none (no truth, outside, unknown).
 inline int truth_at(const cv::Mat& moving, const cv::Point2f& p) {
-  const int u = cvRound(p.x), v = cvRound(p.y);
-  if (moving.empty() || u < 0 || v < 0 || u >= moving.cols || v >= moving.rows) return -1;
+  int u = 0, v = 0;
+  if (moving.empty() || !pixel_of(p.x, p.y, moving.cols, moving.rows, &u, &v)) return -1;
   const std::uint8_t m = moving.at<std::uint8_t>(v, u);
   return m == kTruthUnknown ? -1 : (m != 0 ? 1 : 0);
 }

@@ -56,15 +56,11 @@ PinholeCamera<float> pinhole_of(const CullerCamera& c) {
                               static_cast<float>(c.cy), c.width, c.height};
 }
 
-Status check_camera(const CullerCamera& c, std::string* why) {
-  const std::size_t k = c.distortion.size();
-  if (k != 0 && k != 4 && k != 5 && k != 8 && k != 12 && k != 14)
-    return (*why = "camera: " + std::to_string(k) + " distortion coefficients; OpenCV's model has 4, 5, 8, 12 or 14",
-            Status::InvalidInput);
-  for (std::size_t i = 0; i < k; ++i)
-    if (!std::isfinite(c.distortion[i]))
-      return (*why = "camera: distortion[" + std::to_string(i) + "] is NaN or Inf", Status::InvalidInput);
+// The camera check every entry shares (core/camera_bounds.hpp): distortion first, as before, then the intrinsics.
+Status camera_problem(const CullerCamera& c, std::string* why) {
   std::string w;
+  if (check_distortion(c.distortion.data(), c.distortion.size(), &w) != Status::Ok)
+    return (*why = "camera: " + w, Status::InvalidInput);
   if (pinhole_of(c).validate(&w) != Status::Ok) return (*why = "camera: " + w + " (no default intrinsics)", Status::InvalidInput);
   return Status::Ok;
 }
@@ -102,7 +98,7 @@ Status CullerOptions::validate(std::string* reason) const {
 struct Culler::Impl {
   Impl(const CullerCamera& camera_, const CullerOptions& options_)
       : camera(camera_), options(options_), core(pinhole_of(camera_), core_of(camera_, options_)) {
-    if (check_camera(camera, &reason) != Status::Ok) {
+    if (camera_problem(camera, &reason) != Status::Ok) {
       status = Status::InvalidInput;
     } else if (options.validate(&reason) != Status::Ok) {
       status = Status::InvalidInput;

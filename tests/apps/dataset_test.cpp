@@ -17,6 +17,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -134,6 +135,35 @@ TEST(DatasetSource, BadCameraOrDetectionsStopTheOpenWithTheirReason) {
   vo::DatasetSource again;
   EXPECT_FALSE(again.open(o, &error));
   EXPECT_NE(error.find("yolo.txt:1:"), std::string::npos) << error;
+  fs::remove_all(dir);
+}
+
+// A camera no lens has (on the command line or in camera.txt, or one that fits camera.txt's default size
+// but not the images) stops the open with a reason naming the value: it never runs to the end.
+TEST(DatasetSource, AbsurdCamerasStopTheOpenWithTheirReason) {
+  const fs::path dir = write_small_folder("absurd_camera");
+  vo::DatasetOptions o;
+  o.dir = dir.string();
+  const std::pair<const char*, const char*> specs[] = {{"1e-300,50,32,24", "fx = 1e-300"},
+                                                       {"50,50,-1e300,24", "cx = -1e+300"},
+                                                       {"50,50,32,24,1e300,0,0,0,0", "distortion k1 = 1e+300"}};
+  for (const auto& spec : specs) {
+    o.camera = spec.first;
+    vo::DatasetSource source;
+    std::string error;
+    EXPECT_FALSE(source.open(o, &error)) << spec.first;
+    EXPECT_NE(error.find(spec.second), std::string::npos) << error;
+  }
+  o.camera.clear();
+  std::ofstream(dir / "camera.txt") << "fx 50\nfy 50\ncx 32\ncy 24\ndepth_units_per_metre 1e-300\n";
+  vo::DatasetSource units;
+  std::string error;
+  EXPECT_FALSE(units.open(o, &error));
+  EXPECT_NE(error.find("depth units per metre = 1e-300"), std::string::npos) << error;
+  std::ofstream(dir / "camera.txt") << "fx 50\nfy 50\ncx 500\ncy 24\n";  // fine for 640x480, not for 64x48
+  vo::DatasetSource small;
+  EXPECT_FALSE(small.open(o, &error));
+  EXPECT_NE(error.find("cx = 500 px is more than one image width (64 px)"), std::string::npos) << error;
   fs::remove_all(dir);
 }
 

@@ -82,4 +82,29 @@ TEST(Compact, UnusableRowViewsAndSharedMemoryAreRefusedAndTouchNothing) {
   EXPECT_EQ(compact(kKeep, RowsView(a.data(), 8, 8, 5), RowsView(b.data(), 8, 8, 5), ids), 3);
 }
 
+// keep passed as an array, a view over keep's bytes, a view over a vector's own elements passed with that
+// vector, and a vector that is an element of another: each would move bytes a later pass reads.
+TEST(Compact, AliasingThroughKeepOrAVectorsOwnElementsIsRefusedAndTouchesNothing) {
+  std::vector<std::uint8_t> keep = kKeep;
+  std::vector<int> a = {0, 1, 2, 3, 4};
+  EXPECT_EQ(compact(keep, keep, a), -1);
+  EXPECT_EQ(compact(keep, a, RowsView(keep.data(), 1, 1, 5)), -1);
+  std::vector<std::uint8_t> desc(5 * 4, 9);
+  EXPECT_EQ(compact(keep, desc, RowsView(desc.data(), 4, 4, 5)), -1);  // sizes differ too; below they agree
+  std::vector<std::uint8_t> bytes = {10, 11, 12, 13, 14};
+  EXPECT_EQ(compact(keep, bytes, RowsView(bytes.data(), 1, 1, 5)), -1);
+  std::vector<std::vector<int>> nested(5, std::vector<int>(5, 3));
+  EXPECT_EQ(compact(keep, nested, nested[1]), -1);
+  EXPECT_EQ(keep, kKeep);
+  EXPECT_EQ(a, (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(bytes, (std::vector<std::uint8_t>{10, 11, 12, 13, 14}));
+  EXPECT_EQ(desc, std::vector<std::uint8_t>(5 * 4, 9));
+  EXPECT_EQ(nested, std::vector<std::vector<int>>(5, std::vector<int>(5, 3)));
+  // A copy of the keep mask and vectors of bool (no element address) still work.
+  std::vector<std::uint8_t> mask_copy = kKeep;
+  std::vector<bool> flags = {true, false, true, false, true};
+  EXPECT_EQ(compact(kKeep, mask_copy, flags, a), 3);
+  EXPECT_EQ(flags, (std::vector<bool>{true, true, false}));
+}
+
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -140,6 +141,72 @@ TEST(ReadSmallFile, ReadsUpToTheLimitAndNamesTheSizeBeyondIt) {
   EXPECT_EQ(why, dir.str() + ": is a directory, not a regular file");
   EXPECT_FALSE(read_small_file("/dev/zero", 999, &text, &why));
   EXPECT_EQ(why, "/dev/zero: is a character device, not a regular file");
+}
+
+// Files of the kernel's look regular and have size 0: /proc/self/pagemap streams gigabytes, /proc/kmsg
+// blocks. They are refused by name, also through a link, and nothing of them is read.
+TEST(FileOpeningRule, KernelFilesAreRefusedByNameAlsoThroughALink) {
+  test::ScratchDir dir;
+  std::filesystem::create_symlink("/proc/self/pagemap", dir / "pagemap.txt");
+  std::filesystem::create_symlink("/dev/zero", dir / "zero.cfg");
+  LineReader in;
+  EXPECT_FALSE(in.open("/proc/self/pagemap"));
+  EXPECT_EQ(in.error(), "/proc/self/pagemap: is a file of the kernel's (under /proc), not a regular file");
+  EXPECT_FALSE(in.open(dir / "pagemap.txt"));
+  EXPECT_NE(in.error().find("pagemap.txt: is a file of the kernel's (under /proc)"), std::string::npos) << in.error();
+  EXPECT_FALSE(in.open("/sys/kernel/mm/transparent_hugepage/enabled"));
+  std::string text, why;
+  EXPECT_FALSE(read_small_file("/proc/self/pagemap", 1 << 20, &text, &why));
+  EXPECT_NE(why.find("under /proc"), std::string::npos) << why;
+  EXPECT_FALSE(read_small_file(dir / "zero.cfg", 1 << 20, &text, &why));
+  EXPECT_NE(why.find("zero.cfg: is a character device"), std::string::npos) << why;
+  InputFile raw;
+  EXPECT_FALSE(raw.open("/proc/self/status", 1 << 20, &why));
+  EXPECT_FALSE(raw.is_open());
+}
+
+TEST(FileOpeningRule, EveryEntryRefusesAFifoWithoutBlocking) {
+  test::ScratchDir dir;
+  const std::string fifo = dir / "pipe";
+  if (!test::make_fifo(fifo)) return;
+  std::string text, why;
+  bool read = true;
+  EXPECT_TRUE(test::returns_promptly([&] { read = read_small_file(fifo, 1000, &text, &why); }, fifo));
+  EXPECT_FALSE(read);
+  EXPECT_EQ(why, fifo + ": is a FIFO (named pipe), not a regular file");
+  InputFile raw;
+  EXPECT_TRUE(test::returns_promptly([&] { read = raw.open(fifo, 1000, &why); }, fifo));
+  EXPECT_FALSE(read);
+}
+
+TEST(FileOpeningRule, EachKindHasASizeCapCheckedAtOpen) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "list.txt") << std::string(99, 'x') << "\n";
+  LineReaderOptions o;
+  o.max_bytes = 99;
+  LineReader in;
+  EXPECT_FALSE(in.open(dir / "list.txt", o));
+  EXPECT_EQ(in.error(), dir / "list.txt" + ": 100 bytes, over the limit of 99");
+  o.max_bytes = 100;
+  ASSERT_TRUE(in.open(dir / "list.txt", o)) << in.error();
+  EXPECT_EQ(all_lines(in).size(), 1u);
+  EXPECT_EQ(LineReaderOptions{}.max_bytes, kMaxListFileBytes);
+  EXPECT_LT(kMaxCameraFileBytes, kMaxListFileBytes);
+}
+
+TEST(FileOpeningRule, AFileReadPastItsCapStops) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "f.bin") << std::string(50, 'x');
+  InputFile f;
+  std::string why;
+  ASSERT_TRUE(f.open(dir / "f.bin", 50, &why)) << why;
+  std::ofstream(dir / "f.bin", std::ios::app) << std::string(50, 'y');  // grows after the open
+  char buffer[200];
+  long total = 0;
+  long got = 0;
+  while ((got = f.read(buffer, sizeof buffer)) > 0) total += got;
+  EXPECT_EQ(got, -2);
+  EXPECT_LE(total, 51);
 }
 
 }  // namespace

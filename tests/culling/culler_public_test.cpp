@@ -190,6 +190,34 @@ TEST(Culler, BadCameraRefusesEveryFrameNamingIt) {
   EXPECT_NE(no_focal.reason().find("camera"), std::string::npos) << no_focal.reason();
 }
 
+// The camera check a host can run on its own settings at start-up is the one the culler refuses by.
+TEST(Culler, AbsurdCamerasAreRefusedByTheCheckAHostCanCallToo) {
+  struct Case {
+    CullerCamera camera;
+    double depth_units;
+    const char* named;
+  };
+  const Case cases[] = {
+      {CullerCamera(1e-300, 525, 320, 240, 640, 480), 5000, "fx = 1e-300"},
+      {CullerCamera(525, 525, -1e300, 240, 640, 480), 5000, "cx = -1e+300"},
+      {CullerCamera(525, 525, 320, 240, 640, 480, {1e300, 0, 0, 0, 0}), 5000, "distortion k1 = 1e+300"},
+      {CullerCamera(525, 525, 320, 240, 640, 480, {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2}), 5000, "distortion ty = 2"},
+      {tum_camera(), 1e-300, "depth units per metre = 1e-300"},
+  };
+  for (const Case& c : cases) {
+    std::string why;
+    EXPECT_EQ(check_camera(c.camera, c.depth_units, &why), Status::InvalidInput) << c.named;
+    EXPECT_NE(why.find(c.named), std::string::npos) << why;
+    CullerOptions o;
+    o.depth_units_per_metre = c.depth_units;
+    const Culler culler(c.camera, o);
+    EXPECT_EQ(culler.status(), Status::InvalidInput) << c.named;
+  }
+  EXPECT_EQ(check_camera(tum_camera(), 5000), Status::Ok);
+  EXPECT_EQ(check_camera(CullerCamera(525, 525, 320, 240, 640, 480, {0.26, -0.95, -0.005, 0.002, 1.16}), 1000),
+            Status::Ok);
+}
+
 TEST(Culler, BadOptionsRefuseNamingTheSetting) {
   CullerOptions o;
   o.min_survivor_fraction = 2;

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -49,6 +50,32 @@ TYPED_TEST(CullerTest, InvalidCameraFailsWithItsReason) {
   EXPECT_NE(r.reason.find("no default intrinsics"), std::string::npos) << r.reason;
   ASSERT_EQ(r.keep.size(), v.keypoints.size());
   for (std::uint8_t k : r.keep) EXPECT_EQ(k, 1);
+}
+
+// Depth given but unusable (all 0, all NaN, all beyond the sensor's range): the keyframe has no 3-D
+// point, so the reprojection check cannot run. The frame says so, as it does for depth not given, and
+// is not Ok; with valid depth the same frames are Ok.
+TYPED_TEST(CullerTest, UnusableDepthIsAMissingInputNotAnOkFrame) {
+  using T = TypeParam;
+  const float fills[] = {0.f, std::numeric_limits<float>::quiet_NaN(), 1e6f};
+  for (const float fill : fills) {
+    CullerCore<T> culler(PinholeCamera<T>::tum_fr3());
+    for (int k = 0; k < 3; ++k) {
+      WallView<T> v = wall_view<T>(0.01 * k);
+      std::fill(v.depth.begin(), v.depth.end(), fill);
+      const CullerResult& r = culler.cull(v.frame());
+      if (k == 0) continue;  // the first frame has no keyframe yet
+      EXPECT_EQ(r.status, Status::MissingInput) << "depth " << fill << ", frame " << k << ": " << r.reason;
+      EXPECT_NE(r.reason.find("reprojection: points_3d: none of the"), std::string::npos) << r.reason;
+    }
+  }
+  CullerCore<T> valid(PinholeCamera<T>::tum_fr3());
+  for (int k = 0; k < 3; ++k) {
+    const CullerResult& r = valid.cull(wall_view<T>(0.01 * k).frame());
+    if (k > 0) {
+      EXPECT_TRUE(r.ok()) << r.reason;
+    }
+  }
 }
 
 TYPED_TEST(CullerTest, InvalidOptionsNameTheField) {

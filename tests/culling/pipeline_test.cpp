@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -197,6 +198,30 @@ TYPED_TEST(PipelineTest, ReprojectionEvidenceReplacesTheEpipolarOneWhenPointsAre
   EXPECT_EQ(rb.status, Status::InvalidInput);  // a per-keypoint input of another length refuses the frame
   EXPECT_NE(rb.reason.find("points_3d has 5 points"), std::string::npos) << rb.reason;
   EXPECT_EQ(rb.num_dynamic, 0u);
+}
+
+// Points given but none usable (all NaN, as from a depth image of 0, NaN or out-of-range values): the
+// reprojection check could not run, which the frame's status and reason say as for points not given;
+// the labels are those of points not given.
+TYPED_TEST(PipelineTest, UnusablePointsAreAMissingInputLikeAbsentOnes) {
+  using T = TypeParam;
+  SceneConfig config;
+  const auto s = test::make_culling_scene<T>(config);
+  const auto dets = detections_of(s);
+  auto frame = frame_of(s, dets);
+  PipelineOptions<T> o = presets::recommended<T>();
+  o.reprojection.enabled = true;
+  const std::vector<Vec3<T>> unusable(s.size(), Vec3<T>::Constant(std::numeric_limits<T>::quiet_NaN()));
+  frame.points_3d = &unusable;
+  PipelineState<T> state;
+  const PipelineResult<T>& r = cull_frame(frame, o, &state);
+  EXPECT_EQ(r.reprojection.status, Status::MissingInput) << r.reprojection.reason;
+  EXPECT_NE(r.status, Status::Ok);
+  EXPECT_NE(r.reason.find("reprojection: points_3d: none of the"), std::string::npos) << r.reason;
+  EXPECT_TRUE(r.labelled());
+  frame.points_3d = nullptr;
+  PipelineState<T> state_none;
+  EXPECT_EQ(cull_frame(frame, o, &state_none).labels, r.labels);
 }
 
 // The seated person sways only about 1 px between the frames (a quarter of the scene's default): its

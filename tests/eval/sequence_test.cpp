@@ -169,8 +169,8 @@ TEST_F(SequenceFolder, BadCameraFilesNameFileLineAndKey) {
   EXPECT_NE(reason_of("fx 500\nfy nan\n").find("camera.txt:2: fy: 'nan' is not a finite number"), std::string::npos);
   EXPECT_NE(reason_of("fx 500\nfx 501\n").find("camera.txt:2: fx repeats line 1"), std::string::npos);
   EXPECT_NE(reason_of("fx 500 1\n").find("camera.txt:1: expected 'key value'"), std::string::npos);
-  EXPECT_NE(reason_of("fx -5\nfy 500\ncx 320\ncy 240\n").find("fx and fy must be positive"), std::string::npos);
-  EXPECT_NE(reason_of("fx 5\nfy 5\ncx 3\ncy 2\ndepth_units_per_metre 0\n").find("depth_units_per_metre must be positive"),
+  EXPECT_NE(reason_of("fx -5\nfy 500\ncx 320\ncy 240\n").find("camera.txt: focal lengths fx, fy must be finite and positive"), std::string::npos);
+  EXPECT_NE(reason_of("fx 5\nfy 5\ncx 3\ncy 2\ndepth_units_per_metre 0\n").find("camera.txt: depth units per metre = 0 is outside [1e-3, 1e6]"),
             std::string::npos);
   fs::create_directories(path("camdir"));
   EXPECT_EQ(eval::read_camera_file(path("camdir")).status, Status::IoError);
@@ -200,6 +200,101 @@ TEST(SequenceCamera, FromCommandLineListOrTumName) {
   c = eval::camera_from_spec("kinect");
   EXPECT_EQ(c.status, Status::InvalidInput);
   EXPECT_NE(c.reason.find("names none of TUM's cameras"), std::string::npos) << c.reason;
+}
+
+// A camera no lens has runs to the end with a wrong answer: refused where it enters, naming the value.
+TEST_F(SequenceFolder, AbsurdCamerasAreRefusedNamingTheValue) {
+  auto file_reason = [&](const std::string& text) {
+    write("camera.txt", text);
+    const eval::CameraResult c = eval::read_camera_file(path("camera.txt"));
+    EXPECT_EQ(c.status, Status::InvalidInput) << text;
+    return c.reason;
+  };
+  const std::string ok = "fy 500\ncx 320\ncy 240\n";
+  EXPECT_NE(file_reason("fx 1e-300\n" + ok).find("camera.txt: fx = 1e-300 px is outside [0.64, 6.4e+06]"),
+            std::string::npos);
+  EXPECT_NE(file_reason("fx 500\nfy 500\ncx -1e300\ncy 240\n").find("cx = -1e+300 px is more than one image width"),
+            std::string::npos);
+  EXPECT_NE(file_reason("fx 500\n" + ok + "k1 1e300\n").find("distortion k1 = 1e+300 is outside [-1000, 1000]"),
+            std::string::npos);
+  EXPECT_NE(file_reason("fx 500\n" + ok + "p2 3\n").find("distortion p2 = 3 is outside [-1, 1]"), std::string::npos);
+  EXPECT_NE(file_reason("fx 500\n" + ok + "depth_units_per_metre 1e-300\n").find("depth units per metre = 1e-300"),
+            std::string::npos);
+  EXPECT_NE(file_reason("fx 500\n" + ok + "width 64\nheight 48\n").find("cx = 320 px is more than one image width"),
+            std::string::npos);
+  for (const char* spec : {"1e-300,500,320,240", "500,500,-1e300,240", "500,500,320,240,1e300,0,0,0,0"}) {
+    const eval::CameraResult c = eval::camera_from_spec(spec);
+    EXPECT_EQ(c.status, Status::InvalidInput) << spec;
+    EXPECT_NE(c.reason.find("outside"), std::string::npos) << c.reason;
+  }
+  eval::SequenceCamera camera = eval::camera_from_spec("500,500,320,240").camera;
+  EXPECT_EQ(camera.validate(), Status::Ok);
+  camera.width = 64;  // the images turned out smaller: a caller checks again
+  std::string why;
+  EXPECT_EQ(camera.validate(&why), Status::InvalidInput);
+  EXPECT_NE(why.find("cx = 320"), std::string::npos) << why;
+}
+
+// camera.txt keys and the --camera spec are user text: escaped and cut in reasons.
+TEST_F(SequenceFolder, CameraKeysAndSpecsAreQuotedInReasons) {
+  write("camera.txt", "fx 500\n\x1b[31m" + std::string(8000, 'k') + " 3\n");
+  const eval::CameraResult c = eval::read_camera_file(path("camera.txt"));
+  EXPECT_EQ(c.status, Status::ParseError);
+  EXPECT_EQ(c.reason.find('\x1b'), std::string::npos) << c.reason;
+  EXPECT_LT(c.reason.size(), 400u) << c.reason.size();
+  EXPECT_NE(c.reason.find("unknown key '\\x1b[31mkkk"), std::string::npos) << c.reason;
+  const std::string spec = "500,500,320\x1b]0;title\x07" + std::string(8000, '9');
+  for (const std::string& s : {spec, "1e-300,500,320,240," + std::string(8000, '0') + ",0,0,0,0",
+                               std::string("no\ncamera\x1b") + std::string(8000, 'x')}) {
+    const eval::CameraResult r = eval::camera_from_spec(s);
+    EXPECT_FALSE(r.ok());
+    EXPECT_LT(r.reason.size(), 400u) << r.reason;
+    for (char ch : r.reason) EXPECT_TRUE(ch >= 0x20 && ch < 0x7f) << r.reason;
+  }
+}
+
+// camera.txt has a size cap of its own, and kernel files are refused like every other reader's.
+TEST_F(SequenceFolder, CameraFilesFollowTheFileOpeningRule) {
+  write("camera.txt", "fx 500\nfy 500\ncx 320\ncy 240\n" + std::string(text::kMaxCameraFileBytes, '#'));
+  eval::CameraResult c = eval::read_camera_file(path("camera.txt"));
+  EXPECT_EQ(c.status, Status::IoError);
+  EXPECT_NE(c.reason.find("over the limit of 65536"), std::string::npos) << c.reason;
+  c = eval::camera_from_spec("/proc/self/pagemap");
+  EXPECT_EQ(c.status, Status::IoError);
+  EXPECT_NE(c.reason.find("under /proc"), std::string::npos) << c.reason;
+  c = eval::camera_from_spec("/dev/zero");
+  EXPECT_EQ(c.status, Status::IoError);
+}
+
+// A detections folder holding more files than the sequence needs: the files are read in name order
+// until every frame has its file (the later ones here are not even JSON), nothing is called missing, and
+// the files not read are counted in a note. More files than max_frames is refused, not cut.
+TEST_F(SequenceFolder, JsonDetectionsFolderIsReadOnlyAsFarAsTheFramesNeed) {
+  lists({"10.000", "10.033", "10.066"}, {"10.001", "10.034", "10.067"});
+  fs::create_directories(path("det"));
+  const char* stamps[] = {"10.000", "10.033", "10.066", "10.100"};
+  for (int k = 0; k < 4; ++k)
+    write("det/00000" + std::to_string(k) + ".json",
+          std::string("{\"frame_id\": ") + std::to_string(k) + ", \"timestamp\": " + stamps[k] +
+              ", \"image_path\": \"x.png\", \"detections\": []}");
+  for (int k = 4; k < 30; ++k) write("det/0000" + std::string(k < 10 ? "0" : "") + std::to_string(k) + ".json", "later");
+  const eval::SequenceIndex s = eval::read_sequence(dir_.string());
+  ASSERT_TRUE(s.ok()) << s.reason;
+  const eval::SequenceDetections d = eval::read_sequence_detections(path("det"), s, 640, 480);
+  ASSERT_TRUE(d.ok()) << d.reason;
+  EXPECT_EQ(d.has_file, (std::vector<std::uint8_t>{1, 1, 1}));
+  EXPECT_EQ(d.frames_with_file, 3u);
+  EXPECT_EQ(d.files_unmatched, 1u);  // 10.100, read to see the frames were done
+  std::string all;
+  for (const std::string& n : d.notes.first) all += n + "\n";
+  EXPECT_NE(all.find("26 files after 000003.json not read: every frame has its detections file"), std::string::npos)
+      << all;
+  EXPECT_EQ(all.find("have no detections file"), std::string::npos) << all;
+  eval::SequenceOptions few;
+  few.max_frames = 10;
+  const eval::SequenceDetections capped = eval::read_sequence_detections(path("det"), s, 640, 480, few);
+  EXPECT_EQ(capped.status, Status::ParseError);
+  EXPECT_NE(capped.reason.find("more than 10 detection files"), std::string::npos) << capped.reason;
 }
 
 TEST_F(SequenceFolder, JsonDetectionsMatchFramesByTimestamp) {

@@ -401,6 +401,34 @@ TEST(Associate, MatchesAssociatePyOnJitteredStreams) {
   }
 }
 
+// Exact ties (stamps on a grid of 1/64 s), windows holding many stamps, and an offset so large that
+// distinct stamps round to the same shifted value: the order (difference, a, b) decides every pair.
+TEST(Associate, MatchesAssociatePyWithTiesDenseWindowsAndRoundingOffsets) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> tick(0, 200);
+  for (int trial = 0; trial < 60; ++trial) {
+    const bool huge_offset = trial % 3 == 2;
+    const double base = huge_offset ? 0.0 : 1000.0;
+    std::vector<double> first, second;
+    const int n = 1 + trial % 40, m = 1 + (trial * 7) % 45;
+    for (int k = 0; k < n; ++k) first.push_back(base + tick(rng) / 64.0);
+    for (int k = 0; k < m; ++k) second.push_back(base + tick(rng) / 64.0 + (trial % 2 ? 1e-13 * tick(rng) : 0.0));
+    AssociationOptions options;
+    options.max_difference_s = trial % 4 == 0 ? 0.5 : 0.04;
+    options.offset_s = huge_offset ? 4.0e15 : (trial % 5) / 64.0;
+    if (huge_offset) {  // the shifted stamps land on a grid of 0.5 s: many round together
+      for (double& t : first) t += 4.0e15;
+    }
+    const AssociationResult r = associate(first, second, options);
+    const auto expected = associate_py(first, second, options.offset_s, options.max_difference_s);
+    ASSERT_EQ(r.size(), expected.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      EXPECT_EQ(first[r.first[i]], expected[i].first) << "trial " << trial << " pair " << i;
+      EXPECT_EQ(second[r.second[i]], expected[i].second) << "trial " << trial << " pair " << i;
+    }
+  }
+}
+
 TEST(Associate, GreedyBySmallestDifferenceEachStampOnce) {
   // 1.012 is closer to 1.010 than 1.000 is, so it takes it; 1.000 stays unmatched.
   const AssociationResult r = associate(std::vector<double>{1.000, 1.012}, std::vector<double>{1.010});

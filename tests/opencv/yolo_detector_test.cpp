@@ -5,6 +5,7 @@
 #include "dyncull/opencv/yolo_detector.hpp"
 
 #include "support/counting_allocator.hpp"
+#include "support/special_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,6 +19,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -517,6 +519,92 @@ TEST(YoloDetectorOpen, ClassCountDifferentFromTheHeadsIsInvalidInput) {
   const auto r = d.open(o);
   EXPECT_EQ(r.status, Status::InvalidInput) << r.reason;
   EXPECT_NE(r.reason.find("[3072, 7]"), std::string::npos) << r.reason;
+}
+
+// The real model's files, read whole, for corrupt copies written into a test's scratch directory.
+bool real_model(std::string* cfg, std::string* weights, std::string* why_not) {
+  const char* root = std::getenv("DYNCULL_DATA_DIR");
+  if (root == nullptr || *root == '\0') return (*why_not = "DYNCULL_DATA_DIR is not set: real-model test skipped", false);
+  const fs::path dir = fs::path(root) / "models" / "yolo-fastest-1.1-xl";
+  std::ifstream c(dir / "yolo-fastest-1.1-xl.cfg", std::ios::binary), w(dir / "yolo-fastest-1.1-xl.weights", std::ios::binary);
+  if (!c || !w) return (*why_not = dir.string() + " has no yolo-fastest-1.1-xl.cfg / .weights", false);
+  cfg->assign(std::istreambuf_iterator<char>(c), std::istreambuf_iterator<char>());
+  weights->assign(std::istreambuf_iterator<char>(w), std::istreambuf_iterator<char>());
+  return true;
+}
+
+// Weights that do not fit the cfg's layers (cut, padded, another network's, /dev/zero) are refused at
+// open, naming both sizes; the intact copy opens.
+TEST(YoloDetectorOpen, WeightsWhoseSizeDoesNotFitTheCfgAreRefused) {
+  std::string cfg, weights, why_not;
+  if (!real_model(&cfg, &weights, &why_not)) GTEST_SKIP() << why_not;
+  TempDir dir;
+  YoloDetectorOptions o;
+  o.model = dir.file("net.cfg", cfg);
+  o.weights = dir.file("intact.weights", weights);
+  YoloDetector d;
+  ASSERT_TRUE(d.open(o).ok()) << d.opened().reason;
+  const std::string copies[] = {weights.substr(0, weights.size() / 2), weights.substr(0, weights.size() - 4),
+                                weights + std::string(4, '\0'), weights + weights};
+  for (const std::string& corrupt : copies) {
+    o.weights = dir.file("corrupt.weights", corrupt);
+    const auto r = d.open(o);
+    EXPECT_EQ(r.status, Status::InvalidInput) << corrupt.size() << " bytes";
+    EXPECT_NE(r.reason.find(std::to_string(corrupt.size()) + " bytes, where the layers of"), std::string::npos) << r.reason;
+    EXPECT_NE(r.reason.find("need " + std::to_string(weights.size())), std::string::npos) << r.reason;
+    EXPECT_FALSE(d.ok());
+  }
+  fs::create_symlink("/dev/zero", dir.path / "zero.weights");
+  o.weights = (dir.path / "zero.weights").string();
+  EXPECT_EQ(d.open(o).status, Status::IoError);
+  EXPECT_NE(d.opened().reason.find("character device"), std::string::npos) << d.opened().reason;
+  o.weights = "/proc/self/pagemap";
+  EXPECT_EQ(d.open(o).status, Status::IoError);
+}
+
+// A [yolo] head fed by a convolution of the wrong width: its outputs cannot be the head's.
+TEST(YoloDetectorOpen, HeadNotFedByItsAnchorsTimesClassesFiltersIsRefused) {
+  std::string cfg, weights, why_not;
+  if (!real_model(&cfg, &weights, &why_not)) GTEST_SKIP() << why_not;
+  TempDir dir;
+  const std::size_t classes = cfg.rfind("classes=80");
+  ASSERT_NE(classes, std::string::npos);
+  std::string other = cfg;
+  other.replace(classes, 10, "classes=20");
+  YoloDetectorOptions o;
+  o.model = dir.file("net.cfg", other);
+  o.weights = dir.file("net.weights", weights);
+  o.num_classes = 20;
+  YoloDetector d;
+  const auto r = d.open(o);
+  EXPECT_EQ(r.status, Status::ParseError) << r.reason;
+  EXPECT_NE(r.reason.find("[yolo]: is fed by 255 filters, its 3 anchors of 20 classes need a convolution of 75"),
+            std::string::npos)
+      << r.reason;
+}
+
+// Model files that are FIFOs or devices are refused without blocking or reading.
+TEST(YoloDetectorOpen, ModelFilesThatAreFifosOrDevicesAreRefusedWithoutBlocking) {
+  TempDir dir;
+  TinyYoloNet net(dir);
+  const std::string fifo = (dir.path / "pipe.cfg").string();
+  if (!test::make_fifo(fifo)) return;
+  YoloDetector d;
+  YoloDetectorOptions o = net.options();
+  o.model = fifo;
+  cv_adapter::YoloOpenResult r;
+  EXPECT_TRUE(test::returns_promptly([&] { r = d.open(o); }, fifo));
+  EXPECT_EQ(r.status, Status::IoError);
+  EXPECT_NE(r.reason.find("FIFO"), std::string::npos) << r.reason;
+  o = net.options();
+  o.weights = fifo;
+  EXPECT_TRUE(test::returns_promptly([&] { r = d.open(o); }, fifo));
+  EXPECT_EQ(r.status, Status::IoError);
+  fs::create_symlink("/dev/zero", dir.path / "zero.cfg");
+  o = net.options();
+  o.model = (dir.path / "zero.cfg").string();
+  EXPECT_EQ(d.open(o).status, Status::IoError);
+  EXPECT_TRUE(d.open(net.options()).ok()) << d.opened().reason;
 }
 
 TEST(YoloDetectorOpen, BadOptionsAreInvalidInputNamingTheField) {

@@ -5,11 +5,11 @@
 /// validate() refuses intrinsics that no camera has (bounds relative to the image size).
 #pragma once
 
+#include "dyncull/core/camera_bounds.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/types.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 namespace dyncull {
@@ -44,46 +44,16 @@ struct PinholeCamera {
     k << fx, T(0), cx, T(0), fy, cy, T(0), T(0), T(1);
     return k;
   }
-  /// Bounds of a camera that exists, relative to the larger image side s = max(width, height): focal
-  /// lengths in [kMinFocalPerSide, kMaxFocalPerSide] * s (a field of view across s between about
-  /// 0.006 and 179.8 degrees), the principal point within one image size of the image
-  /// (cx in [-width, 2 width], cy in [-height, 2 height]).
-  static constexpr double kMinFocalPerSide = 1e-3;
-  static constexpr double kMaxFocalPerSide = 1e4;
+  /// Bounds of a camera that exists (CameraBounds in core/camera_bounds.hpp).
+  static constexpr double kMinFocalPerSide = CameraBounds::kMinFocalPerSide;
+  static constexpr double kMaxFocalPerSide = CameraBounds::kMaxFocalPerSide;
 
-  /// Ok, or InvalidInput naming the first intrinsic no camera has: a non-positive image size, a
-  /// non-finite or non-positive focal length, a focal length or principal point outside the bounds above.
+  /// Ok, or InvalidInput naming the first intrinsic no camera has (check_intrinsics): an image size
+  /// outside [1, 100000], a non-finite or non-positive focal length, a focal length or principal point
+  /// outside CameraBounds.
   Status validate(std::string* reason = nullptr) const {
-    auto bad = [&](const std::string& why) {
-      if (reason) *reason = why;
-      return Status::InvalidInput;
-    };
-    auto num = [](double v) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%.6g", v);
-      return std::string(buf);
-    };
-    if (width <= 0 || height <= 0)
-      return bad("image size must be positive, got " + std::to_string(width) + "x" + std::to_string(height));
-    if (!(fx > T(0)) || !(fy > T(0)) || !std::isfinite(fx) || !std::isfinite(fy))
-      return bad("focal lengths fx, fy must be finite and positive");
-    if (!std::isfinite(cx) || !std::isfinite(cy)) return bad("principal point cx, cy must be finite");
-    const double side = static_cast<double>(width > height ? width : height);
-    const double lo = kMinFocalPerSide * side, hi = kMaxFocalPerSide * side;
-    const double f[2] = {static_cast<double>(fx), static_cast<double>(fy)};
-    for (int k = 0; k < 2; ++k)
-      if (!(f[k] >= lo && f[k] <= hi))
-        return bad(std::string(k == 0 ? "fx" : "fy") + " = " + num(f[k]) + " px is outside [" + num(lo) + ", " +
-                   num(hi) + "] for a " + std::to_string(width) + "x" +
-                   std::to_string(height) + " image (1e-3 to 1e4 times its larger side)");
-    const double c[2] = {static_cast<double>(cx), static_cast<double>(cy)};
-    const int size[2] = {width, height};
-    for (int k = 0; k < 2; ++k)
-      if (!(c[k] >= -double(size[k]) && c[k] <= 2.0 * double(size[k])))
-        return bad(std::string(k == 0 ? "cx" : "cy") + " = " + num(c[k]) + " px is more than one image " +
-                   (k == 0 ? "width" : "height") + " (" + std::to_string(size[k]) + " px) outside the image");
-    if (reason) reason->clear();
-    return Status::Ok;
+    return check_intrinsics(static_cast<double>(fx), static_cast<double>(fy), static_cast<double>(cx),
+                            static_cast<double>(cy), width, height, reason);
   }
   /// validate() == Ok.
   bool valid() const { return validate() == Status::Ok; }

@@ -9,6 +9,7 @@
 /// API:
 /// @code
 ///   dyncull::CullerCamera camera(fx, fy, cx, cy, 640, 480);        // plus distortion when the lens has it
+///   dyncull::check_camera(camera, 5000.0, &why);                     // at start-up: the culler's camera check
 ///   dyncull::Culler culler(camera, dyncull::CullerOptions("recommended"));   // culler.ok(), culler.reason()
 ///   dyncull::CullerFrame f;
 ///   f.keypoints = dyncull::points_view(keys);  f.descriptors = ...;  f.depth_m = ...;  // each optional:
@@ -20,6 +21,7 @@
 /// and ids is cull_frame (culling/pipeline.hpp).
 #pragma once
 
+#include "dyncull/core/camera_bounds.hpp"
 #include "dyncull/core/compact.hpp"
 #include "dyncull/core/depth.hpp"
 #include "dyncull/core/status.hpp"
@@ -53,6 +55,15 @@ struct CullerCamera {
     return false;
   }
 };
+
+/// The camera check of core/camera_bounds.hpp on a CullerCamera and a depth scale (raw units per metre;
+/// 1 when the host has no depth): what the culler refuses a camera for, for a host to check its settings
+/// once at start-up. Ok, or InvalidInput with the first reason.
+inline Status check_camera(const CullerCamera& camera, double depth_units_per_metre, std::string* reason = nullptr) {
+  return check_camera(camera.fx, camera.fy, camera.cx, camera.cy, camera.width, camera.height,
+                      camera.distortion.empty() ? nullptr : &camera.distortion[0],
+                      camera.distortion.size(), depth_units_per_metre, reason);
+}
 
 /// Who decides when the current frame becomes the reference keyframe.
 enum class KeyframePolicy : std::uint8_t {

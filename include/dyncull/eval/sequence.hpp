@@ -14,6 +14,7 @@
 #pragma once
 
 #include "dyncull/core/box.hpp"
+#include "dyncull/core/camera_bounds.hpp"
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/text.hpp"
 #include "dyncull/core/text_file.hpp"
@@ -109,6 +110,13 @@ struct SequenceCamera {
   bool has_distortion() const {
     return std::any_of(distortion.begin(), distortion.end(), [](double d) { return d != 0.0; });
   }
+  /// The camera check of core/camera_bounds.hpp (intrinsics for width x height, distortion, depth scale):
+  /// Ok, or InvalidInput naming the value. Every reader here runs it; run it again after changing the
+  /// image size (a caller that takes the size from the images).
+  Status validate(std::string* reason = nullptr) const {
+    return check_camera(fx, fy, cx, cy, width, height, distortion.data(), distortion.size(), depth_units_per_metre,
+                        reason);
+  }
 };
 
 struct CameraResult {
@@ -133,13 +141,17 @@ struct SequenceDetections {
 
 namespace detail {
 
-/// Calls line(number, text) for each line of a regular file (text::LineReader: streaming, bounded),
-/// '\r' stripped. IoError for a missing, non-regular or unreadable file; ParseError "path:line: ..." for
+/// Calls line(number, text) for each line of a regular file of at most max_bytes (text::LineReader:
+/// streaming, bounded), '\r' stripped. IoError for a missing, non-regular or unreadable file; ParseError "path:line: ..." for
 /// a data line over max_chars or past the line limit. `line` returns false to stop with its own reason.
 template <class Fn>
-Status for_each_line(const std::string& path, std::size_t max_chars, std::string* reason, Fn&& line) {
+Status for_each_line(const std::string& path, std::size_t max_chars, std::string* reason, Fn&& line,
+                     std::uint64_t max_bytes = text::kMaxListFileBytes) {
+  text::LineReaderOptions limits;
+  limits.max_line_chars = max_chars;
+  limits.max_bytes = max_bytes;
   text::LineReader in;
-  if (!in.open(path, text::LineReaderOptions{max_chars, text::LineReaderOptions{}.max_lines})) {
+  if (!in.open(path, limits)) {
     *reason = in.error();
     return Status::IoError;
   }
@@ -250,16 +262,11 @@ inline CameraResult camera_error(Status status, std::string reason) {
   return r;
 }
 
-/// The camera's own checks: positive focal lengths and depth scale, finite everything.
+/// The camera check every entry shares (core/camera_bounds.hpp): intrinsics within the ranges a camera
+/// has for its image size, distortion and depth scale within physical ranges. `where` names the source.
 inline CameraResult checked_camera(SequenceCamera c, const std::string& where) {
-  if (!(c.fx > 0) || !(c.fy > 0) || !std::isfinite(c.fx) || !std::isfinite(c.fy))
-    return camera_error(Status::InvalidInput, where + "fx and fy must be positive and finite");
-  if (!std::isfinite(c.cx) || !std::isfinite(c.cy))
-    return camera_error(Status::InvalidInput, where + "cx and cy must be finite");
-  if (!(c.depth_units_per_metre > 0) || !std::isfinite(c.depth_units_per_metre))
-    return camera_error(Status::InvalidInput, where + "depth_units_per_metre must be positive and finite");
-  for (double d : c.distortion)
-    if (!std::isfinite(d)) return camera_error(Status::InvalidInput, where + "distortion coefficients must be finite");
+  std::string why;
+  if (c.validate(&why) != Status::Ok) return camera_error(Status::InvalidInput, where + why);
   CameraResult r;
   r.camera = std::move(c);
   return r;
@@ -268,35 +275,39 @@ inline CameraResult checked_camera(SequenceCamera c, const std::string& where) {
 }  // namespace detail
 
 /// camera.txt: one "key value" per line ('#' comments): fx, fy, cx, cy (required), k1 k2 p1 p2 k3,
-/// depth_units_per_metre, width, height (optional). An unknown key, a repeated key or a bad value is a
-/// ParseError naming file:line.
+/// depth_units_per_metre, width, height (optional); at most text::kMaxCameraFileBytes. An unknown key, a
+/// repeated key or a bad value is a ParseError naming file:line; a camera outside the physical ranges of
+/// core/camera_bounds.hpp is InvalidInput naming the value. Keys and the path are quoted (text::quote_token,
+/// text::quote_path) in reasons.
 inline CameraResult read_camera_file(const std::string& path, const SequenceOptions& options = {}) {
   SequenceCamera c;
-  c.source = path;
+  c.source = text::quote_path(path);
   std::map<std::string, std::size_t> seen;
   std::string reason;
+  const std::string shown = text::quote_path(path);
   const Status st = detail::for_each_line(
-      path, options.max_line_chars, &reason, [&](std::size_t number, std::string_view line, std::string* why) {
+      path, options.max_line_chars, &reason,
+      [&](std::size_t number, std::string_view line, std::string* why) {
         const std::size_t first = line.find_first_not_of(" \t");
         if (first == std::string_view::npos || line[first] == '#') return true;
-        const std::string where = path + ":" + std::to_string(number) + ": ";
+        const std::string where = shown + ":" + std::to_string(number) + ": ";
         const std::vector<std::string_view> f = detail::fields_of(line);
         if (f.size() != 2) {
           *why = where + "expected 'key value'";
           return false;
         }
-        const std::string key(f[0]);
-        double v = 0;
-        if (!detail::parse_number(f[1], &v)) {
-          *why = where + key + ": " + text::quote_token(f[1]) + " is not a finite number";
-          return false;
-        }
         static const std::array<const char*, 12> keys = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3",
                                                           "depth_units_per_metre", "width", "height"};
-        const auto k = std::find_if(keys.begin(), keys.end(), [&](const char* s) { return key == s; });
+        const auto k = std::find_if(keys.begin(), keys.end(), [&](const char* s) { return f[0] == s; });
         if (k == keys.end()) {
           *why = where + "unknown key " + text::quote_token(f[0]) +
                  " (fx fy cx cy k1 k2 p1 p2 k3 depth_units_per_metre width height)";
+          return false;
+        }
+        const std::string key(*k);  // one of the names above: printable
+        double v = 0;
+        if (!detail::parse_number(f[1], &v)) {
+          *why = where + key + ": " + text::quote_token(f[1]) + " is not a finite number";
           return false;
         }
         if (seen.count(key)) {
@@ -317,11 +328,12 @@ inline CameraResult read_camera_file(const std::string& path, const SequenceOpti
           (i == 10 ? c.width : c.height) = static_cast<int>(v);  // checked: a whole number in [1, 100000]
         }
         return true;
-      });
+      },
+      text::kMaxCameraFileBytes);
   if (st != Status::Ok) return detail::camera_error(st, reason);
   for (const char* required : {"fx", "fy", "cx", "cy"})
-    if (!seen.count(required)) return detail::camera_error(Status::ParseError, path + ": no " + required);
-  return detail::checked_camera(c, path + ": ");
+    if (!seen.count(required)) return detail::camera_error(Status::ParseError, shown + ": no " + required);
+  return detail::checked_camera(c, shown + ": ");
 }
 
 /// TUM's published intrinsics (ROS default calibration of the three Kinects): "fr1" / "freiburg1",
@@ -329,7 +341,7 @@ inline CameraResult read_camera_file(const std::string& path, const SequenceOpti
 /// InvalidInput when none is named.
 inline CameraResult tum_camera(const std::string& name) {
   SequenceCamera c;
-  c.source = "TUM " + name;
+  c.source = "TUM " + text::quote_path(name);
   auto has = [&](const char* s) { return name.find(s) != std::string::npos; };
   if (has("freiburg1") || has("fr1")) {
     c.fx = 517.3, c.fy = 516.5, c.cx = 318.6, c.cy = 255.3;
@@ -338,7 +350,7 @@ inline CameraResult tum_camera(const std::string& name) {
   } else if (has("freiburg3") || has("fr3")) {
     c.fx = 535.4, c.fy = 539.2, c.cx = 320.1, c.cy = 247.6;
   } else {
-    return detail::camera_error(Status::InvalidInput, "'" + name + "' names none of TUM's cameras fr1, fr2, fr3");
+    return detail::camera_error(Status::InvalidInput, text::quote_token(name) + " names none of TUM's cameras fr1, fr2, fr3");
   }
   CameraResult r;
   r.camera = c;
@@ -351,24 +363,25 @@ inline CameraResult camera_from_spec(const std::string& spec, const SequenceOpti
   std::error_code ec;
   if (std::filesystem::exists(spec, ec)) return read_camera_file(spec, options);
   const std::vector<std::string_view> f = detail::fields_of(spec);
+  const std::string shown = "camera " + text::quote_token(spec);  // user text: escaped and cut to 32 characters
   double first = 0;
   if (!f.empty() && detail::parse_number(f[0], &first)) {
     if (f.size() != 4 && f.size() != 9)
-      return detail::camera_error(Status::InvalidInput, "camera '" + spec + "': expected fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2,k3 (" +
+      return detail::camera_error(Status::InvalidInput, shown + ": expected fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2,k3 (" +
                                                             std::to_string(f.size()) + " numbers given)");
     SequenceCamera c;
     c.source = "command line";
     double v[9] = {};
     for (std::size_t k = 0; k < f.size(); ++k)
       if (!detail::parse_number(f[k], &v[k]))
-        return detail::camera_error(Status::InvalidInput, "camera '" + spec + "': value " + std::to_string(k + 1) + " " +
+        return detail::camera_error(Status::InvalidInput, shown + ": value " + std::to_string(k + 1) + " " +
                                                               text::quote_token(f[k]) + " is not a finite number");
     c.fx = v[0], c.fy = v[1], c.cx = v[2], c.cy = v[3];
     for (std::size_t k = 4; k < f.size(); ++k) c.distortion[k - 4] = v[k];
-    return detail::checked_camera(c, "camera '" + spec + "': ");
+    return detail::checked_camera(c, shown + ": ");
   }
   CameraResult r = tum_camera(spec);
-  if (!r.ok()) r.reason = "camera: no file '" + spec + "', not fx,fy,cx,cy, and " + r.reason;
+  if (!r.ok()) r.reason = "camera: no file " + text::quote_token(spec) + ", not fx,fy,cx,cy, and " + r.reason;
   return r;
 }
 
@@ -404,7 +417,8 @@ inline SequenceIndex read_sequence(const std::string& dir, const SequenceOptions
         kept.push_back(e);
       } else {
         ++*count;
-        s.notes.add(file + ":" + std::to_string(e.line) + ": " + e.path + " does not exist", options.max_notes);
+        s.notes.add(file + ":" + std::to_string(e.line) + ": " + text::quote_path(e.path) + " does not exist",
+                    options.max_notes);
       }
     }
     return kept;
@@ -438,8 +452,8 @@ inline SequenceIndex read_sequence(const std::string& dir, const SequenceOptions
       ++s.frames_without_depth;
       char dt[32];
       std::snprintf(dt, sizeof dt, "%g", options.max_difference_s);
-      s.notes.add(rgb_file + ":" + std::to_string(rgb[i].line) + ": frame " + std::to_string(i) + " (" + rgb[i].path +
-                      ") has no depth within " + dt + " s: it runs without depth",
+      s.notes.add(rgb_file + ":" + std::to_string(rgb[i].line) + ": frame " + std::to_string(i) + " (" +
+                      text::quote_path(rgb[i].path) + ") has no depth within " + dt + " s: it runs without depth",
                   options.max_notes);
     }
     s.frames.push_back(std::move(f));
@@ -458,49 +472,87 @@ inline void keep_filtered(const std::vector<Detection<float>>& boxes, int width,
   out->insert(out->end(), f.detections.begin(), f.detections.end());
 }
 
-/// A folder of per-frame JSON (yolo_json.hpp) matched to the frames by stamp.
-inline void read_json_folder(const std::string& dir, const SequenceIndex& s, int width, int height,
-                             const SequenceOptions& options, SequenceDetections* d) {
-  std::vector<std::string> files;
+/// A folder's *.json names (not starting with '_'), sorted; ParseError past max_frames of them (the
+/// reader's frame limit: a folder with more files than a sequence may have frames is refused, never cut
+/// in directory order), IoError when the folder cannot be listed.
+inline Status list_json_files(const std::string& dir, const SequenceOptions& options, std::vector<std::string>* files,
+                              std::string* reason) {
   std::error_code ec;
   for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::filesystem::path& p = it->path();
-    if (p.extension() == ".json" && p.filename().string().front() != '_') files.push_back(p.string());
-    if (files.size() > options.max_frames) break;
+    if (p.extension() != ".json" || p.filename().string().front() == '_') continue;
+    if (files->size() >= options.max_frames) {
+      *reason = text::quote_path(dir) + ": more than " + std::to_string(options.max_frames) +
+                " detection files (SequenceOptions::max_frames)";
+      return Status::ParseError;
+    }
+    files->push_back(p.string());
   }
   if (ec) {
-    d->status = Status::IoError;
-    d->reason = dir + ": " + ec.message();
-    return;
+    *reason = text::quote_path(dir) + ": " + ec.message();
+    return Status::IoError;
   }
-  std::sort(files.begin(), files.end());
+  std::sort(files->begin(), files->end());
+  return Status::Ok;
+}
+
+/// A folder of per-frame JSON (yolo_json.hpp) matched to the frames by stamp. Files are read in name
+/// order, and reading stops once every frame has a file within detection_max_difference_s and the last
+/// file read lies past the last frame: the files after it are not read, and a note says how many.
+inline void read_json_folder(const std::string& dir, const SequenceIndex& s, int width, int height,
+                             const SequenceOptions& options, SequenceDetections* d) {
+  std::vector<std::string> files;
+  d->status = list_json_files(dir, options, &files, &d->reason);
+  if (!d->ok()) return;
   std::vector<double> frame_t, file_t;
   std::vector<YoloJsonFrame<float>> parsed;
   for (const SequenceFrame& f : s.frames) frame_t.push_back(f.timestamp);
-  for (const std::string& file : files) {
-    YoloJsonFrame<float> j = read_yolo_json<float>(file);
+  const double tolerance = options.detection_max_difference_s;
+  const double last_frame = frame_t.empty() ? 0.0 : *std::max_element(frame_t.begin(), frame_t.end());
+  std::vector<std::uint8_t> covered(frame_t.size(), 0);
+  std::size_t frames_covered = 0;
+  const bool can_stop = !frame_t.empty() && std::is_sorted(frame_t.begin(), frame_t.end());
+  std::size_t read = 0;
+  for (; read < files.size(); ++read) {
+    if (can_stop && frames_covered == frame_t.size() && !file_t.empty() && file_t.back() > last_frame + tolerance)
+      break;
+    YoloJsonFrame<float> j = read_yolo_json<float>(files[read]);
     if (!j.ok()) {
       d->status = j.status;
       d->reason = j.reason;
       return;
     }
+    // Frames within the window of this stamp (frame stamps sorted): a cover, not the final pairing.
+    if (can_stop) {
+      const auto lo = std::lower_bound(frame_t.begin(), frame_t.end(), j.timestamp - tolerance);
+      for (auto it = lo; it != frame_t.end() && *it <= j.timestamp + tolerance; ++it) {
+        const std::size_t i = static_cast<std::size_t>(it - frame_t.begin());
+        frames_covered += covered[i] == 0;
+        covered[i] = 1;
+      }
+    }
     file_t.push_back(j.timestamp);
     parsed.push_back(std::move(j));
   }
+  if (read < files.size())
+    d->notes.add(text::quote_path(dir) + ": " + std::to_string(files.size() - read) + " files after " +
+                     text::quote_path(std::filesystem::path(files[read - 1]).filename().string()) +
+                     " not read: every frame has its detections file",
+                 options.max_notes);
   AssociationOptions ao;
-  ao.max_difference_s = options.detection_max_difference_s;
+  ao.max_difference_s = tolerance;
   const AssociationResult m = associate(frame_t, file_t, ao);
-  std::vector<std::uint8_t> file_used(files.size(), 0);
+  std::vector<std::uint8_t> file_used(file_t.size(), 0);
   for (std::size_t k = 0; k < m.size(); ++k) {
     const std::size_t i = m.first[k], j = m.second[k];
     d->has_file[i] = 1;
     file_used[j] = 1;
     keep_filtered(parsed[j].detections, width, height, options, d, &d->per_frame[i]);
   }
-  for (std::size_t j = 0; j < files.size(); ++j) {
+  for (std::size_t j = 0; j < file_t.size(); ++j) {
     if (file_used[j]) continue;
     ++d->files_unmatched;
-    d->notes.add(files[j] + ": timestamp matches no frame", options.max_notes);
+    d->notes.add(text::quote_path(files[j]) + ": timestamp matches no frame", options.max_notes);
   }
 }
 

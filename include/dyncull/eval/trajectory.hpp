@@ -16,7 +16,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <queue>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -87,8 +89,7 @@ struct AssociationOptions {
   double max_difference_s = 0.02;  ///< pairs need |t_first - (t_second + offset)| < this (strict, as TUM)
   double offset_s = 0.0;           ///< added to the second list's stamps
 
-  /// Upper bound of max_difference_s: a wider window pairs poses seconds apart, and makes the
-  /// candidate list (every pair inside the window) grow with the product of the two lengths.
+  /// Upper bound of max_difference_s: a wider window pairs poses seconds apart.
   static constexpr double kMaxDifferenceS = 10.0;
 
   /// Ok, or InvalidInput with a reason naming the field.
@@ -159,7 +160,8 @@ WriteResult write_tum_trajectory(const std::string& path, const Trajectory<T>& t
 /// NaN or Inf (a file never gives one: the reader skips such lines), the reason naming the list, the
 /// index, the value and how many there are; TooFewPoints when nothing associates; InvalidInput when
 /// options.validate() fails.
-/// Cost: O((n + m) log(n + m) + k log k) for k candidates (TUM's script is O(n m)).
+/// Cost: memory O(n + m) whatever the window holds; time O((n + m) log(n + m)) (TUM's script is O(n m)
+/// in both).
 inline AssociationResult associate(const double* first, std::size_t num_first, const double* second,
                                    std::size_t num_second, const AssociationOptions& options = {});
 
@@ -196,6 +198,106 @@ inline std::size_t sorted_unique_stamp_order(const double* stamps, std::size_t n
   }
   order->resize(kept);
   return dropped;
+}
+
+/// Unused positions of a sorted list, found in amortised constant time: the nearest unused position at
+/// or after (at or before) a given one, by union-find with path halving over two link arrays.
+class UnusedPositions {
+ public:
+  explicit UnusedPositions(std::size_t n) : right_(n + 1), left_(n + 1) {
+    for (std::size_t k = 0; k <= n; ++k) right_[k] = left_[k] = static_cast<std::uint32_t>(k);
+  }
+  /// The first unused position >= j, or n when there is none.
+  std::uint32_t at_or_after(std::uint32_t j) { return find(&right_, j); }
+  /// The last unused position <= j, or kNone when there is none.
+  std::uint32_t at_or_before(std::uint32_t j) {
+    const std::uint32_t k = find(&left_, j + 1);  // left_ is shifted by one: slot 0 means "none"
+    return k == 0 ? kNone : k - 1;
+  }
+  void use(std::uint32_t j) {
+    right_[j] = j + 1;
+    left_[j + 1] = j;
+  }
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+ private:
+  static std::uint32_t find(std::vector<std::uint32_t>* links, std::uint32_t k) {
+    std::vector<std::uint32_t>& p = *links;
+    while (p[k] != k) {
+      p[k] = p[p[k]];
+      k = p[k];
+    }
+    return k;
+  }
+  std::vector<std::uint32_t> right_, left_;
+};
+
+/// associate.py's greedy matching (every pair with |a - (b + offset)| < max_diff, taken in the order of
+/// (difference, a, b), each stamp once) without listing the pairs: the next pair taken is the smallest
+/// of each unused a's best unused b, kept in a heap and refreshed when its b is taken. |a - (b + offset)|
+/// does not decrease as b moves away from a in the sorted list, so an a's best b is the nearest unused
+/// one on either side (on the left, the first of a run of equal differences). `a` and `b` are positions
+/// of sorted distinct stamps. Returns (position in a, position in b) pairs sorted by a. Memory O(n + m).
+inline std::vector<std::pair<std::uint32_t, std::uint32_t>> greedy_nearest_pairs(
+    const double* first, const std::vector<std::uint32_t>& a, const double* second,
+    const std::vector<std::uint32_t>& b, double offset, double max_diff) {
+  const std::uint32_t nb = static_cast<std::uint32_t>(b.size());
+  const auto shifted = [&](std::uint32_t j) { return second[b[j]] + offset; };
+  const auto diff_of = [&](std::uint32_t i, std::uint32_t j) { return std::abs(first[a[i]] - shifted(j)); };
+  // split[i]: the first b position whose shifted stamp is >= a's stamp (both lists sorted).
+  std::vector<std::uint32_t> split(a.size());
+  for (std::uint32_t i = 0, j = 0; i < a.size(); ++i) {
+    while (j < nb && shifted(j) < first[a[i]]) ++j;
+    split[i] = j;
+  }
+  UnusedPositions unused(b.size());
+  struct Best {
+    double diff;
+    std::uint32_t i, j;
+    bool operator>(const Best& o) const {
+      return diff > o.diff || (diff == o.diff && (i > o.i || (i == o.i && j > o.j)));
+    }
+  };
+  // a's best unused b within the window, if any.
+  const auto best_of = [&](std::uint32_t i, Best* out) {
+    bool found = false;
+    const std::uint32_t r = unused.at_or_after(split[i]);
+    if (r < nb && diff_of(i, r) < max_diff) {
+      *out = Best{diff_of(i, r), i, r};
+      found = true;
+    }
+    std::uint32_t l = split[i] == 0 ? UnusedPositions::kNone : unused.at_or_before(split[i] - 1);
+    if (l != UnusedPositions::kNone && diff_of(i, l) < max_diff) {
+      const double d = diff_of(i, l);
+      // Ties go to the smaller b: walk to the first of the unused b's at this same difference.
+      for (std::uint32_t k; l > 0 && (k = unused.at_or_before(l - 1)) != UnusedPositions::kNone && diff_of(i, k) == d;)
+        l = k;
+      if (!found || !(d > out->diff)) *out = Best{d, i, l};  // equal difference: the left b is smaller
+      found = true;
+    }
+    return found;
+  };
+  std::priority_queue<Best, std::vector<Best>, std::greater<Best>> heap;
+  for (std::uint32_t i = 0; i < a.size(); ++i) {
+    Best best{};
+    if (best_of(i, &best)) heap.push(best);
+  }
+  std::vector<std::uint8_t> used_b(b.size(), 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> matches;
+  while (!heap.empty()) {
+    const Best top = heap.top();
+    heap.pop();
+    if (used_b[top.j]) {  // taken since: this a's best is now further away (never nearer)
+      Best next{};
+      if (best_of(top.i, &next)) heap.push(next);
+      continue;
+    }
+    used_b[top.j] = 1;
+    unused.use(top.j);
+    matches.emplace_back(top.i, top.j);
+  }
+  std::sort(matches.begin(), matches.end());
+  return matches;
 }
 
 inline bool is_separator(char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r' || c == '\v' || c == '\f'; }
@@ -474,44 +576,10 @@ inline AssociationResult associate(const double* first, std::size_t num_first, c
   result.num_duplicates_first = detail::sorted_unique_stamp_order(first, num_first, &a);
   result.num_duplicates_second = detail::sorted_unique_stamp_order(second, num_second, &b);
 
-  struct Candidate {
-    double diff;
-    std::uint64_t ab;  // (position in a) << 32 | (position in b): sorted positions, so ordering them orders the stamps
-  };
-  std::vector<Candidate> candidates;
-  candidates.reserve(a.size() + b.size());
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> matches =
+      detail::greedy_nearest_pairs(first, a, second, b, options.offset_s, options.max_difference_s);
   const double offset = options.offset_s;
   const double max_diff = options.max_difference_s;
-  std::size_t lo = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const double ta = first[a[i]];
-    // Window start: b stamps are sorted, so (b + offset) - ta is non-decreasing in b's position.
-    while (lo < b.size() && (second[b[lo]] + offset) - ta <= -max_diff) ++lo;
-    for (std::size_t j = lo; j < b.size(); ++j) {
-      const double shifted = second[b[j]] + offset;
-      if (shifted - ta >= max_diff) break;
-      const double diff = std::abs(ta - shifted);  // the exact expression associate.py tests
-      if (diff < max_diff) {
-        candidates.push_back(Candidate{diff, (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint64_t>(j)});
-      }
-    }
-  }
-  // Python sorts the tuples (diff, a, b): ties on diff go to the earlier first stamp, then second.
-  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-    return x.diff < y.diff || (x.diff == y.diff && x.ab < y.ab);
-  });
-  std::vector<std::uint8_t> used_a(a.size(), 0);
-  std::vector<std::uint8_t> used_b(b.size(), 0);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> matches;  // (position in a, position in b)
-  for (const Candidate& c : candidates) {
-    const std::uint32_t ia = static_cast<std::uint32_t>(c.ab >> 32);
-    const std::uint32_t ib = static_cast<std::uint32_t>(c.ab & 0xffffffffu);
-    if (used_a[ia] || used_b[ib]) continue;
-    used_a[ia] = 1;
-    used_b[ib] = 1;
-    matches.emplace_back(ia, ib);
-  }
-  std::sort(matches.begin(), matches.end());
   result.first.reserve(matches.size());
   result.second.reserve(matches.size());
   for (const auto& m : matches) {

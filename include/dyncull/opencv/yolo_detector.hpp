@@ -18,6 +18,9 @@
 #include "dyncull/core/box.hpp"
 #include "dyncull/core/pixel.hpp"
 #include "dyncull/core/status.hpp"
+#include "dyncull/core/text.hpp"
+#include "dyncull/core/text_file.hpp"
+#include "dyncull/opencv/darknet_layout.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
@@ -26,8 +29,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <exception>
-#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -59,6 +63,11 @@ enum class YoloResize {
   Plain,      ///< stretched to the input size, as cv::dnn::blobFromImage does
   Letterbox,  ///< scaled by min(in_w / W, in_h / H), centred, the rest filled (YOLOv5 / YOLOv8 export)
 };
+
+/// Size caps of the model files (the file-opening rule of core/text_file.hpp): a Darknet cfg is a few
+/// kB of text; the largest YOLO weights and ONNX exports are a few hundred MB.
+constexpr std::uint64_t kMaxYoloCfgBytes = std::uint64_t(1) << 20;
+constexpr std::uint64_t kMaxYoloModelBytes = std::uint64_t(1) << 30;
 
 struct YoloDetectorOptions {
   std::string model;    ///< Darknet .cfg or .onnx
@@ -244,6 +253,24 @@ inline void collect_candidates(const cv::Mat& out, YoloHead head, const YoloInpu
   }
 }
 
+/// A Darknet network's outputs against its cfg: one per [yolo] layer, each holding a whole number of
+/// grid cells of that layer's anchors.
+inline bool outputs_fit_layout(const std::vector<cv::Mat>& outputs, const DarknetLayout& layout, std::string* why) {
+  if (outputs.size() != layout.heads.size()) {
+    *why = std::to_string(outputs.size()) + " outputs for the cfg's " + std::to_string(layout.heads.size()) + " [yolo] layers";
+    return false;
+  }
+  for (std::size_t k = 0; k < outputs.size(); ++k) {
+    const int anchors = layout.heads[k].anchors;
+    if (outputs[k].dims != 2 || outputs[k].rows == 0 || outputs[k].rows % anchors != 0) {
+      *why = "output " + std::to_string(k) + " has shape " + shape_of(outputs[k]) + ", not whole grid cells of " +
+             std::to_string(anchors) + " anchors";
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace detail
 
 /// Raw network outputs -> detections: candidates with objectness x class score >= min_confidence, NMS
@@ -329,9 +356,14 @@ inline void decode_yolo_outputs(const std::vector<cv::Mat>& outputs, YoloHead he
 class YoloDetector {
  public:
   /// Loads the network and runs it once on a blank input to check its outputs are a YOLO head (and to
-  /// allocate its buffers). Any failure leaves the detector closed, with the reason: IoError for a
-  /// missing file, InvalidInput for bad options, a cfg without weights, an unknown model extension or
-  /// outputs that are not a YOLO head, ParseError when OpenCV cannot read the model.
+  /// allocate its buffers). The files are read under the file-opening rule of core/text_file.hpp
+  /// (regular files, not the kernel's, never waited on; cfg at most kMaxYoloCfgBytes, weights and ONNX at
+  /// most kMaxYoloModelBytes) and OpenCV parses the bytes. A Darknet cfg is followed layer by layer
+  /// (darknet_layout.hpp): the weights must have exactly the size its layers need. Any failure leaves
+  /// the detector closed, with the reason: IoError for a file that is missing, not regular, the kernel's
+  /// or over its cap; InvalidInput for bad options, a cfg without weights, an unknown model extension,
+  /// weights of another size than the cfg's layers need, or outputs that are not its YOLO heads;
+  /// ParseError for a cfg whose layers cannot be followed or a model OpenCV cannot read.
   YoloOpenResult open(const YoloDetectorOptions& options) {
     opened_ = YoloOpenResult{};
     net_ = cv::dnn::Net();
@@ -350,18 +382,33 @@ class YoloDetector {
     const bool onnx = ends_with(options.model, ".onnx");
     if (!darknet && !onnx)
       return fail(Status::InvalidInput, options.model + ": unknown model type (expected a Darknet .cfg or an .onnx)");
-    if (!readable(options.model)) return fail(Status::IoError, options.model + ": cannot open the model");
     if (darknet && options.weights.empty())
-      return fail(Status::InvalidInput, options.model + ": a Darknet cfg needs its .weights file (options.weights is empty)");
+      return fail(Status::InvalidInput, text::quote_path(options.model) +
+                                            ": a Darknet cfg needs its .weights file (options.weights is empty)");
     if (onnx && !options.weights.empty())
-      return fail(Status::InvalidInput, options.model + ": an ONNX model holds its own weights (options.weights must be empty)");
-    if (darknet && !readable(options.weights)) return fail(Status::IoError, options.weights + ": cannot open the weights");
+      return fail(Status::InvalidInput, text::quote_path(options.model) +
+                                            ": an ONNX model holds its own weights (options.weights must be empty)");
     if (darknet && (options.head == YoloHead::YoloV5 || options.head == YoloHead::YoloV8))
-      return fail(Status::InvalidInput, options.model + ": a Darknet cfg has Darknet heads, not " + to_string(options.head));
+      return fail(Status::InvalidInput, text::quote_path(options.model) + ": a Darknet cfg has Darknet heads, not " +
+                                            to_string(options.head));
     if (onnx && options.head == YoloHead::Darknet)
-      return fail(Status::InvalidInput, options.model + ": an ONNX export has a YOLOv5 or YOLOv8 head, not darknet");
+      return fail(Status::InvalidInput, text::quote_path(options.model) +
+                                            ": an ONNX export has a YOLOv5 or YOLOv8 head, not darknet");
+    // The files are read here, under the file-opening rule, and OpenCV parses the bytes: it never opens a
+    // path itself, so a FIFO, a device or a file swapped after the check never reaches it.
+    std::vector<char> model_bytes, weights_bytes;
+    if (!read_model_file(options.model, darknet ? kMaxYoloCfgBytes : kMaxYoloModelBytes, &model_bytes, &why) ||
+        (darknet && !read_model_file(options.weights, kMaxYoloModelBytes, &weights_bytes, &why)))
+      return fail(Status::IoError, why);
+    DarknetLayout layout;
+    if (darknet) {
+      const Status st = check_darknet_files(options, model_bytes, weights_bytes, &layout, &why);
+      if (st != Status::Ok) return fail(st, why);
+    }
     try {
-      net_ = darknet ? cv::dnn::readNetFromDarknet(options.model, options.weights) : cv::dnn::readNetFromONNX(options.model);
+      net_ = darknet ? cv::dnn::readNetFromDarknet(model_bytes.data(), model_bytes.size(), weights_bytes.data(),
+                                                   weights_bytes.size())
+                     : cv::dnn::readNetFromONNX(model_bytes.data(), model_bytes.size());
     } catch (const cv::Exception& e) {
       return fail(Status::ParseError, options.model + ": OpenCV cannot read the model: " + first_line(e.what()));
     } catch (const std::exception& e) {
@@ -386,6 +433,9 @@ class YoloDetector {
     if (outputs_.empty()) return fail(Status::InvalidInput, options.model + ": the network has no output");
     if (darknet) {
       head_ = YoloHead::Darknet;
+      // A cfg without [yolo] layers is reported below with its outputs' shapes.
+      if (!layout.heads.empty() && !detail::outputs_fit_layout(outputs_, layout, &why))
+        return fail(Status::InvalidInput, options.model + ": " + why);
     } else {
       // Some YOLOv5 exports keep the raw per-scale maps ([1, 3, H, W, 85]) beside the decoded output:
       // the outputs that are a head are used, the others not computed.
@@ -486,7 +536,50 @@ class YoloDetector {
     }
     return true;
   }
-  static bool readable(const std::string& path) { return static_cast<bool>(std::ifstream(path, std::ios::binary)); }
+  /// The whole file under the file-opening rule (text::InputFile: regular, not the kernel's, at most max_bytes).
+  static bool read_model_file(const std::string& path, std::uint64_t max_bytes, std::vector<char>* bytes,
+                              std::string* why) {
+    text::InputFile file;
+    if (!file.open(path, max_bytes, why)) return false;
+    bytes->resize(static_cast<std::size_t>(file.size()));
+    std::size_t at = 0;
+    while (true) {
+      char chunk[1 << 16];
+      const long got = file.read(chunk, sizeof chunk);
+      if (got == 0) break;
+      if (got < 0 || at + static_cast<std::size_t>(got) > bytes->size()) {
+        *why = text::quote_path(path) + (got == -1 ? ": read error" : ": changed size while read");
+        return false;
+      }
+      std::memcpy(bytes->data() + at, chunk, static_cast<std::size_t>(got));
+      at += static_cast<std::size_t>(got);
+    }
+    if (at != bytes->size()) {
+      *why = text::quote_path(path) + ": changed size while read";
+      return false;
+    }
+    return true;
+  }
+
+  /// The cfg's layout (darknet_layout) and the weights file's size against it: exactly its header and 4
+  /// bytes per float of every convolution. (The heads' classes are checked on the outputs' shapes.)
+  static Status check_darknet_files(const YoloDetectorOptions& options, const std::vector<char>& cfg,
+                                    const std::vector<char>& weights, DarknetLayout* layout, std::string* why) {
+    const std::string cfg_name = text::quote_path(options.model), weights_name = text::quote_path(options.weights);
+    if (!darknet_layout(std::string_view(cfg.data(), cfg.size()), layout, why)) {
+      *why = cfg_name + ": " + *why;
+      return Status::ParseError;
+    }
+    std::int32_t version[2] = {0, 0};
+    if (weights.size() >= sizeof version) std::memcpy(version, weights.data(), sizeof version);
+    const std::uint64_t need = layout->weights_bytes(version[0], version[1]);
+    if (weights.size() != need) {
+      *why = weights_name + ": " + std::to_string(weights.size()) + " bytes, where the layers of " + cfg_name +
+             " need " + std::to_string(need) + (weights.size() < need ? " (truncated?)" : " (padded, or another network's?)");
+      return Status::InvalidInput;
+    }
+    return Status::Ok;
+  }
   static std::string first_line(const char* what) {
     std::string s(what ? what : "");
     // OpenCV's messages start with a newline and "OpenCV(4.x) file:line: error: ..."

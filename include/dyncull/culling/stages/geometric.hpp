@@ -29,6 +29,24 @@ struct GeometricSlice {
         reprojection_needs(needs_of(o, &PipelineResult<T>::reprojection)) {}
 };
 
+/// No Ok without its evidence: when enough tracks are flagged valid but none has a finite 3-D point
+/// (depth given but all 0, NaN or out of range where the points came from), the reprojection check could
+/// not run for want of a usable input. That is a missing input of the frame (MissingInput, the reason
+/// naming points_3d), not a frame with nothing to do (Skipped, which leaves the frame Ok).
+inline void report_unusable_points(FlagView track_valid, std::size_t n, std::size_t min_tracks, std::size_t num_usable,
+                                   StageReport* report) {
+  if (report->status != Status::Skipped || num_usable > 0) return;
+  std::size_t flagged = n;
+  if (track_valid.given) {
+    flagged = 0;
+    for (std::size_t i = 0; i < n && i < track_valid.size; ++i) flagged += track_valid[i] != 0;
+  }
+  if (flagged == 0 || flagged < min_tracks) return;
+  report->status = Status::MissingInput;
+  report->reason = "points_3d: none of the " + std::to_string(flagged) +
+                   " valid tracks has a finite 3-D point (the depth they came from is unusable: 0, NaN or out of range)";
+}
+
 /// Geometric evidence of this frame (out->labels, valid when out->ok); reports into
 /// r.moving_consistency and r.reprojection.
 template <class T, class Frame>
@@ -59,6 +77,8 @@ void gather_geometric_evidence(const Frame& frame, const NonDeduced<GeometricSli
       r->reprojection.status = g.reprojection.status;
       r->reprojection.reason = g.reprojection.reason;
       r->reprojection.num_dynamic = g.reprojection.num_dynamic;
+      report_unusable_points(frame.track_valid, n, options.reprojection.min_tracks, g.reprojection.num_valid,
+                             &r->reprojection);
     }
     if (r->reprojection.ran()) {
       if (!r->moving_consistency.ran()) {
