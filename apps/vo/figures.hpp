@@ -4,7 +4,6 @@
 /// equation.
 #pragma once
 
-#include "dyncull/core/pixel.hpp"
 #include "report.hpp"
 #include "runner.hpp"
 
