@@ -15,10 +15,11 @@
 #       the same on dyncull's scene families (write_tum_sequence --family, seed 1): one orbslam3_summary.csv
 #       per family and motion under OUT/families/, and OUT/orbslam3_families.csv (no page section yet)
 #   scripts/orbslam3.sh --build-only       builds everything, runs nothing
-#   scripts/orbslam3.sh --compile-check    applies the patches to a copy of ORB-SLAM3 and compiles the
-#       translation units the culler patch changes (src/Tracking.cc, src/Atlas.cc) with ORB-SLAM3's flags
-#       against dyncull's install: no Pangolin build (its headers are configured only), no ORB-SLAM3 build,
-#       no run.
+#   scripts/orbslam3.sh --compile-check    applies the patches to a copy of ORB-SLAM3 and compiles what the
+#       culler patch changes with ORB-SLAM3's flags against dyncull's install: src/Atlas.cc whole, and the
+#       statements it adds to src/Tracking.cc against ORB-SLAM3's Frame.h (the whole file takes minutes);
+#       no Pangolin build (its headers are configured only), no ORB-SLAM3 build, no run.
+#   scripts/orbslam3.sh --compile-check-full  the same and the whole patched src/Tracking.cc (-fsyntax-only)
 # Variants: stock, box_only, culler (boxes from the sequence's detections folder), culler_live and
 # culler_live_sync (a YOLO detector beside the tracker or waited for, --detector), as scripts/orbslam2.sh.
 # Options:
@@ -41,11 +42,13 @@ integration="$root/integrations/orb_slam3"
 # shellcheck source=scripts/orbslam_common.sh
 source "$root/scripts/orbslam_common.sh"
 sensor=rgbd
+full_check=""
 while (($#)); do
   common_option "$@"
   if ((used > 0)); then shift "$used"; continue; fi
   case "$1" in
     --sensor) (($# >= 2)) || die "--sensor needs a value" 2; sensor=$2; shift 2 ;;
+    --compile-check-full) mode=compile_check; full_check=1; shift ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) die "unknown argument '$1' (see --help)" 2 ;;
   esac
@@ -117,11 +120,15 @@ vocabulary_tree() {
 
 # --- compile check: the culler patch's translation units, with ORB-SLAM3's flags, against the install ---
 # ORB-SLAM3's flags (its CMakeLists.txt): -Wall -O3 -std=c++11 -DCOMPILEDWITHC11, Release -O3 -DNDEBUG
-# -march=native. Atlas.cc is compiled to an object; Tracking.cc, whose headers (g2o, Sophus, Boost
-# serialization, Eigen) make code generation take minutes, is checked with the same flags and
-# -fsyntax-only: every template of the host harness it calls is instantiated and checked, no object written.
+# -march=native. src/Atlas.cc is compiled whole. src/Tracking.cc takes minutes to compile (its headers
+# are most of ORB-SLAM3, g2o, Eigen and Boost serialization), so the check compiles what the patch adds
+# to it instead: the patched statements, cut from the patched file as they are, in a unit that includes
+# ORB-SLAM3's own Frame.h (Sophus, DBoW2, the Frame the helper culls) and declares the Tracking members
+# they use with Tracking.h's types (each declaration is checked to be in Tracking.h). --compile-check-full
+# also checks the whole patched Tracking.cc with -fsyntax-only.
 compile_check() {
-  local start tree="$work/compile-check/ORB_SLAM3" cxx_flags flags includes
+  local start tree="$work/compile-check/ORB_SLAM3" cxx_flags flags includes unit="$work/compile-check/tracking_patch.cc"
+  local declaration statements
   start=$(date +%s)
   install_dyncull
   rm -rf "$tree"
@@ -140,14 +147,50 @@ compile_check() {
   check_compile "$work/compile-check/Atlas.o" "$work/compile-check/Atlas.log" ORB-SLAM3
   grep -q 'U dyncull::host::HostCuller::reset' < <(nm -C "$work/compile-check/Atlas.o") ||
     die "Atlas.o does not reset the culler: the patch did not apply as expected"
-  g++ "${flags[@]}" -fsyntax-only "$tree/src/Tracking.cc" "${includes[@]}" \
-    2>"$work/compile-check/Tracking.log" || { tail -40 "$work/compile-check/Tracking.log" >&2; exit 1; }
-  if grep -n 'include/dyncull/' "$work/compile-check/Tracking.log" >&2; then
-    die "the lines above are warnings in dyncull's headers under ORB-SLAM3's flags"
-  fi
-  [[ $(grep -c 'dyncull::host::cull_orb_slam_frame' "$tree/src/Tracking.cc") == 3 ]] ||
+
+  for declaration in 'eTrackingState mState;' 'Frame mCurrentFrame;' 'Frame mLastFrame;' 'cv::Mat mK;' \
+    'cv::Mat mDistCoef;' 'bool mbVelocity' 'Sophus::SE3f mVelocity;' 'OK=2,'; do
+    grep -qF "$declaration" "$tree/include/Tracking.h" ||
+      die "include/Tracking.h declares no '$declaration': the check's stand-in for Tracking no longer matches"
+  done
+  # Each patched statement: from its cull_orb_slam_frame( line to the line that ends it with ");".
+  statements=$(awk '/dyncull::host::cull_orb_slam_frame\(/ { on = 1 } on { print } on && /\);[[:space:]]*$/ { on = 0 }' \
+    "$tree/src/Tracking.cc")
+  [[ $(grep -c 'cull_orb_slam_frame(' <<<"$statements") == 3 ]] ||
     die "src/Tracking.cc does not cull in GrabImageStereo, GrabImageRGBD and GrabImageMonocular: the patch did not apply as expected"
-  log "compile check passed: patched src/Atlas.cc (object) and src/Tracking.cc (-fsyntax-only) compile with -std=c++11 -O3 against $dyncull_prefix ($(($(date +%s) - start)) s)"
+  {
+    echo '// The statements dyncull-culler.patch adds to src/Tracking.cc, as patched, with the members they use.'
+    echo '#include "Frame.h"'
+    echo '#include <dyncull/host/host_culler.hpp>'
+    echo 'namespace ORB_SLAM3 {'
+    echo 'struct PatchedTracking {'
+    echo '  enum eTrackingState { SYSTEM_NOT_READY = -1, NO_IMAGES_YET = 0, NOT_INITIALIZED = 1, OK = 2 };'
+    echo '  eTrackingState mState;'
+    echo '  Frame mCurrentFrame, mLastFrame;'
+    echo '  cv::Mat mK, mDistCoef;'
+    echo '  bool mbVelocity;'
+    echo '  Sophus::SE3f mVelocity;'
+    echo '  void grab(const cv::Mat& imRectLeft, const cv::Mat& imRGB, const cv::Mat& imDepth, const cv::Mat& im) {'
+    echo "$statements"
+    echo '  }'
+    echo '};'
+    echo 'void grab(PatchedTracking& t, const cv::Mat& image) { t.grab(image, image, image, image); }'
+    echo '}  // namespace ORB_SLAM3'
+  } >"$unit"
+  g++ "${flags[@]}" -c "$unit" -o "$work/compile-check/tracking_patch.o" "${includes[@]}" \
+    2>"$work/compile-check/tracking_patch.log" || { tail -40 "$work/compile-check/tracking_patch.log" >&2; exit 1; }
+  check_compile "$work/compile-check/tracking_patch.o" "$work/compile-check/tracking_patch.log" ORB-SLAM3
+  grep -q 'U dyncull::host::HostCuller::cull' < <(nm -C "$work/compile-check/tracking_patch.o") ||
+    die "the patched statements do not call the culler"
+  if [[ -n "$full_check" ]]; then
+    log "checking the whole patched src/Tracking.cc with -fsyntax-only (minutes)"
+    g++ "${flags[@]}" -fsyntax-only "$tree/src/Tracking.cc" "${includes[@]}" \
+      2>"$work/compile-check/Tracking.log" || { tail -40 "$work/compile-check/Tracking.log" >&2; exit 1; }
+    if grep -n 'include/dyncull/' "$work/compile-check/Tracking.log" >&2; then
+      die "the lines above are warnings in dyncull's headers under ORB-SLAM3's flags"
+    fi
+  fi
+  log "compile check passed: patched src/Atlas.cc and src/Tracking.cc's patched statements${full_check:+ (and the whole file, -fsyntax-only)} compile with -std=c++11 -O3 against $dyncull_prefix ($(($(date +%s) - start)) s)"
 }
 
 if [[ "$mode" == compile_check ]]; then
