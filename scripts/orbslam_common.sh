@@ -3,7 +3,7 @@
 # (its integrations/ folder). The options both scripts take are parsed by common_option; the functions
 # build and install dyncull and Pangolin, copy a host tree with patches applied, train or find a
 # vocabulary, configure the headers a compile check needs, and run the variants on sequences.
-# shellcheck shell=bash
+# shellcheck shell=bash disable=SC2034,SC2154  # sets the options the sourcing script reads; reads its host and root
 
 thirdparty="$root/../shared/thirdparty"
 work="${XDG_CACHE_HOME:-$HOME/.cache}/dyncull-$host"
