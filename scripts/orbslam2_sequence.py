@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
-"""Sequence side of scripts/orbslam2.sh (standard library; the trajectory figure needs matplotlib).
+"""Sequence side of scripts/orbslam2.sh and scripts/orbslam3.sh (standard library; the trajectory figure
+needs matplotlib).
 
   orbslam2_sequence.py prepare SEQUENCE OUT [--dyncull-eval PATH]
       OUT/orbslam2_settings.yaml (ORB-SLAM2's settings, written from SEQUENCE/camera.txt) and
       OUT/associations.txt (rgb and depth paired by `dyncull_eval --associate` as the TUM benchmark's
       associate.py: |dt| < 0.02 s, closest pairs first, each stamp once); when SEQUENCE has rgb_color.txt (colour frames of the same
       stamps, for a live detector), OUT/associations_color.txt pairs those with depth the same way.
+  orbslam2_sequence.py prepare SEQUENCE OUT --host orbslam3
+      the same with OUT/orbslam3_settings.yaml (ORB-SLAM3's settings format 1.0) in place of ORB-SLAM2's.
   orbslam2_sequence.py summarise SEQUENCE OUT [--vocabulary FILE] [--command TEXT] [--page FILE]
       reads OUT/runs/VARIANT/runN/ (rgbd_tum.log, CameraTrajectory.txt, ate.json), writes
       OUT/orbslam2_summary.csv (a row per variant and run) and prints the table; with --page, replaces
@@ -16,6 +19,12 @@
       reads OUT/families/NAME/orbslam2_summary.csv (one folder per family and camera motion), writes
       OUT/orbslam2_families.csv (median ATE, lost frames per variant and sequence) and prints the table;
       with --page, replaces (or appends) the page's "## Scene families in ORB-SLAM2" section.
+
+  With --host orbslam3 [--sensor rgbd|mono], summarise and families read and write orbslam3_summary.csv
+  and orbslam3_families.csv: the same columns and `sensor`; a monocular run is read from mono_tum.log,
+  its frames are rgb.txt's (mono_tum reads the colour list itself) and its ATE is after Sim(3) alignment
+  (the script evaluates it with --scale). ORB-SLAM3's maps (Atlas) beyond the first are counted in the
+  run's note. No page section is written for ORB-SLAM3 yet.
 
 Lost frames: ORB-SLAM2 leaves a frame out of CameraTrajectory.txt when it was lost (and every frame before
 its map exists), without a message; they are counted as association lines minus trajectory lines.
@@ -131,18 +140,62 @@ Viewer.ViewpointF: 500
 """
 
 
-def prepare(sequence, out, dyncull_eval):
+SETTINGS_ORBSLAM3 = """%YAML:1.0
+# Written by scripts/orbslam3.sh from {camera} (ORB-SLAM3's settings format 1.0: real numbers with a point).
+File.version: "1.0"
+Camera.type: "PinHole"
+Camera1.fx: {fx!r}
+Camera1.fy: {fy!r}
+Camera1.cx: {cx!r}
+Camera1.cy: {cy!r}
+Camera1.k1: {k1!r}
+Camera1.k2: {k2!r}
+Camera1.p1: {p1!r}
+Camera1.p2: {p2!r}
+Camera1.k3: {k3!r}
+Camera.width: {width}
+Camera.height: {height}
+Camera.fps: 30
+Camera.RGB: 1
+# IR projector baseline (about 40 / fx metres for a Kinect-class sensor, as ORB-SLAM2's Camera.bf 40)
+Stereo.ThDepth: 40.0
+Stereo.b: {baseline!r}
+RGBD.DepthMapFactor: {depth_factor!r}
+ORBextractor.nFeatures: 1000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+Viewer.KeyFrameSize: 0.05
+Viewer.KeyFrameLineWidth: 1.0
+Viewer.GraphLineWidth: 0.9
+Viewer.PointSize: 2.0
+Viewer.CameraSize: 0.08
+Viewer.CameraLineWidth: 3.0
+Viewer.ViewpointX: 0.0
+Viewer.ViewpointY: -0.7
+Viewer.ViewpointZ: -1.8
+Viewer.ViewpointF: 500.0
+"""
+
+
+def prepare(sequence, out, dyncull_eval, host="orbslam2"):
     camera = read_camera(os.path.join(sequence, "camera.txt"))
     rgb = read_list(os.path.join(sequence, "rgb.txt"))
     depth = read_list(os.path.join(sequence, "depth.txt"))
     if not rgb or not depth:
         sys.exit("orbslam2_sequence.py: %s has an empty rgb.txt or depth.txt" % sequence)
     width, height = png_size(os.path.join(sequence, rgb[0][1]))
-    settings = SETTINGS.format(
-        camera="camera.txt", width=width, height=height,
-        depth_factor=camera.get("depth_units_per_metre", 5000.0),
-        **{k: camera.get(k, 0.0) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")})
-    with open(os.path.join(out, "orbslam2_settings.yaml"), "w") as f:
+    values = {k: float(camera.get(k, 0.0)) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")}
+    depth_factor = float(camera.get("depth_units_per_metre", 5000.0))
+    if host == "orbslam3":
+        settings = SETTINGS_ORBSLAM3.format(camera="camera.txt", width=width, height=height, depth_factor=depth_factor,
+                                            baseline=40.0 / values["fx"], **values)
+    else:
+        settings = SETTINGS.format(camera="camera.txt", width=width, height=height,
+                                   depth_factor=camera.get("depth_units_per_metre", 5000.0),
+                                   **{k: camera.get(k, 0.0) for k in values})
+    with open(os.path.join(out, "%s_settings.yaml" % host), "w") as f:
         f.write(settings)
     depth_list = os.path.join(sequence, "depth.txt")
     pairs = associate(dyncull_eval, os.path.join(sequence, "rgb.txt"), depth_list)
@@ -164,12 +217,12 @@ def count_lines(path):
         return sum(1 for line in f if line.strip() and not line.startswith("#"))
 
 
-def read_run(directory, frames):
+def read_run(directory, frames, log_name="rgbd_tum.log"):
     row = {"ate_rmse_m": "", "ate_pairs": "", "track_ms": "", "track_median_ms": "", "cull_ms": "", "features": "",
            "features_kept": "", "note": "", "fps": "", "track_ms_p95": "", "detector_ms": "", "box_age_frames": ""}
     poses = count_lines(os.path.join(directory, "CameraTrajectory.txt"))
     row["lost_frames"] = frames - poses
-    log_path = os.path.join(directory, "rgbd_tum.log")
+    log_path = os.path.join(directory, log_name)
     text = open(log_path, errors="replace").read() if os.path.exists(log_path) else ""
     m = re.search(r"median tracking time: ([0-9.eE+-]+)", text)
     if m:
@@ -198,7 +251,10 @@ def read_run(directory, frames):
     except (OSError, ValueError, KeyError):
         row["note"] = "no trajectory" if poses == 0 else "evaluation failed"
     if not row["track_ms"]:
-        row["note"] = (row["note"] + "; " if row["note"] else "") + "rgbd_tum did not finish"
+        row["note"] = (row["note"] + "; " if row["note"] else "") + "%s did not finish" % log_name[:-4]
+    maps = len(re.findall(r"Creation of new map with id", text))  # ORB-SLAM3's Atlas; none in ORB-SLAM2
+    if maps > 1:
+        row["note"] = (row["note"] + "; " if row["note"] else "") + "%d maps" % maps
     return row
 
 
@@ -230,8 +286,11 @@ def median_range(values, scale=1.0, digits=2):
     return (fmt + " (" + fmt + "-" + fmt + ")") % (statistics.median(v), min(v), max(v))
 
 
-def summarise(sequence, out, vocabulary, command, page):
-    frames = count_lines(os.path.join(out, "associations.txt"))
+def summarise(sequence, out, vocabulary, command, page, host="orbslam2", sensor="rgbd"):
+    mono = host == "orbslam3" and sensor == "mono"
+    frames = count_lines(os.path.join(sequence, "rgb.txt") if mono else os.path.join(out, "associations.txt"))
+    columns = COLUMNS + (["sensor"] if host == "orbslam3" else [])
+    log_name = "mono_tum.log" if mono else "rgbd_tum.log"
     rows = []
     runs_dir = os.path.join(out, "runs")
     for variant in VARIANTS:
@@ -240,16 +299,18 @@ def summarise(sequence, out, vocabulary, command, page):
             continue
         runs = sorted((int(d[3:]) for d in os.listdir(vdir) if re.fullmatch(r"run[0-9]+", d)))
         for r in runs:
-            row = read_run(os.path.join(vdir, "run%d" % r), frames)
-            row.update(variant=variant, run=r, frames=frames)
+            row = read_run(os.path.join(vdir, "run%d" % r), frames, log_name)
+            row.update(variant=variant, run=r, frames=frames, sensor=sensor)
             rows.append(row)
-    with open(os.path.join(out, "orbslam2_summary.csv"), "w") as f:
-        f.write(",".join(COLUMNS) + "\n")
+    with open(os.path.join(out, "%s_summary.csv" % host), "w") as f:
+        f.write(",".join(columns) + "\n")
         for row in rows:
-            f.write(",".join(str(row[c]).replace(",", ";") for c in COLUMNS) + "\n")
+            f.write(",".join(str(row[c]).replace(",", ";") for c in columns) + "\n")
     table = summary_table(rows)
+    if mono:
+        table = table.replace("ATE RMSE, cm", "ATE RMSE after Sim(3) alignment, cm")
     print(table)
-    if page:
+    if page and host == "orbslam2":
         write_page(page, table, rows, sequence, out, vocabulary, command)
 
 
@@ -404,16 +465,17 @@ def lost_cell(values):
     return "%g (%g-%g)" % (statistics.median(values), min(values), max(values))
 
 
-def families(out, command, page):
+def families(out, command, page, host="orbslam2"):
     root = os.path.join(out, "families")
-    names = sorted(d for d in os.listdir(root) if os.path.exists(os.path.join(root, d, "orbslam2_summary.csv")))
+    summary = "%s_summary.csv" % host
+    names = sorted(d for d in os.listdir(root) if os.path.exists(os.path.join(root, d, summary)))
     table = ["| Sequence | Runs | Stock ATE, cm | Box-only ATE, cm | Culler ATE, cm | Culler / stock | "
              "Lost frames: stock; box-only; culler |",
              "|---|---|---|---|---|---|---|"]
     csv = ["sequence,variant,runs,ate_median_m,ate_min_m,ate_max_m,lost_median,frames"]
     ratios, wins, no_more_lost = [], 0, 0
     for name in names:
-        rows = read_summary(os.path.join(root, name, "orbslam2_summary.csv"))
+        rows = read_summary(os.path.join(root, name, summary))
         medians, ranges, lost, lost_median, runs = {}, {}, {}, {}, 0
         for variant in VARIANTS:
             ate = numbers(rows, variant, "ate_rmse_m")
@@ -441,11 +503,11 @@ def families(out, command, page):
         cell = lambda v: ranges.get(v, "n/a")
         table.append("| %s | %d | %s | %s | %s | %s | %s |" % (name, runs, cell("stock"), cell("box_only"), cell("culler"),
                                                                 ratio or "n/a", "; ".join(lost[v] for v in VARIANTS)))
-    with open(os.path.join(out, "orbslam2_families.csv"), "w") as f:
+    with open(os.path.join(out, "%s_families.csv" % host), "w") as f:
         f.write("\n".join(csv) + "\n")
     text = "\n".join(table)
     print(text)
-    if not page:
+    if not page or host != "orbslam2":
         return
     within = sum(1 for r in ratios if r <= 0.5)
     section = "\n".join([
@@ -493,13 +555,18 @@ def main():
     parser.add_argument("--page", default="")
     parser.add_argument("--dyncull-eval", default=os.environ.get("DYNCULL_EVAL", "dyncull_eval"),
                         help="the dyncull_eval program (default: $DYNCULL_EVAL, else dyncull_eval on the PATH)")
+    parser.add_argument("--host", choices=["orbslam2", "orbslam3"], default="orbslam2")
+    parser.add_argument("--sensor", choices=["rgbd", "mono"], default="rgbd",
+                        help="ORB-SLAM3's sensor (ORB-SLAM2 runs RGB-D only)")
     a = parser.parse_args()
+    if a.host == "orbslam2" and a.sensor != "rgbd":
+        parser.error("--sensor mono needs --host orbslam3")
     if a.action == "families":
-        families(a.sequence, a.command, a.page)
+        families(a.sequence, a.command, a.page, a.host)
     elif a.action == "prepare":
-        prepare(a.sequence, a.out, a.dyncull_eval)
+        prepare(a.sequence, a.out, a.dyncull_eval, a.host)
     else:
-        summarise(a.sequence, a.out, a.vocabulary, a.command, a.page)
+        summarise(a.sequence, a.out, a.vocabulary, a.command, a.page, a.host, a.sensor)
 
 
 if __name__ == "__main__":
