@@ -85,7 +85,8 @@ void usage(const char* argv0) {
       "                      groundtruth.txt, camera.txt, detections/) instead of the synthetic sequences:\n"
       "                      every frame unless --frames; writes dataset_summary.csv (ATE, RPE over 1 s, lost\n"
       "                      frames, culls in person boxes / outside boxes, times), the trajectories, the\n"
-      "                      trajectory plot and a strip of annotated frames. --tum DIR is the same\n"
+      "                      plots' data (NAME_poses.csv, NAME_frames.csv: scripts/figures.py draws them)\n"
+      "                      and a strip of annotated frames. --tum DIR is the same\n"
       "  --camera SPEC       intrinsics for --dataset: a camera.txt (fx fy cx cy [k1 k2 p1 p2 k3]\n"
       "                      [depth_units_per_metre] as 'key value' lines), fx,fy,cx,cy[,k1,k2,p1,p2,k3], or\n"
       "                      fr1 / fr2 / fr3 (default: DIR/camera.txt, else TUM's by the folder's name)\n"
@@ -544,7 +545,6 @@ int main(int argc, char** argv) try {
                " frames a sequence)\n";
     std::ofstream(args.out + "/family_summary.md") << summary;
     std::ofstream(args.out + "/family_summary.csv") << vo::family_summary_csv(rows);
-    if (vo::plot_family_summary(args.out + "/family_summary.png", rows)) figures.push_back("family_summary.png");
     if (vo::write_frame_strip(args.out + "/frame_strip.png", family_frames(reports))) figures.push_back("frame_strip.png");
     table = summary + "\n" + table;
   }

@@ -4,7 +4,7 @@
 # (dynamic_vo --suite: every family x static,xyz,rpy,halfsphere x seeds 1,2,3, 150 frames each, on
 # DYNCULL_JOBS threads, default all cores) and prints one summary table, a row per family; it also writes
 # family_summary.md / family_summary.csv. With arguments they go to dynamic_vo instead (try --help).
-# Output (tables, plots, frames) goes to ./dynamic_vo_out unless --out is given. DYNCULL_DEMO_BUILD sets
+# Output (tables, CSV, plots drawn by scripts/figures.py, frames) goes to ./dynamic_vo_out unless --out is given. DYNCULL_DEMO_BUILD sets
 # the build directory (default build/demo).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -16,4 +16,15 @@ cmake --build "$build" -j "${DYNCULL_JOBS:-$(nproc)}" --target dynamic_vo dyncul
 if (($# == 0)); then
   set -- --suite --jobs "${DYNCULL_JOBS:-$(nproc)}"
 fi
-exec "$build/apps/dynamic_vo" "$@"
+"$build/apps/dynamic_vo" "$@"
+# dynamic_vo writes the plots' data (CSV); scripts/figures.py draws them (matplotlib) beside it. The
+# suite's dozens of sequences get the family summary only.
+out=dynamic_vo_out summary_only=() previous=
+for arg in "$@"; do
+  [[ "$previous" == --out ]] && out=$arg
+  [[ "$arg" == --suite ]] && summary_only=(--summary-only)
+  previous=$arg
+done
+if [[ -f "$out/family_summary.csv" ]] || compgen -G "$out/*_poses.csv" >/dev/null; then
+  python3 "$root/scripts/figures.py" "$out" "${summary_only[@]}"
+fi

@@ -1,20 +1,30 @@
 #!/usr/bin/env python3
-"""Sequence side of scripts/orbslam2.sh (standard library only).
+"""Sequence side of scripts/orbslam2.sh and scripts/orbslam3.sh (standard library; the trajectory figure
+needs matplotlib).
 
-  orbslam2_sequence.py prepare SEQUENCE OUT
+  orbslam2_sequence.py prepare SEQUENCE OUT [--dyncull-eval PATH]
       OUT/orbslam2_settings.yaml (ORB-SLAM2's settings, written from SEQUENCE/camera.txt) and
-      OUT/associations.txt (rgb and depth paired as the TUM benchmark's associate.py: |dt| < 0.02 s,
-      closest pairs first, each stamp once); when SEQUENCE has rgb_color.txt (colour frames of the same
+      OUT/associations.txt (rgb and depth paired by `dyncull_eval --associate` as the TUM benchmark's
+      associate.py: |dt| < 0.02 s, closest pairs first, each stamp once); when SEQUENCE has rgb_color.txt (colour frames of the same
       stamps, for a live detector), OUT/associations_color.txt pairs those with depth the same way.
+  orbslam2_sequence.py prepare SEQUENCE OUT --host orbslam3
+      the same with OUT/orbslam3_settings.yaml (ORB-SLAM3's settings format 1.0) in place of ORB-SLAM2's.
   orbslam2_sequence.py summarise SEQUENCE OUT [--vocabulary FILE] [--command TEXT] [--page FILE]
       reads OUT/runs/VARIANT/runN/ (rgbd_tum.log, CameraTrajectory.txt, ate.json), writes
       OUT/orbslam2_summary.csv (a row per variant and run) and prints the table; with --page, replaces
-      (or appends) the page's "## In ORB-SLAM2" section.
+      (or appends) the page's "## In ORB-SLAM2" section, with the trajectory figure of each variant's
+      median run drawn by scripts/figures.py from that run's poses.csv (dyncull_eval --poses-csv).
 
   orbslam2_sequence.py families OUT [--command TEXT] [--page FILE]
       reads OUT/families/NAME/orbslam2_summary.csv (one folder per family and camera motion), writes
       OUT/orbslam2_families.csv (median ATE, lost frames per variant and sequence) and prints the table;
       with --page, replaces (or appends) the page's "## Scene families in ORB-SLAM2" section.
+
+  With --host orbslam3 [--sensor rgbd|mono], summarise and families read and write orbslam3_summary.csv
+  and orbslam3_families.csv: the same columns and `sensor`; a monocular run is read from mono_tum.log,
+  its frames are rgb.txt's (mono_tum reads the colour list itself) and its ATE is after Sim(3) alignment
+  (the script evaluates it with --scale). ORB-SLAM3's maps (Atlas) beyond the first are counted in the
+  run's note. No page section is written for ORB-SLAM3 yet.
 
 Lost frames: ORB-SLAM2 leaves a frame out of CameraTrajectory.txt when it was lost (and every frame before
 its map exists), without a message; they are counted as association lines minus trajectory lines.
@@ -29,7 +39,6 @@ import struct
 import subprocess
 import sys
 
-MAX_DIFFERENCE_S = 0.02
 # culler: boxes from the detections folder; culler_live: a detector running beside the tracker (newest
 # finished boxes); culler_live_sync: the detector waited for on every frame.
 VARIANTS = ["stock", "box_only", "culler", "culler_live", "culler_live_sync"]
@@ -46,25 +55,18 @@ def read_list(path):
     return out
 
 
-def associate(rgb, depth):
-    """associate.py's greedy pairing: candidate pairs under the window, closest first, each stamp once."""
-    candidates = []
-    depth_stamps = [float(s) for s, _ in depth]
-    for i, (stamp, _) in enumerate(rgb):
-        t = float(stamp)
-        for j, d in enumerate(depth_stamps):
-            if abs(d - t) < MAX_DIFFERENCE_S:
-                candidates.append((abs(d - t), i, j))
-    candidates.sort()
-    used_rgb, used_depth, pairs = set(), set(), []
-    for _, i, j in candidates:
-        if i in used_rgb or j in used_depth:
-            continue
-        used_rgb.add(i)
-        used_depth.add(j)
-        pairs.append((i, j))
-    pairs.sort()
-    return [(rgb[i][0], rgb[i][1], depth[j][0], depth[j][1]) for i, j in pairs]
+def associate(dyncull_eval, first, second):
+    """Lines "stamp file stamp file" of two lists paired as the TUM benchmark's associate.py (|dt| < 0.02 s,
+    closest pairs first, each stamp once), by `dyncull_eval --associate`."""
+    done = subprocess.run([dyncull_eval, "--associate", first, second], capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit("orbslam2_sequence.py: %s --associate: %s" % (dyncull_eval, done.stderr.strip()))
+    return done.stdout.splitlines()
+
+
+def write_lines(path, lines):
+    with open(path, "w") as f:
+        f.write("".join(line + "\n" for line in lines))
 
 
 def read_camera(path):
@@ -138,31 +140,72 @@ Viewer.ViewpointF: 500
 """
 
 
-def prepare(sequence, out):
+SETTINGS_ORBSLAM3 = """%YAML:1.0
+# Written by scripts/orbslam3.sh from {camera} (ORB-SLAM3's settings format 1.0: real numbers with a point).
+File.version: "1.0"
+Camera.type: "PinHole"
+Camera1.fx: {fx!r}
+Camera1.fy: {fy!r}
+Camera1.cx: {cx!r}
+Camera1.cy: {cy!r}
+Camera1.k1: {k1!r}
+Camera1.k2: {k2!r}
+Camera1.p1: {p1!r}
+Camera1.p2: {p2!r}
+Camera1.k3: {k3!r}
+Camera.width: {width}
+Camera.height: {height}
+Camera.fps: 30
+Camera.RGB: 1
+# IR projector baseline (about 40 / fx metres for a Kinect-class sensor, as ORB-SLAM2's Camera.bf 40)
+Stereo.ThDepth: 40.0
+Stereo.b: {baseline!r}
+RGBD.DepthMapFactor: {depth_factor!r}
+ORBextractor.nFeatures: 1000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+Viewer.KeyFrameSize: 0.05
+Viewer.KeyFrameLineWidth: 1.0
+Viewer.GraphLineWidth: 0.9
+Viewer.PointSize: 2.0
+Viewer.CameraSize: 0.08
+Viewer.CameraLineWidth: 3.0
+Viewer.ViewpointX: 0.0
+Viewer.ViewpointY: -0.7
+Viewer.ViewpointZ: -1.8
+Viewer.ViewpointF: 500.0
+"""
+
+
+def prepare(sequence, out, dyncull_eval, host="orbslam2"):
     camera = read_camera(os.path.join(sequence, "camera.txt"))
     rgb = read_list(os.path.join(sequence, "rgb.txt"))
     depth = read_list(os.path.join(sequence, "depth.txt"))
     if not rgb or not depth:
         sys.exit("orbslam2_sequence.py: %s has an empty rgb.txt or depth.txt" % sequence)
     width, height = png_size(os.path.join(sequence, rgb[0][1]))
-    settings = SETTINGS.format(
-        camera="camera.txt", width=width, height=height,
-        depth_factor=camera.get("depth_units_per_metre", 5000.0),
-        **{k: camera.get(k, 0.0) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")})
-    with open(os.path.join(out, "orbslam2_settings.yaml"), "w") as f:
+    values = {k: float(camera.get(k, 0.0)) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")}
+    depth_factor = float(camera.get("depth_units_per_metre", 5000.0))
+    if host == "orbslam3":
+        settings = SETTINGS_ORBSLAM3.format(camera="camera.txt", width=width, height=height, depth_factor=depth_factor,
+                                            baseline=40.0 / values["fx"], **values)
+    else:
+        settings = SETTINGS.format(camera="camera.txt", width=width, height=height,
+                                   depth_factor=camera.get("depth_units_per_metre", 5000.0),
+                                   **{k: camera.get(k, 0.0) for k in values})
+    with open(os.path.join(out, "%s_settings.yaml" % host), "w") as f:
         f.write(settings)
-    pairs = associate(rgb, depth)
-    with open(os.path.join(out, "associations.txt"), "w") as f:
-        for p in pairs:
-            f.write("%s %s %s %s\n" % p)
+    depth_list = os.path.join(sequence, "depth.txt")
+    pairs = associate(dyncull_eval, os.path.join(sequence, "rgb.txt"), depth_list)
+    write_lines(os.path.join(out, "associations.txt"), pairs)
     print("orbslam2_sequence.py: %d rgb frames, %d with a depth partner (associations.txt), %dx%d"
           % (len(rgb), len(pairs), width, height), file=sys.stderr)
     colour_list = os.path.join(sequence, "rgb_color.txt")
     if os.path.exists(colour_list):
-        colour_pairs = associate(read_list(colour_list), depth)
-        with open(os.path.join(out, "associations_color.txt"), "w") as f:
-            for p in colour_pairs:
-                f.write("%s %s %s %s\n" % p)
+        colour_pairs = associate(dyncull_eval, colour_list, depth_list)
+        write_lines(os.path.join(out, "associations_color.txt"), colour_pairs)
         print("orbslam2_sequence.py: %d colour frames with a depth partner (associations_color.txt)"
               % len(colour_pairs), file=sys.stderr)
 
@@ -174,12 +217,12 @@ def count_lines(path):
         return sum(1 for line in f if line.strip() and not line.startswith("#"))
 
 
-def read_run(directory, frames):
+def read_run(directory, frames, log_name="rgbd_tum.log"):
     row = {"ate_rmse_m": "", "ate_pairs": "", "track_ms": "", "track_median_ms": "", "cull_ms": "", "features": "",
            "features_kept": "", "note": "", "fps": "", "track_ms_p95": "", "detector_ms": "", "box_age_frames": ""}
     poses = count_lines(os.path.join(directory, "CameraTrajectory.txt"))
     row["lost_frames"] = frames - poses
-    log_path = os.path.join(directory, "rgbd_tum.log")
+    log_path = os.path.join(directory, log_name)
     text = open(log_path, errors="replace").read() if os.path.exists(log_path) else ""
     m = re.search(r"median tracking time: ([0-9.eE+-]+)", text)
     if m:
@@ -208,7 +251,10 @@ def read_run(directory, frames):
     except (OSError, ValueError, KeyError):
         row["note"] = "no trajectory" if poses == 0 else "evaluation failed"
     if not row["track_ms"]:
-        row["note"] = (row["note"] + "; " if row["note"] else "") + "rgbd_tum did not finish"
+        row["note"] = (row["note"] + "; " if row["note"] else "") + "%s did not finish" % log_name[:-4]
+    maps = len(re.findall(r"Creation of new map with id", text))  # ORB-SLAM3's Atlas; none in ORB-SLAM2
+    if maps > 1:
+        row["note"] = (row["note"] + "; " if row["note"] else "") + "%d maps" % maps
     return row
 
 
@@ -240,8 +286,11 @@ def median_range(values, scale=1.0, digits=2):
     return (fmt + " (" + fmt + "-" + fmt + ")") % (statistics.median(v), min(v), max(v))
 
 
-def summarise(sequence, out, vocabulary, command, page):
-    frames = count_lines(os.path.join(out, "associations.txt"))
+def summarise(sequence, out, vocabulary, command, page, host="orbslam2", sensor="rgbd"):
+    mono = host == "orbslam3" and sensor == "mono"
+    frames = count_lines(os.path.join(sequence, "rgb.txt") if mono else os.path.join(out, "associations.txt"))
+    columns = COLUMNS + (["sensor"] if host == "orbslam3" else [])
+    log_name = "mono_tum.log" if mono else "rgbd_tum.log"
     rows = []
     runs_dir = os.path.join(out, "runs")
     for variant in VARIANTS:
@@ -250,16 +299,18 @@ def summarise(sequence, out, vocabulary, command, page):
             continue
         runs = sorted((int(d[3:]) for d in os.listdir(vdir) if re.fullmatch(r"run[0-9]+", d)))
         for r in runs:
-            row = read_run(os.path.join(vdir, "run%d" % r), frames)
-            row.update(variant=variant, run=r, frames=frames)
+            row = read_run(os.path.join(vdir, "run%d" % r), frames, log_name)
+            row.update(variant=variant, run=r, frames=frames, sensor=sensor)
             rows.append(row)
-    with open(os.path.join(out, "orbslam2_summary.csv"), "w") as f:
-        f.write(",".join(COLUMNS) + "\n")
+    with open(os.path.join(out, "%s_summary.csv" % host), "w") as f:
+        f.write(",".join(columns) + "\n")
         for row in rows:
-            f.write(",".join(str(row[c]).replace(",", ";") for c in COLUMNS) + "\n")
+            f.write(",".join(str(row[c]).replace(",", ";") for c in columns) + "\n")
     table = summary_table(rows)
+    if mono:
+        table = table.replace("ATE RMSE, cm", "ATE RMSE after Sim(3) alignment, cm")
     print(table)
-    if page:
+    if page and host == "orbslam2":
         write_page(page, table, rows, sequence, out, vocabulary, command)
 
 
@@ -323,122 +374,31 @@ def timing_note(rows):
     return ("; ".join(parts) + ".") if parts else ""
 
 
-def read_tum(path):
-    """stamp -> (x, y, z) of a TUM trajectory file."""
-    out = {}
-    if not os.path.exists(path):
-        return out
-    with open(path) as f:
-        for line in f:
-            fields = line.split()
-            if len(fields) >= 8 and not fields[0].startswith("#"):
-                out[float(fields[0])] = tuple(float(v) for v in fields[1:4])
-    return out
-
-
-def pair_positions(truth, estimate):
-    """(truth, estimate) positions paired as associate.py: closest stamps first, each once."""
-    stamps = sorted(truth)
-    candidates = []
-    for t in estimate:
-        lo, hi = 0, len(stamps)
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if stamps[mid] < t - MAX_DIFFERENCE_S:
-                lo = mid + 1
-            else:
-                hi = mid
-        k = lo
-        while k < len(stamps) and stamps[k] < t + MAX_DIFFERENCE_S:
-            candidates.append((abs(stamps[k] - t), stamps[k], t))
-            k += 1
-    candidates.sort()
-    used_t, used_e, pairs = set(), set(), []
-    for _, g, e in candidates:
-        if g in used_t or e in used_e:
-            continue
-        used_t.add(g)
-        used_e.add(e)
-        pairs.append((e, truth[g], estimate[e]))
-    pairs.sort()
-    return [(g, e) for _, g, e in pairs]
-
-
-def horn_alignment(pairs):
-    """Rotation R and translation t with R * estimate + t closest to truth (Horn 1987, unit quaternions)."""
-    n = float(len(pairs))
-    cg = [sum(p[0][i] for p in pairs) / n for i in range(3)]
-    ce = [sum(p[1][i] for p in pairs) / n for i in range(3)]
-    S = [[sum((p[1][i] - ce[i]) * (p[0][j] - cg[j]) for p in pairs) for j in range(3)] for i in range(3)]
-    (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = S
-    N = [[xx + yy + zz, yz - zy, zx - xz, xy - yx],
-         [yz - zy, xx - yy - zz, xy + yx, zx + xz],
-         [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
-         [xy - yx, zx + xz, yz + zy, -xx - yy + zz]]
-    shift = sum(abs(v) for row in N for v in row) + 1.0  # N + shift I is positive definite: power iteration
-    q = [1.0, 0.0, 0.0, 0.0]                            # finds N's largest eigenvalue's vector
-    for _ in range(500):
-        q = [sum(N[i][j] * q[j] for j in range(4)) + shift * q[i] for i in range(4)]
-        norm = sum(v * v for v in q) ** 0.5
-        q = [v / norm for v in q]
-    w, x, y, z = q
-    R = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-    t = [cg[i] - sum(R[i][j] * ce[j] for j in range(3)) for i in range(3)]
-    return R, t
-
-
-COLOURS = {"truth": "#000000", "stock": "#d62728", "box_only": "#ff7f0e", "culler": "#1f77b4"}
-
-
-def plot_trajectories(sequence, out, rows, svg_path):
-    """Top view (the two axes of largest ground-truth extent) of the ground truth and, per variant, the
-    run with the median ATE, aligned as the ATE aligns it. Returns the runs drawn."""
-    truth = read_tum(os.path.join(sequence, "groundtruth.txt"))
-    curves, drawn = {}, []
+def median_runs(out, rows):
+    """Per variant, the run with the median ATE that has dyncull_eval's poses.csv (its pairs, aligned as the
+    ATE aligns them): [(variant, run, ate_m, poses path)]."""
+    chosen = []
     for variant in VARIANTS:
-        mine = sorted((float(r["ate_rmse_m"]), r["run"]) for r in rows if r["variant"] == variant and r["ate_rmse_m"])
+        mine = sorted((float(r["ate_rmse_m"]), int(r["run"])) for r in rows if r["variant"] == variant and r["ate_rmse_m"])
         if not mine:
             continue
         ate, run = mine[(len(mine) - 1) // 2]
-        pairs = pair_positions(truth, read_tum(os.path.join(out, "runs", variant, "run%d" % run, "CameraTrajectory.txt")))
-        if len(pairs) < 3:
-            continue
-        R, t = horn_alignment(pairs)
-        curves[variant] = [[sum(R[i][j] * e[j] for j in range(3)) + t[i] for i in range(3)] for _, e in pairs]
-        drawn.append((variant, run, ate))
-    if not curves:
-        return drawn
-    stamps = sorted(truth)
-    gt = [truth[s] for s in stamps]
-    extent = [max(p[i] for p in gt) - min(p[i] for p in gt) for i in range(3)]
-    a, b = sorted(range(3), key=lambda i: -extent[i])[:2]
-    everything = gt + [p for c in curves.values() for p in c]
-    lo_a, hi_a = min(p[a] for p in everything), max(p[a] for p in everything)
-    lo_b, hi_b = min(p[b] for p in everything), max(p[b] for p in everything)
-    size, margin = 520.0, 40.0
-    scale = (size - 2 * margin) / max(hi_a - lo_a, hi_b - lo_b, 1e-6)
-    def xy(p):
-        return "%.1f,%.1f" % (margin + (p[a] - lo_a) * scale, size - margin - (p[b] - lo_b) * scale)
-    legend = [("ground truth", "truth")] + [("%s (run %d, ATE %.1f cm)" % (v, r, 100 * e), v) for v, r, e in drawn]
-    lines = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" font-size="12">'
-             % (size, size + 18 * len(legend)), '<rect width="100%" height="100%" fill="white"/>']
-    for name, points, width in [("truth", gt, 2.5)] + [(v, curves[v], 1.5) for v in VARIANTS if v in curves]:
-        lines.append('<polyline fill="none" stroke="%s" stroke-width="%.1f" points="%s"/>'
-                     % (COLOURS[name], width, " ".join(xy(p) for p in points)))
-    for k, (label, key) in enumerate(legend):
-        y = size + 18 * k
-        lines.append('<line x1="%d" y1="%d" x2="%d" y2="%d" stroke="%s" stroke-width="3"/>' % (margin, y, margin + 20, y, COLOURS[key]))
-        lines.append('<text x="%d" y="%d">%s</text>' % (margin + 26, y + 4, label))
-    scale_bar = 0.5 * scale
-    lines.append('<line x1="%.1f" y1="20" x2="%.1f" y2="20" stroke="black" stroke-width="2"/>' % (size - margin - scale_bar, size - margin))
-    lines.append('<text x="%.1f" y="14">0.5 m</text>' % (size - margin - scale_bar))
-    lines.append('<text x="10" y="16">top view, axes %s-%s of the ground truth</text>' % ("xyz"[a], "xyz"[b]))
-    lines.append("</svg>")
-    with open(svg_path, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    return drawn
+        poses = os.path.join(out, "runs", variant, "run%d" % run, "poses.csv")
+        if os.path.exists(poses):
+            chosen.append((variant, run, ate, poses))
+    return chosen
+
+
+def plot_trajectories(name, out, rows, path):
+    """scripts/figures.py's trajectory panels (matplotlib) of each variant's median run. Returns the runs drawn."""
+    chosen = median_runs(out, rows)
+    if chosen:
+        import figures  # matplotlib: only when there is something to draw
+        runs = {}
+        for variant, run, _, poses in chosen:
+            runs.update(figures.read_poses(poses, "%s (run %d)" % (variant, run)))
+        figures.plot_trajectories(runs, "ORB-SLAM2 on %s" % name, path)
+    return chosen
 
 
 def machine():
@@ -457,7 +417,7 @@ def write_page(page, table, rows, sequence, out, vocabulary, command):
     trained = "synthetic" in voc
     image = "images/orbslam2_%s_trajectories.svg" % name
     os.makedirs(os.path.join(os.path.dirname(os.path.abspath(page)), "images"), exist_ok=True)
-    drawn = plot_trajectories(sequence, out, rows, os.path.join(os.path.dirname(os.path.abspath(page)), image))
+    drawn = plot_trajectories(name, out, rows, os.path.join(os.path.dirname(os.path.abspath(page)), image))
     section = "\n".join([
         "## In ORB-SLAM2",
         "",
@@ -505,16 +465,17 @@ def lost_cell(values):
     return "%g (%g-%g)" % (statistics.median(values), min(values), max(values))
 
 
-def families(out, command, page):
+def families(out, command, page, host="orbslam2"):
     root = os.path.join(out, "families")
-    names = sorted(d for d in os.listdir(root) if os.path.exists(os.path.join(root, d, "orbslam2_summary.csv")))
+    summary = "%s_summary.csv" % host
+    names = sorted(d for d in os.listdir(root) if os.path.exists(os.path.join(root, d, summary)))
     table = ["| Sequence | Runs | Stock ATE, cm | Box-only ATE, cm | Culler ATE, cm | Culler / stock | "
              "Lost frames: stock; box-only; culler |",
              "|---|---|---|---|---|---|---|"]
     csv = ["sequence,variant,runs,ate_median_m,ate_min_m,ate_max_m,lost_median,frames"]
     ratios, wins, no_more_lost = [], 0, 0
     for name in names:
-        rows = read_summary(os.path.join(root, name, "orbslam2_summary.csv"))
+        rows = read_summary(os.path.join(root, name, summary))
         medians, ranges, lost, lost_median, runs = {}, {}, {}, {}, 0
         for variant in VARIANTS:
             ate = numbers(rows, variant, "ate_rmse_m")
@@ -542,11 +503,11 @@ def families(out, command, page):
         cell = lambda v: ranges.get(v, "n/a")
         table.append("| %s | %d | %s | %s | %s | %s | %s |" % (name, runs, cell("stock"), cell("box_only"), cell("culler"),
                                                                 ratio or "n/a", "; ".join(lost[v] for v in VARIANTS)))
-    with open(os.path.join(out, "orbslam2_families.csv"), "w") as f:
+    with open(os.path.join(out, "%s_families.csv" % host), "w") as f:
         f.write("\n".join(csv) + "\n")
     text = "\n".join(table)
     print(text)
-    if not page:
+    if not page or host != "orbslam2":
         return
     within = sum(1 for r in ratios if r <= 0.5)
     section = "\n".join([
@@ -592,13 +553,20 @@ def main():
     parser.add_argument("--vocabulary", default="")
     parser.add_argument("--command", default="scripts/orbslam2.sh")
     parser.add_argument("--page", default="")
+    parser.add_argument("--dyncull-eval", default=os.environ.get("DYNCULL_EVAL", "dyncull_eval"),
+                        help="the dyncull_eval program (default: $DYNCULL_EVAL, else dyncull_eval on the PATH)")
+    parser.add_argument("--host", choices=["orbslam2", "orbslam3"], default="orbslam2")
+    parser.add_argument("--sensor", choices=["rgbd", "mono"], default="rgbd",
+                        help="ORB-SLAM3's sensor (ORB-SLAM2 runs RGB-D only)")
     a = parser.parse_args()
+    if a.host == "orbslam2" and a.sensor != "rgbd":
+        parser.error("--sensor mono needs --host orbslam3")
     if a.action == "families":
-        families(a.sequence, a.command, a.page)
+        families(a.sequence, a.command, a.page, a.host)
     elif a.action == "prepare":
-        prepare(a.sequence, a.out)
+        prepare(a.sequence, a.out, a.dyncull_eval, a.host)
     else:
-        summarise(a.sequence, a.out, a.vocabulary, a.command, a.page)
+        summarise(a.sequence, a.out, a.vocabulary, a.command, a.page, a.host, a.sensor)
 
 
 if __name__ == "__main__":

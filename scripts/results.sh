@@ -105,15 +105,18 @@ if [[ -x "$vo" && -z "$real_only" ]]; then
   "$vo" --list | awk '$1 ~ /^recommended-no_/' | sed 's/ *(ablation).*//' >"$ablation/strategies.txt"
 fi
 
-# The demo's pictures, for this page and the README.
+# The demo's pictures, for this page and the README: the plots drawn again from the runs' CSV (folders
+# given with --suite / --real may predate them).
 mkdir -p "$root/docs/images"
 if [[ -z "$real_only" ]]; then
+  python3 "$root/scripts/figures.py" "$suite" --summary-only
   for f in family_summary.png frame_strip.png; do
     [[ -f "$suite/$f" ]] && cp "$suite/$f" "$root/docs/images/$f"
   done
 fi
 if [[ -n "$real" ]]; then
-  for f in trajectories.png frame_strip.png; do
+  if compgen -G "$real/*_poses.csv" >/dev/null; then python3 "$root/scripts/figures.py" "$real"; fi
+  for f in trajectories.png ate_over_time.png frame_strip.png; do
     [[ -f "$real/crowd_part1_$f" ]] && cp "$real/crowd_part1_$f" "$root/docs/images/bonn_crowd_part1_$f"
   done
   [[ -f "$real/truth/outside_boxes_strip.png" ]] &&

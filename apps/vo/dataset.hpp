@@ -4,7 +4,7 @@
 /// evaluated as the TUM benchmark does: ATE RMSE after rigid alignment (0.02 s association) and RPE over
 /// 1 s (evaluate_rpe.py --fixed_delta), plus lost frames, where the culls fall relative to the boxes and
 /// culling time against the front end's. Writes dataset_summary.csv / .md, the trajectories (TUM format),
-/// the trajectory plot and a strip of annotated frames.
+/// the plots' data (CSV for scripts/figures.py) and a strip of annotated frames.
 #pragma once
 
 #include "dyncull/eval/rpe.hpp"
@@ -495,7 +495,7 @@ inline bool rerun_with_seeds(const DatasetOptions& options, DatasetSource& sourc
 }  // namespace detail
 
 /// Runs every strategy over the folder (RunnerOptions::max_frames frames at most), evaluates it against
-/// DIR/groundtruth.txt and writes the summary, trajectories, plot and strip into runner.out_dir (when
+/// DIR/groundtruth.txt and writes the summary, trajectories, plots' data and strip into runner.out_dir (when
 /// runner.write_outputs). False with `error` when the folder, camera or detections cannot be read, a frame
 /// cannot be loaded, or no strategy can run.
 inline bool run_dataset(const DatasetOptions& options, DatasetRun* out, std::string* error) {

@@ -1,7 +1,7 @@
 /// @file report.hpp
 /// Outputs of the dynamic_vo demo: per-feature label counts against the sim's per-pixel motion truth
-/// (precision / recall of the dynamic labels, DLD-SLAM eq. 6-7 style tables), a top-view trajectory plot
-/// and frames with kept / culled features drawn (PNG through OpenCV).
+/// (precision / recall of the dynamic labels, DLD-SLAM eq. 6-7 style tables) and frames with kept / culled
+/// features drawn (PNG through OpenCV).
 #pragma once
 
 #include "dyncull/core/pixel.hpp"
@@ -220,76 +220,6 @@ struct RecallBySpeed {
     return o.str();
   }
 };
-
-/// A distinct colour per strategy (BGR), ground truth is black: as many as dynamic_vo's default strategies
-/// and a few more, so no two strategies of one figure share a colour.
-inline cv::Scalar strategy_colour(std::size_t i) {
-  static const std::array<cv::Scalar, 12> colours = {
-      cv::Scalar(40, 40, 220),  cv::Scalar(40, 160, 40),  cv::Scalar(220, 120, 30), cv::Scalar(180, 50, 180),
-      cv::Scalar(30, 160, 220), cv::Scalar(140, 140, 40), cv::Scalar(90, 90, 90),   cv::Scalar(200, 60, 120),
-      cv::Scalar(20, 90, 140),  cv::Scalar(160, 200, 90), cv::Scalar(120, 20, 20),  cv::Scalar(170, 150, 250)};
-  return colours[i % colours.size()];
-}
-
-/// Writes a top view of the ground truth and the (aligned) estimates. The two world axes with the
-/// largest ground-truth extent span the plot, so it reads as x-y or x-z as the motion dictates.
-inline bool plot_trajectories(const std::string& path, const std::string& title,
-                              const std::vector<Vec3<double>>& truth, const std::vector<std::string>& names,
-                              const std::vector<std::vector<Vec3<double>>>& estimates) {
-  const int size = 720, margin = 60, legend = 24 * static_cast<int>(names.size() + 1);
-  cv::Mat img(size + legend, size, CV_8UC3, cv::Scalar(255, 255, 255));
-  Vec3<double> lo = Vec3<double>::Constant(1e300), hi = Vec3<double>::Constant(-1e300);
-  auto grow = [&](const std::vector<Vec3<double>>& pts) {
-    for (const auto& p : pts) {
-      if (!p.allFinite()) continue;
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-  };
-  grow(truth);
-  Vec3<double> extent = hi - lo;
-  if (!extent.allFinite()) extent.setZero();
-  int a = 0, b = 1;
-  {
-    std::array<int, 3> axes = {0, 1, 2};
-    std::sort(axes.begin(), axes.end(), [&](int i, int j) { return extent[i] > extent[j]; });
-    a = std::min(axes[0], axes[1]);
-    b = std::max(axes[0], axes[1]);
-  }
-  for (const auto& e : estimates) grow(e);
-  if (!(lo.allFinite() && hi.allFinite())) return false;
-  const double span = std::max({hi[a] - lo[a], hi[b] - lo[b], 0.05});
-  const double scale = (size - 2 * margin) / span;
-  const double ca = 0.5 * (lo[a] + hi[a]), cb = 0.5 * (lo[b] + hi[b]);
-  auto to_px = [&](const Vec3<double>& p) {
-    constexpr int kFar = 1 << 20;  // far outside any plot: cv::line clips it
-    return cv::Point(clamped_int(std::round(size / 2 + (p[a] - ca) * scale), -kFar, kFar),
-                     clamped_int(std::round(size / 2 - (p[b] - cb) * scale), -kFar, kFar));
-  };
-  auto draw = [&](const std::vector<Vec3<double>>& pts, const cv::Scalar& colour, int thickness) {
-    for (std::size_t i = 1; i < pts.size(); ++i) {
-      if (!pts[i - 1].allFinite() || !pts[i].allFinite()) continue;
-      cv::line(img, to_px(pts[i - 1]), to_px(pts[i]), colour, thickness, cv::LINE_AA);
-    }
-  };
-  for (std::size_t i = 0; i < estimates.size(); ++i) draw(estimates[i], strategy_colour(i), 1);
-  draw(truth, cv::Scalar(0, 0, 0), 2);
-
-  const char* axis_name = "xyz";
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%s  (top view: %c right, %c up; %.2f m across)", title.c_str(), axis_name[a],
-                axis_name[b], span);
-  cv::putText(img, buf, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  int y = size + 16;
-  cv::line(img, cv::Point(10, y - 4), cv::Point(40, y - 4), cv::Scalar(0, 0, 0), 2);
-  cv::putText(img, "ground truth", cv::Point(50, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    y += 24;
-    cv::line(img, cv::Point(10, y - 4), cv::Point(40, y - 4), strategy_colour(i), 2);
-    cv::putText(img, names[i], cv::Point(50, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
-  return cv::imwrite(path, img);
-}
 
 /// Draws detection boxes, kept features (green) and culled features (red) on a copy of `bgr`.
 /// With truth, culled static features are drawn as red crosses and kept moving ones as yellow rings.

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -39,6 +40,13 @@ struct RunnerOptions {
 };
 
 /// Everything measured for one strategy on one sequence.
+/// One pose of a run beside its ground truth: the estimate as the ATE aligned it, and their distance.
+struct PosePair {
+  double stamp = 0;
+  Vec3<double> truth = Vec3<double>::Zero(), estimate = Vec3<double>::Zero();
+  double error_m = 0;
+};
+
 struct StrategyRun {
   StrategySpec spec;
   eval::Trajectory<double> estimate;
@@ -53,7 +61,7 @@ struct StrategyRun {
   double ate_rmse_m = std::numeric_limits<double>::quiet_NaN();
   std::size_t ate_pairs = 0;
   std::string ate_note;                  ///< how the ATE was computed when not the standard way
-  std::vector<Vec3<double>> aligned_positions;
+  std::vector<PosePair> pose_pairs;      ///< the ATE's pairs (aligned estimate), for the figures
 
   double cull_ms_per_frame() const { return frames ? cull_ms / static_cast<double>(frames) : 0.0; }
   double front_end_ms_per_frame() const { return frames ? front_end_ms / static_cast<double>(frames) : 0.0; }
@@ -68,6 +76,8 @@ struct SequenceReport {
   eval::Trajectory<double> truth;  ///< per frame when the source has it (sim)
   std::string truth_note;
   std::vector<StrategyRun> runs;
+  std::vector<double> frame_stamps;     ///< per frame run
+  std::vector<int> person_boxes;        ///< per frame: the detector's person boxes (people in view)
   std::vector<std::string> files;  ///< PNG / trajectory files written
 };
 
@@ -93,6 +103,8 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
   std::vector<FrontEnd> front_ends;
   std::vector<Culler> cullers;
   report->runs.clear();
+  report->frame_stamps.clear();
+  report->person_boxes.clear();
   for (const StrategySpec& s : specs) {
     front_ends.emplace_back(camera, options.front_end);
     cullers.emplace_back(s, camera);
@@ -114,6 +126,10 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
   for (int i = 0; i < n; ++i) {
     if (!source.load(i, &frame, error)) return false;
     if (frame.has_truth_pose) report->truth.push_back(frame.timestamp, frame.truth_world_from_cam);
+    report->frame_stamps.push_back(frame.timestamp);
+    report->person_boxes.push_back(static_cast<int>(std::count_if(
+        frame.detections.begin(), frame.detections.end(),
+        [](const Detection<float>& d) { return d.class_id == BoxCullCounts::kPersonClass; })));
     input.timestamp = frame.timestamp;
     input.gray = frame.gray;
     input.depth_m = frame.depth_m;
@@ -172,31 +188,70 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
   return true;
 }
 
+inline PosePair pose_pair(const eval::Trajectory<double>& truth, std::size_t truth_index, const Vec3<double>& estimate) {
+  PosePair p;
+  p.stamp = truth.stamps[truth_index];
+  p.truth = truth.poses[truth_index].t;
+  p.estimate = estimate;
+  p.error_m = (estimate - p.truth).norm();
+  return p;
+}
+
+/// Every run's pose pairs, `strategy,stamp,gt_x,gt_y,gt_z,x,y,z,error_m` (dyncull_eval --poses-csv's
+/// columns after the strategy), metres.
+inline std::string poses_csv(const SequenceReport& report) {
+  std::string out = "strategy,stamp,gt_x,gt_y,gt_z,x,y,z,error_m\n";
+  char line[256];
+  for (const StrategyRun& run : report.runs) {
+    for (const PosePair& p : run.pose_pairs) {
+      std::snprintf(line, sizeof line, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", p.stamp, p.truth.x(), p.truth.y(),
+                    p.truth.z(), p.estimate.x(), p.estimate.y(), p.estimate.z(), p.error_m);
+      out += run.spec.name + line;
+    }
+  }
+  return out;
+}
+
+/// Per frame run: `frame,stamp,person_boxes` (the detector's person boxes: the frames with people in view).
+inline std::string frames_csv(const SequenceReport& report) {
+  std::string out = "frame,stamp,person_boxes\n";
+  char line[96];
+  for (std::size_t i = 0; i < report.frame_stamps.size(); ++i) {
+    std::snprintf(line, sizeof line, "%zu,%.6f,%d\n", i, report.frame_stamps[i], report.person_boxes[i]);
+    out += line;
+  }
+  return out;
+}
+
 /// ATE of every run against `truth`. The standard TUM way (associate, SE(3) alignment, RMSE); when
 /// the truth does not move (static camera: the alignment is undefined) the estimate is compared
 /// unaligned, in the truth frame it was started in, and the run's ate_note says so.
 inline void evaluate(const eval::Trajectory<double>& truth, SequenceReport* report, const RunnerOptions& options) {
   for (StrategyRun& run : report->runs) {
     const eval::AteResult<double> ate = eval::evaluate_ate(truth, run.estimate);
-    run.aligned_positions.clear();
+    run.pose_pairs.clear();
     if (ate.ok()) {
       run.has_ate = true;
       run.ate_rmse_m = ate.error_m.rmse;
       run.ate_pairs = ate.num_pairs;
-      for (const auto& p : run.estimate.poses) run.aligned_positions.push_back(ate.groundtruth_from_estimate.apply(p.t));
+      for (std::size_t j = 0; j < ate.groundtruth_index.size(); ++j)
+        run.pose_pairs.push_back(pose_pair(truth, ate.groundtruth_index[j], ate.groundtruth_from_estimate.apply(
+                                                                               run.estimate.poses[ate.estimate_index[j]].t)));
     } else if (ate.status == Status::Degenerate) {
       const eval::AssociationResult m = eval::associate(truth.stamps, run.estimate.stamps);
       std::vector<double> err;
-      for (std::size_t j = 0; j < m.size(); ++j)
-        err.push_back((truth.poses[m.first[j]].t - run.estimate.poses[m.second[j]].t).norm());
+      for (std::size_t j = 0; j < m.size(); ++j) {
+        run.pose_pairs.push_back(pose_pair(truth, m.first[j], run.estimate.poses[m.second[j]].t));
+        err.push_back(run.pose_pairs.back().error_m);
+      }
       const eval::ErrorStatistics<double> s = eval::compute_statistics(err.data(), err.size());
       if (s.ok()) {
         run.has_ate = true;
         run.ate_rmse_m = s.rmse;
         run.ate_pairs = s.count;
         run.ate_note = "unaligned (truth does not move: " + ate.reason + ")";
-        for (const auto& p : run.estimate.poses) run.aligned_positions.push_back(p.t);
       } else {
+        run.pose_pairs.clear();
         run.ate_note = s.reason;
       }
     } else {
@@ -210,17 +265,11 @@ inline void evaluate(const eval::Trajectory<double>& truth, SequenceReport* repo
   if (!options.write_outputs) return;
   const std::string truth_file = options.out_dir + "/" + report->name + "_groundtruth.txt";
   if (eval::write_tum_trajectory(truth_file, truth).ok()) report->files.push_back(truth_file);
-  std::vector<Vec3<double>> truth_xyz;
-  for (const auto& p : truth.poses) truth_xyz.push_back(p.t);
-  std::vector<std::string> names;
-  std::vector<std::vector<Vec3<double>>> est;
-  for (const StrategyRun& run : report->runs) {
-    names.push_back(run.spec.name);
-    est.push_back(run.aligned_positions);
-  }
-  const std::string png = options.out_dir + "/" + report->name + "_trajectories.png";
-  if (plot_trajectories(png, report->name + ": ground truth vs estimates (aligned)", truth_xyz, names, est))
-    report->files.push_back(png);
+  // The figures' data: scripts/figures.py draws the trajectories and the error over time from these.
+  const std::string poses = options.out_dir + "/" + report->name + "_poses.csv";
+  if (std::ofstream(poses) << poses_csv(*report)) report->files.push_back(poses);
+  const std::string frames = options.out_dir + "/" + report->name + "_frames.csv";
+  if (std::ofstream(frames) << frames_csv(*report)) report->files.push_back(frames);
 }
 
 /// Sim: the truth recorded frame by frame.

@@ -1,7 +1,8 @@
 /// @file dyncull.hpp
-/// Umbrella header for dyncull's core modules (standard library + Eigen only): core, geometry,
-/// culling, eval and sim. Including single headers compiles faster; the OpenCV and Ceres adapters
-/// are included separately: dyncull/opencv/..., dyncull/ceres/....
+/// Umbrella header for the dyncull library (standard library + Eigen only): core, geometry and culling,
+/// the stateful culler included. Including single headers compiles faster. The evaluation product
+/// (dyncull/eval/..., dyncull/sim/...) and the adapters (dyncull/opencv/..., dyncull/ceres/...,
+/// dyncull/host/...) are included by name (docs/design.md, "Modules and dependency rules").
 #pragma once
 
 #include "dyncull/core/box.hpp"
@@ -27,6 +28,7 @@
 
 #include "dyncull/culling/box_rule.hpp"
 #include "dyncull/culling/box_tracker.hpp"
+#include "dyncull/culling/culler.hpp"
 #include "dyncull/culling/depth_mask.hpp"
 #include "dyncull/culling/descriptor_switch.hpp"
 #include "dyncull/culling/detections.hpp"
@@ -40,20 +42,3 @@
 #include "dyncull/culling/presets.hpp"
 #include "dyncull/culling/subbox_memory.hpp"
 #include "dyncull/culling/subbox_refine.hpp"
-
-#include "dyncull/eval/ate.hpp"
-#include "dyncull/eval/labels.hpp"
-#include "dyncull/eval/report.hpp"
-#include "dyncull/eval/rpe.hpp"
-#include "dyncull/eval/statistics.hpp"
-#include "dyncull/eval/trajectory.hpp"
-
-#include "dyncull/sim/actors.hpp"
-#include "dyncull/sim/depth_noise.hpp"
-#include "dyncull/sim/families.hpp"
-#include "dyncull/sim/primitives.hpp"
-#include "dyncull/sim/scene.hpp"
-#include "dyncull/sim/scene_keys.hpp"
-#include "dyncull/sim/texture.hpp"
-#include "dyncull/sim/trajectory.hpp"
-#include "dyncull/sim/truth.hpp"

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -319,6 +320,7 @@ struct HostCuller::Impl {
   Stats stats;
   bool has_frame = false;
   unsigned long last_frame_id = 0;
+  std::atomic<bool> reset_requested{false};  // HostCuller::reset, from any thread
   bool warned_missing = false, warned_not_ok = false;
 
   bool refuse(const std::string& why) {
@@ -424,8 +426,16 @@ bool HostCuller::Impl::boxes_for(const HostFrame& f, std::string* why, std::stri
   return found;
 }
 
-// A frame id not above the last one: the host restarted its map, and the keyframe belongs to the old one.
+// A frame id not above the last one, or a reset the host asked for: the host restarted its map, and the
+// keyframe belongs to the old one.
 void HostCuller::Impl::note_frame_id(unsigned long frame_id) {
+  if (reset_requested.exchange(false)) {
+    if (has_frame && culler) {
+      culler->reset();
+      ++stats.restarts;
+    }
+    has_frame = false;
+  }
   if (has_frame && frame_id <= last_frame_id && culler) {
     culler->reset();
     ++stats.restarts;
@@ -550,6 +560,8 @@ const std::vector<std::uint8_t>* HostCuller::cull(const HostFrame& frame) noexce
   }
   return nullptr;
 }
+
+void HostCuller::reset() noexcept { impl_->reset_requested.store(true); }
 
 void HostCuller::pass_uncut(double stamp, std::size_t features, const std::string& why) noexcept {
   try {

@@ -15,7 +15,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -215,19 +214,6 @@ TEST(DatasetSummary, CullsAreCountedInPersonBoxesOtherBoxesAndOutside) {
   EXPECT_DOUBLE_EQ(counts.culled_outside_boxes(), 0.5);
 }
 
-// The family summary and the trajectory plot colour strategies by their index: every default strategy
-// (none, the presets, the culler, the oracle) gets its own colour.
-TEST(DatasetFigures, EveryDefaultStrategyHasItsOwnColour) {
-  std::size_t n = 0;
-  for (const vo::StrategySpec& s : vo::all_strategies()) n += s.in_default ? 1 : 0;
-  std::set<std::vector<double>> colours;
-  for (std::size_t i = 0; i < n; ++i) {
-    const cv::Scalar c = vo::strategy_colour(i);
-    colours.insert({c[0], c[1], c[2]});
-  }
-  EXPECT_EQ(colours.size(), n);
-}
-
 std::map<std::string, std::string> csv_row(const std::string& header, const std::string& line) {
   std::map<std::string, std::string> out;
   std::istringstream h(header), l(line);
@@ -331,7 +317,7 @@ TEST(DatasetRun, BonnCrowdFirstFramesWriteTheSummary) {
   EXPECT_GT(std::stod(rows[1]["culled_in_person_boxes"]), 0.5);
   EXPECT_LT(std::stod(rows[1]["culled_outside_boxes"]), 0.05);
   EXPECT_GT(std::stod(rows[1]["cull_ms"]), 0.0);
-  for (const char* f : {"crowd_part1_none.txt", "crowd_part1_zhu_2024.txt", "crowd_part1_trajectories.png",
+  for (const char* f : {"crowd_part1_none.txt", "crowd_part1_zhu_2024.txt", "crowd_part1_poses.csv", "crowd_part1_frames.csv",
                         "crowd_part1_frame_strip.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   fs::remove_all(out);

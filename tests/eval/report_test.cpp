@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <clocale>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -84,6 +86,53 @@ TEST(EvalRun, MalformedFileGivesFileAndLine) {
   args.estimate_path = dir + "/does_not_exist.txt";
   EXPECT_EQ(run_eval(args).status, Status::IoError);
   EXPECT_NE(format_report_json(run_eval(args)).find("\"status\": \"i/o error\""), std::string::npos);
+}
+
+// --poses-csv: one row per pair in stamp order; an estimate that is the truth moved rigidly comes back
+// onto the truth after the alignment, with zero error.
+TEST(EvalRun, PosesCsvHoldsEachPairAligned) {
+  const std::string dir = ::testing::TempDir();
+  const std::string truth = dir + "/dyncull_eval_poses_truth.txt";
+  const std::string moved = dir + "/dyncull_eval_poses_moved.txt";
+  std::ofstream(truth) << "1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n3 1 1 0 0 0 0 1\n4 0 1 1 0 0 0 1\n";
+  std::ofstream(moved) << "1 5 0 0 0 0 0 1\n2 5 1 0 0 0 0 1\n3 4 1 0 0 0 0 1\n4 4 0 1 0 0 0 1\n";  // turned 90 deg, shifted
+  const ParseArgsResult parsed = parse({truth.c_str(), moved.c_str(), "--poses-csv", "poses.csv"});
+  ASSERT_TRUE(parsed.ok()) << parsed.reason;
+  EXPECT_EQ(parsed.args.poses_csv, "poses.csv");
+  EXPECT_FALSE(parse({truth.c_str(), moved.c_str(), "--poses-csv"}).ok());
+  const std::string csv = format_poses_csv(run_eval(parsed.args));
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "stamp,gt_x,gt_y,gt_z,x,y,z,error_m");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
+  std::istringstream rows(csv.substr(csv.find('\n') + 1));
+  std::string row;
+  double expected_stamp = 1.0;
+  while (std::getline(rows, row)) {
+    std::vector<double> v;
+    std::istringstream fields(row);
+    for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+    ASSERT_EQ(v.size(), 8u) << row;
+    EXPECT_DOUBLE_EQ(v[0], expected_stamp++);
+    for (int k = 1; k <= 3; ++k) EXPECT_NEAR(v[k + 3], v[k], 1e-6) << row;
+    EXPECT_NEAR(v[7], 0.0, 1e-6) << row;
+  }
+}
+
+// --associate: rgb.txt and depth.txt pairs as associate.py makes them: depth 1.052 is within the window of rgb
+// 1.033 (0.019 s) and rgb 1.067 (0.015 s), the closer one gets it; rgb 1.100 has no depth within 0.02 s.
+TEST(EvalRun, AssociateListsPairsClosestFirstEachStampOnce) {
+  const std::string dir = ::testing::TempDir();
+  const std::string rgb = dir + "/dyncull_eval_rgb.txt", depth = dir + "/dyncull_eval_depth.txt";
+  std::ofstream(rgb) << "# color images\n1.000000 rgb/1.png\n1.033333 rgb/2.png\n1.066667 rgb/3.png\n1.100000 rgb/4.png\n";
+  std::ofstream(depth) << "# depth maps\n1.010000 depth/a.png\n1.052000 depth/b.png\n1.130000 depth/c.png\n";
+  const ParseArgsResult parsed = parse({"--associate", rgb.c_str(), depth.c_str()});
+  ASSERT_TRUE(parsed.ok()) << parsed.reason;
+  const ListAssociation pairs = associate_lists(parsed.args);
+  ASSERT_TRUE(pairs.ok()) << pairs.reason;
+  EXPECT_EQ(pairs.text, "1.000000 rgb/1.png 1.010000 depth/a.png\n1.066667 rgb/3.png 1.052000 depth/b.png\n");
+  std::ofstream(depth) << "1.000000\n";  // a line without its file
+  const ListAssociation bad = associate_lists(parsed.args);
+  EXPECT_EQ(bad.status, Status::ParseError);
+  EXPECT_EQ(bad.reason.rfind(depth + ":1: ", 0), 0u) << bad.reason;
 }
 
 TEST(EvalRun, RealDataPrintsTheTumScriptsLines) {

@@ -592,6 +592,128 @@ TEST(HostCullerFrame, RandomBadInputsNeverLeaveTheFrameInconsistent) {
   }
 }
 
+// A reset the host asks for (ORB-SLAM3's Atlas starting a map) restarts the culler at the next frame, also
+// when the frame counter goes on; before the first frame it counts nothing.
+TEST(HostCullerModes, AResetRestartsTheCullerAtTheNextFrame) {
+  TempDir dir("reset");
+  write_two_frames(dir);
+  const Keys k = three_keys();
+  const cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.f));
+  HostCuller culler(settings_for(Mode::Culler, dir));
+  ASSERT_TRUE(culler.ok()) << culler.reason();
+  culler.reset();  // the Atlas's first map, before any frame
+  ASSERT_NE(cull(culler, kStamp0, 0, k, depth), nullptr);
+  EXPECT_EQ(culler.stats().restarts, 0u);
+  culler.reset();
+  culler.reset();  // two requests before one frame: one restart
+  ASSERT_NE(cull(culler, kStamp0 + 1.0 / 30, 1, k, depth), nullptr);
+  EXPECT_EQ(culler.stats().restarts, 1u);
+  ASSERT_NE(cull(culler, kStamp0 + 2.0 / 30, 2, k, depth), nullptr);
+  EXPECT_EQ(culler.stats().restarts, 1u);
+  EXPECT_NE(culler.summary().find("1 restarts"), std::string::npos) << culler.summary();
+}
+
+// The members of ORB-SLAM3's Frame that cull_orb_slam_frame reads beyond ORB-SLAM2's: one camera
+// (Nleft = Nright = -1, no left-right matches) unless a test sets them.
+struct Vector3 {
+  float x, y, z;
+};
+struct FakeFrame3 : FakeFrame {
+  int Nleft = -1, Nright = -1;
+  std::vector<int> mvLeftToRightMatch;
+  std::vector<Vector3> mvStereo3Dpoints;
+};
+
+FakeFrame3 three_key_frame3() {
+  FakeFrame3 f;
+  static_cast<FakeFrame&>(f) = three_key_frame();
+  return f;
+}
+
+// A pose as Sophus gives it: matrix() returns a 4x4 with rows(), cols() and operator()(r, c).
+struct Matrix4 {
+  float m[4][4];
+  int rows() const { return 4; }
+  int cols() const { return 4; }
+  float operator()(int r, int c) const { return m[r][c]; }
+};
+struct FakeSE3 {
+  float tz;
+  Matrix4 matrix() const {
+    Matrix4 out = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, tz}, {0, 0, 0, 1}}};
+    return out;
+  }
+};
+
+TEST(HostCullerFrame, AnOrbSlam3OneCameraFrameIsCulledWithASophusPose) {
+  TempDir dir("orb3");
+  write_two_frames(dir);
+  HostCuller culler(settings_for(Mode::BoxOnly, dir));
+  FakeFrame3 f = three_key_frame3();
+  EXPECT_EQ(host::cull_orb_slam_frame(culler, f, kGrey, cv::Mat(), camera_K(), cv::Mat(), FakeSE3{0.5f}, true), 2);
+  EXPECT_EQ(f.mvKeys.size(), 2u);
+  EXPECT_EQ(f.mvDepth, (std::vector<float>{20.f, 30.f}));
+  EXPECT_EQ(f.Nleft, -1);
+  FakeFrame3 g = three_key_frame3();  // no pose known: the same culling
+  g.mTimeStamp = kStamp0 + 1.0 / 30;
+  g.mnId = 1;
+  EXPECT_EQ(host::cull_orb_slam_frame(culler, g, kGrey, cv::Mat(), camera_K(), cv::Mat(), FakeSE3{0.f}, false), 3);
+  EXPECT_EQ(culler.stats().frames_not_ok, 0u);
+}
+
+// The culler reads the pose the host predicts: a Sophus-like pose that is not rigid (a NaN) is refused by
+// the culler, and the frame passes uncut with the reason.
+TEST(HostCullerFrame, ASophusPoseReachesTheCuller) {
+  const cv::Mat pose = host::detail::pose_matrix(FakeSE3{0.25f});
+  ASSERT_EQ(pose.type(), CV_64F);
+  ASSERT_EQ(pose.size(), cv::Size(4, 4));
+  EXPECT_DOUBLE_EQ(pose.at<double>(2, 3), 0.25);
+  EXPECT_DOUBLE_EQ(pose.at<double>(3, 3), 1.0);
+  TempDir dir("orb3pose");
+  write_two_frames(dir);
+  HostSettings s = settings_for(Mode::Culler, dir);
+  s.log_path = dir.file("frames.csv");
+  {
+    HostCuller culler(s);
+    FakeFrame3 f = three_key_frame3();
+    const cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.f));
+    EXPECT_EQ(host::cull_orb_slam_frame(culler, f, kGrey, depth, camera_K(), cv::Mat(),
+                                        FakeSE3{std::numeric_limits<float>::quiet_NaN()}),
+              3);
+    EXPECT_EQ(f.mvKeys.size(), 3u);
+    EXPECT_EQ(culler.stats().frames_not_ok, 1u);
+  }
+  const std::vector<std::string> log = lines_of(s.log_path);
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_NE(log[1].find(",non-finite input,cam_from_world has a NaN"), std::string::npos) << log[1];
+}
+
+// A two-camera frame (fisheye stereo: keys left then right, Nleft and Nright set) or a frame with
+// left-right matches passes uncut, logged with the arrays named.
+TEST(HostCullerFrame, AnOrbSlam3TwoCameraFrameIsLoggedAsNotCulled) {
+  TempDir dir("orb3stereo");
+  write_two_frames(dir);
+  HostSettings s = settings_for(Mode::BoxOnly, dir);
+  s.log_path = dir.file("frames.csv");
+  {
+    HostCuller culler(s);
+    FakeFrame3 f = three_key_frame3();
+    f.Nleft = 2;
+    f.Nright = 1;
+    EXPECT_EQ(host::cull_orb_slam_frame(culler, f, kGrey, cv::Mat(), camera_K(), cv::Mat(), FakeSE3{0.f}), 3);
+    EXPECT_EQ(f.mvKeys.size(), 3u);
+    FakeFrame3 g = three_key_frame3();
+    g.mvLeftToRightMatch = {0, -1, 1};
+    EXPECT_EQ(host::cull_orb_slam_frame(culler, g, kGrey, cv::Mat(), camera_K(), cv::Mat(), FakeSE3{0.f}), 3);
+    EXPECT_EQ(g.mvKeys.size(), 3u);
+    EXPECT_EQ(culler.stats().frames_not_ok, 2u);
+  }
+  const std::vector<std::string> log = lines_of(s.log_path);
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_NE(log[1].find("a two-camera frame (Nleft 2; Nright 1)"), std::string::npos) << log[1];
+  EXPECT_NE(log[2].find("mvLeftToRightMatch 3"), std::string::npos) << log[2];
+}
+
 // The OpenCV camera reads distortion from any layout, also a column view of a larger matrix.
 TEST(HostCullerFrame, CullerCameraReadsADistortionView) {
   cv::Mat wide(5, 3, CV_64F, cv::Scalar(0));

@@ -1,12 +1,14 @@
 // A C++11 host of the host harness (host/host_culler.hpp), built as ORB-SLAM2/3 compile (CXX_STANDARD 11,
 // -Wall -Wextra -Wpedantic -Werror) against dyncull::host and run: an ORB-SLAM-like Frame culled in
 // stock mode (untouched) and in box_only mode with a stand-in detector waited for (the person box's
-// features removed, every parallel array in step); exit code 0 when all is as the header says.
+// features removed, every parallel array in step), and an ORB-SLAM3-like Frame with a Sophus-like pose and
+// a reset from another thread (box_only: nothing to restart); exit code 0 when all is as the header says.
 #include <dyncull/host/host_culler.hpp>
 
 #include <opencv2/core.hpp>
 
 #include <cstdio>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -36,6 +38,24 @@ struct Frame {
     y = 0;
     return true;
   }
+};
+
+// ORB-SLAM3's Frame: ORB-SLAM2's members and the two-camera ones (one camera: Nleft = Nright = -1).
+struct Frame3 : Frame {
+  int Nleft, Nright;
+  std::vector<int> mvLeftToRightMatch;
+  std::vector<cv::Vec3f> mvStereo3Dpoints;
+  Frame3() : Nleft(-1), Nright(-1) {}
+};
+
+// Sophus::SE3f's shape: matrix() gives a 4x4 with rows(), cols() and (r, c).
+struct Pose {
+  struct Matrix {
+    int rows() const { return 4; }
+    int cols() const { return 4; }
+    float operator()(int r, int c) const { return r == c ? 1.f : 0.f; }
+  };
+  Matrix matrix() const { return Matrix(); }
 };
 
 // One person box over the left half, whatever the frame.
@@ -87,6 +107,23 @@ int main() {
   expect(g.mvKeysUn.size() == static_cast<std::size_t>(kept) && g.mDescriptors.rows == kept &&
              g.mvDepth.size() == static_cast<std::size_t>(kept) && g.mvpMapPoints.size() == static_cast<std::size_t>(kept),
          "every parallel array keeps step with N");
+
+  Frame3 h;
+  static_cast<Frame&>(h) = grid_frame();
+  h.mnId = 1;
+  std::thread atlas([&box_only] { box_only.reset(); });  // ORB-SLAM3's Atlas starting a map
+  atlas.join();
+  const int kept3 = host::cull_orb_slam_frame(box_only, h, colour, cv::Mat(), K, cv::Mat(), Pose(), true);
+  expect(kept3 == kept && h.mvDepth.size() == static_cast<std::size_t>(kept3) && h.Nleft == -1,
+         "an ORB-SLAM3 one-camera frame with a Sophus-like pose is culled as ORB-SLAM2's");
+  expect(box_only.stats().restarts == 0, "a reset from another thread in box_only: no keyframe to forget");
+  Frame3 two = Frame3();
+  static_cast<Frame&>(two) = grid_frame();
+  two.Nleft = 100;
+  two.Nright = two.N - 100;
+  expect(host::cull_orb_slam_frame(box_only, two, colour, cv::Mat(), K, cv::Mat(), Pose(), false) == n &&
+             two.mvKeys.size() == static_cast<std::size_t>(n),
+         "an ORB-SLAM3 two-camera frame passes uncut");
   std::printf("orb_slam_host: %d of %d kept, %d failures\n", kept, n, failures);
   return failures == 0 ? 0 : 1;
 }

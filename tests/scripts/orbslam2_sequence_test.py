@@ -1,11 +1,10 @@
 #!/usr/bin/env python3
-"""Tests of scripts/orbslam2_sequence.py (run by ctest): rgb and depth paired as associate.py (closest
-first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
-Horn's alignment recovers a known rotation and translation; a run's lost frames are counted against the
+"""Tests of scripts/orbslam2_sequence.py (run by ctest): rgb and depth paired by dyncull_eval --associate as
+associate.py (closest first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
+the trajectory figure takes each variant's median run as dyncull_eval aligned it; a run's lost frames are counted against the
 associations (ORB-SLAM2 leaves them out of its trajectory); the summary has a row per variant and run with
 the required columns, and a run without a trajectory is reported, not dropped."""
 import json
-import math
 import os
 import shutil
 import struct
@@ -28,6 +27,11 @@ def write_png(path, width, height):
                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
+# The pairing is dyncull_eval's (ctest passes the built program in DYNCULL_EVAL).
+DYNCULL_EVAL = os.environ.get("DYNCULL_EVAL", "")
+
+
+@unittest.skipUnless(DYNCULL_EVAL and os.access(DYNCULL_EVAL, os.X_OK), "DYNCULL_EVAL names no dyncull_eval program")
 class Sequence(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.mkdtemp(prefix="dyncull_orbslam2_test_")
@@ -47,14 +51,13 @@ class Sequence(unittest.TestCase):
         shutil.rmtree(self.dir)
 
     def test_pairs_closest_first_each_stamp_once(self):
-        pairs = seq.associate(seq.read_list(os.path.join(self.dir, "rgb.txt")),
-                              seq.read_list(os.path.join(self.dir, "depth.txt")))
-        self.assertEqual([(p[0], p[1], p[2], p[3]) for p in pairs],
-                         [("1.000000", "rgb/1.000000.png", "1.010000", "depth/a.png"),
-                          ("1.066667", "rgb/1.066667.png", "1.052000", "depth/b.png")])
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
+        self.assertEqual(open(os.path.join(self.dir, "associations.txt")).read().splitlines(),
+                         ["1.000000 rgb/1.000000.png 1.010000 depth/a.png",
+                          "1.066667 rgb/1.066667.png 1.052000 depth/b.png"])
 
     def test_settings_from_camera_and_image_size(self):
-        seq.prepare(self.dir, self.dir)
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
         text = open(os.path.join(self.dir, "orbslam2_settings.yaml")).read()
         self.assertTrue(text.startswith("%YAML:1.0\n"))
         for line in ("Camera.fx: 542.8", "Camera.cy: 237.7", "Camera.k1: 0.0", "Camera.width: 64",
@@ -63,7 +66,7 @@ class Sequence(unittest.TestCase):
         self.assertEqual(seq.count_lines(os.path.join(self.dir, "associations.txt")), 2)
 
     def test_lost_frames_and_summary_rows(self):
-        seq.prepare(self.dir, self.dir)
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
         good = os.path.join(self.dir, "runs", "culler", "run1")
         empty = os.path.join(self.dir, "runs", "culler", "run2")
         os.makedirs(good)
@@ -93,7 +96,7 @@ class Sequence(unittest.TestCase):
     def test_live_variant_reads_detector_time_and_box_age(self):
         with open(os.path.join(self.dir, "rgb_color.txt"), "w") as f:
             f.write("# colour\n1.000000 rgb_color/1.000000.jpg\n1.066667 rgb_color/1.066667.jpg\n")
-        seq.prepare(self.dir, self.dir)
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
         self.assertEqual(seq.count_lines(os.path.join(self.dir, "associations_color.txt")), 2)
         run = os.path.join(self.dir, "runs", "culler_live", "run1")
         os.makedirs(run)
@@ -111,19 +114,38 @@ class Sequence(unittest.TestCase):
         self.assertEqual((row["variant"], row["detector_ms"], row["box_age_frames"]), ("culler_live", "41.5", "1.50"))
 
 
-class Alignment(unittest.TestCase):
-    def test_horn_recovers_a_rotation_and_translation(self):
-        angle = 0.7
-        c, s = math.cos(angle), math.sin(angle)
-        R = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-        t = [0.5, -1.0, 2.0]
-        estimate = [(0.0, 0.0, 0.0), (1.0, 0.2, 0.0), (0.3, 1.5, 0.4), (-0.7, 0.1, 1.2), (0.2, -0.9, -0.5)]
-        truth = [tuple(sum(R[i][j] * p[j] for j in range(3)) + t[i] for i in range(3)) for p in estimate]
-        R_fit, t_fit = seq.horn_alignment(list(zip(truth, estimate)))
-        for i in range(3):
-            self.assertAlmostEqual(t_fit[i], t[i], places=9)
-            for j in range(3):
-                self.assertAlmostEqual(R_fit[i][j], R[i][j], places=9)
+class Trajectories(unittest.TestCase):
+    """The trajectory figure shows each variant's median-ATE run as dyncull_eval aligned it (its poses.csv)."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="dyncull_orbslam2_plot_test_")
+        self.rows = [{"variant": "stock", "run": str(k), "ate_rmse_m": ate} for k, ate in ((1, "0.30"), (2, "0.10"), (3, "0.20"))]
+        self.rows.append({"variant": "culler", "run": "1", "ate_rmse_m": "0.02"})
+        self.rows.append({"variant": "box_only", "run": "1", "ate_rmse_m": ""})  # no trajectory
+        for variant, run in (("stock", 1), ("stock", 2), ("stock", 3), ("culler", 1)):
+            run_dir = os.path.join(self.dir, "runs", variant, "run%d" % run)
+            os.makedirs(run_dir)
+            with open(os.path.join(run_dir, "poses.csv"), "w") as f:
+                f.write("stamp,gt_x,gt_y,gt_z,x,y,z,error_m\n")
+                for i in range(5):
+                    f.write("%d.0,%d,0,%d,%d,0.01,%d,0.01\n" % (i, i, i % 2, i, i % 2))
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def test_median_run_of_each_variant(self):
+        chosen = seq.median_runs(self.dir, self.rows)
+        self.assertEqual([(v, r, a) for v, r, a, _ in chosen], [("stock", 3, 0.2), ("culler", 1, 0.02)])
+        self.assertTrue(chosen[0][3].endswith(os.path.join("runs", "stock", "run3", "poses.csv")))
+
+    def test_figure_is_drawn_from_the_poses(self):
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            self.skipTest("python3-matplotlib is not installed (scripts/install-deps.sh installs it)")
+        path = os.path.join(self.dir, "trajectories.svg")
+        self.assertEqual(len(seq.plot_trajectories("seq", self.dir, self.rows, path)), 2)
+        self.assertIn("<svg", open(path).read())
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@
 #include "dyncull/core/text.hpp"
 #include "dyncull/eval/ate.hpp"
 #include "dyncull/eval/rpe.hpp"
+#include "dyncull/eval/sequence.hpp"
 #include "dyncull/eval/statistics.hpp"
 #include "dyncull/eval/trajectory.hpp"
 
@@ -29,6 +30,8 @@ struct EvalCommandLine {
   double max_difference_s = 0.02;            ///< --max-difference S
   double offset_s = 0.0;                     ///< --offset S (added to the estimate's stamps)
   bool json = false;                         ///< --json
+  std::string poses_csv;                     ///< --poses-csv FILE: each pair, aligned, for plots
+  bool associate_lists = false;              ///< --associate: the two files are "timestamp file" lists
   bool help = false;                         ///< -h / --help
 };
 
@@ -50,12 +53,14 @@ struct EvalReport {
   AteResult<double> ate;
   RpeResult<double> rpe;  ///< computed when args.rpe
   double rpe_scale = 1.0; ///< fixed scale applied to the estimate's relative motions (ATE scale with --scale)
+  Trajectory<double> groundtruth, estimate;  ///< as read, for format_poses_csv
 };
 
 inline std::string eval_usage(const std::string& program = "dyncull_eval") {
   return "usage: " + program +
          " GROUNDTRUTH ESTIMATE [--rpe] [--delta N] [--delta-unit frames|seconds|metres|degrees|radians]\n"
-         "       [--scale] [--max-difference S] [--offset S] [--json]\n"
+         "       [--scale] [--max-difference S] [--offset S] [--json] [--poses-csv FILE]\n"
+         "       " + program + " --associate FIRST_LIST SECOND_LIST [--max-difference S] [--offset S]\n"
          "\n"
          "Evaluates an estimated trajectory against ground truth, both TUM files\n"
          "(timestamp tx ty tz qx qy qz qw; '#' comments). Numbers equal the TUM benchmark scripts'.\n"
@@ -74,6 +79,10 @@ inline std::string eval_usage(const std::string& program = "dyncull_eval") {
          "  --max-difference S association window in seconds (default 0.02)\n"
          "  --offset S         time offset added to the estimate's stamps (default 0)\n"
          "  --json             machine-readable output\n"
+         "  --associate        pair two 'timestamp file' lists (rgb.txt, depth.txt) as TUM's associate.py and\n"
+         "                     print 'stamp file stamp file' per pair, in the first list's stamp order\n"
+         "  --poses-csv FILE   also write each associated pair (stamp, ground-truth position, aligned estimate\n"
+         "                     position, error) as CSV: the data of trajectory and error-over-time plots\n"
          "  -h, --help         this text\n"
          "\n"
          "Exit status: 0 ok, 1 evaluation failed (bad file: the message gives file:line), 2 bad arguments.\n";
@@ -194,6 +203,10 @@ inline ParseArgsResult parse_eval_args(int argc, const char* const* argv) {
       if (!value(&v) || !detail::parse_number_arg(v, &a.max_difference_s) || !(a.max_difference_s > 0)) {
         return fail("--max-difference needs a positive number of seconds");
       }
+    } else if (arg == "--associate") {
+      a.associate_lists = true;
+    } else if (arg == "--poses-csv") {
+      if (!value(&a.poses_csv) || a.poses_csv.empty()) return fail("--poses-csv needs a file name");
     } else if (arg == "--offset") {
       if (!value(&v) || !detail::parse_number_arg(v, &a.offset_s)) return fail("--offset needs a number of seconds");
     } else if (arg.size() > 1 && arg[0] == '-') {
@@ -231,6 +244,8 @@ inline EvalReport run_eval(const EvalCommandLine& args) {
   report.estimate_poses = est.trajectory.size();
   report.groundtruth_skipped = gt.num_skipped;
   report.estimate_skipped = est.num_skipped;
+  report.groundtruth = gt.trajectory;
+  report.estimate = est.trajectory;
 
   AteOptions ate_options;
   ate_options.association.max_difference_s = args.max_difference_s;
@@ -256,6 +271,67 @@ inline EvalReport run_eval(const EvalCommandLine& args) {
     }
   }
   return report;
+}
+
+/// dyncull_eval --associate: the pairs of two "timestamp file" lists (args.groundtruth_path and
+/// args.estimate_path), as TUM's associate.py pairs them (associate()), one "stamp file stamp file" line
+/// each (%.6f stamps). A list that cannot be read is its status and "path:line: ..." reason; lists with
+/// no pair within the window are TooFewPoints.
+struct ListAssociation {
+  Status status = Status::Ok;
+  std::string reason;
+  bool ok() const { return status == Status::Ok; }
+  std::string text;
+};
+
+inline ListAssociation associate_lists(const EvalCommandLine& args) {
+  ListAssociation result;
+  std::vector<detail::ListEntry> first, second;
+  for (auto [path, list] : {std::pair{&args.groundtruth_path, &first}, std::pair{&args.estimate_path, &second}}) {
+    result.status = detail::read_list(*path, SequenceOptions{}, list, &result.reason);
+    if (!result.ok()) return result;
+  }
+  auto stamps = [](const std::vector<detail::ListEntry>& list) {
+    std::vector<double> out;
+    for (const detail::ListEntry& e : list) out.push_back(e.timestamp);
+    return out;
+  };
+  AssociationOptions options;
+  options.max_difference_s = args.max_difference_s;
+  options.offset_s = args.offset_s;
+  const AssociationResult pairs = associate(stamps(first), stamps(second), options);
+  if (!pairs.ok()) {
+    result.status = pairs.status;
+    result.reason = text::quote_path(args.groundtruth_path) + " and " + text::quote_path(args.estimate_path) + ": " + pairs.reason;
+    return result;
+  }
+  char buffer[64];
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const detail::ListEntry &a = first[pairs.first[k]], &b = second[pairs.second[k]];
+    std::snprintf(buffer, sizeof buffer, "%.6f ", a.timestamp);
+    result.text += buffer + a.path;
+    std::snprintf(buffer, sizeof buffer, " %.6f ", b.timestamp);
+    result.text += buffer + b.path + "\n";
+  }
+  return result;
+}
+
+/// The ATE's pairs in ground-truth stamp order as CSV, `stamp,gt_x,gt_y,gt_z,x,y,z,error_m`: the
+/// ground truth's stamp and position, the estimate's position after the ATE's alignment, and the
+/// distance between them (metres, %.6f). A report without an ATE gives the header alone.
+inline std::string format_poses_csv(const EvalReport& r) {
+  std::string out = "stamp,gt_x,gt_y,gt_z,x,y,z,error_m\n";
+  if (!r.ate.ok()) return out;
+  char line[256];
+  for (std::size_t k = 0; k < r.ate.groundtruth_index.size(); ++k) {
+    const std::size_t g = r.ate.groundtruth_index[k], e = r.ate.estimate_index[k];
+    const Vec3<double> truth = r.groundtruth.poses[g].t;
+    const Vec3<double> aligned = r.ate.groundtruth_from_estimate.apply(r.estimate.poses[e].t);
+    std::snprintf(line, sizeof(line), "%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", r.groundtruth.stamps[g], truth.x(),
+                  truth.y(), truth.z(), aligned.x(), aligned.y(), aligned.z(), (aligned - truth).norm());
+    out += line;
+  }
+  return out;
 }
 
 /// TUM-script lines (evaluate_ate.py / evaluate_rpe.py --verbose names and %f format), preceded by

@@ -8,6 +8,7 @@
 /// API:
 ///   dyncull::host::HostCuller& culler = dyncull::host::environment_culler();  // at start: a bad setting exits
 ///   dyncull::host::cull_orb_slam_frame(culler, frame, colour, depth, K, dist, predicted_Tcw);  // per frame
+///   culler.reset();  // the host started a new map (ORB-SLAM3's Atlas): from any thread
 ///   // or, for any host: const std::vector<std::uint8_t>* keep = culler.cull(host_frame);
 #pragma once
 
@@ -103,6 +104,11 @@ class HostCuller {
   /// one means the host restarted its map: the culler forgets its keyframe first.
   const std::vector<std::uint8_t>* cull(const HostFrame& frame) noexcept;
 
+  /// The host started a new map (ORB-SLAM3's Atlas creating one): the culler forgets its keyframe before
+  /// the next frame it culls, and the summary counts a restart when there was one to forget. Only sets a
+  /// flag: safe from any thread, at any time (before the first frame it does nothing).
+  void reset() noexcept;
+
   /// Logs and counts a frame of `features` features that the host passes uncut because `why` (its arrays
   /// disagree, for example): status InvalidInput, every feature kept.
   void pass_uncut(double stamp, std::size_t features, const std::string& why) noexcept;
@@ -158,19 +164,57 @@ std::string orb_slam_frame_disagreement(const Frame& f) {
     return says("mDescriptors", f.mDescriptors.dims > 2 ? 0 : static_cast<std::size_t>(f.mDescriptors.rows));
   return std::string();
 }
+
+/// ORB-SLAM3's Frame (it has Nleft, Nright, mvLeftToRightMatch, mvStereo3Dpoints): empty for a one-camera
+/// frame (Nleft == -1, no left-right matches), else why it passes uncut. A two-camera frame (fisheye
+/// stereo) indexes its keys as left then right, which the culling here does not keep in step.
+template <class Frame>
+auto two_camera_refusal(const Frame& f, int)
+    -> decltype(f.Nleft + f.Nright + f.mvLeftToRightMatch.size() + f.mvStereo3Dpoints.size(), std::string()) {
+  if (f.Nleft != -1 || f.Nright != -1)
+    return "a two-camera frame (Nleft " + std::to_string(f.Nleft) + ", Nright " + std::to_string(f.Nright) +
+           "): its left and right keys are not culled; the frame passes uncut";
+  if (!f.mvLeftToRightMatch.empty() || !f.mvStereo3Dpoints.empty())
+    return "a one-camera frame with left-right matches (mvLeftToRightMatch " +
+           std::to_string(f.mvLeftToRightMatch.size()) + ", mvStereo3Dpoints " +
+           std::to_string(f.mvStereo3Dpoints.size()) + " entries): the frame passes uncut";
+  return std::string();
+}
+/// ORB-SLAM2's Frame (no such arrays): always one camera.
+template <class Frame>
+std::string two_camera_refusal(const Frame&, long) {
+  return std::string();
+}
+
+/// A pose as a 4x4 cv::Mat: a cv::Mat as it is (empty: none), anything with matrix() (Sophus::SE3f,
+/// Sophus::SE3d, an Eigen transform) copied element by element as CV_64F.
+inline cv::Mat pose_matrix(const cv::Mat& pose) { return pose; }
+template <class Pose>
+cv::Mat pose_matrix(const Pose& pose) {
+  const auto m = pose.matrix();
+  if (m.rows() != 4 || m.cols() != 4) return cv::Mat();
+  cv::Mat out(4, 4, CV_64F);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out.at<double>(r, c) = static_cast<double>(m(r, c));
+  return out;
+}
 }  // namespace detail
 
-/// Culls an ORB-SLAM2/3-style Frame after its constructor and before tracking uses it: applies the keep
-/// mask to mvKeys, mvKeysUn, mDescriptors, mvuRight and mvDepth, sets N, and rebuilds what is sized by N
-/// (mvpMapPoints, mvbOutlier, the feature grid through the Frame's public PosInGrid). `image`: the frame
-/// as captured (colour for a live detector; ORB-SLAM's imRGB before it is turned grey). Returns the new N;
-/// the old one, with nothing touched, in stock mode, when the frame's arrays disagree (logged as not
-/// culled) or when anything fails (logged).
-template <class Frame>
+/// Culls an ORB-SLAM2 or ORB-SLAM3 Frame after its constructor and before tracking uses it: applies the
+/// keep mask to mvKeys, mvKeysUn, mDescriptors, mvuRight and mvDepth, sets N, and rebuilds what is sized
+/// by N (mvpMapPoints, mvbOutlier, the feature grid through the Frame's public PosInGrid). `image`: the
+/// frame as captured (colour for a live detector; ORB-SLAM's imRGB before it is turned grey).
+/// `predicted_Tcw`: cam_from_world, a 4x4 cv::Mat (ORB-SLAM2; empty: none) or a Sophus SE3 (ORB-SLAM3),
+/// used only when `pose_known`. An ORB-SLAM3 two-camera frame (Nleft != -1) passes uncut, logged.
+/// Returns the new N; the old one, with nothing touched, in stock mode, when the frame's arrays disagree
+/// (logged as not culled) or when anything fails (logged).
+template <class Frame, class Pose>
 int cull_orb_slam_frame(HostCuller& culler, Frame& frame, const cv::Mat& image, const cv::Mat& depth,
-                        const cv::Mat& K, const cv::Mat& distortion, const cv::Mat& predicted_Tcw) noexcept {
+                        const cv::Mat& K, const cv::Mat& distortion, const Pose& predicted_Tcw,
+                        bool pose_known = true) noexcept {
   try {
-    const std::string disagreement = detail::orb_slam_frame_disagreement(frame);
+    std::string disagreement = detail::two_camera_refusal(frame, 0);
+    if (disagreement.empty()) disagreement = detail::orb_slam_frame_disagreement(frame);
     if (!disagreement.empty()) {
       culler.pass_uncut(frame.mTimeStamp, frame.mvKeys.size(), disagreement);
       return frame.N;
@@ -185,7 +229,8 @@ int cull_orb_slam_frame(HostCuller& culler, Frame& frame, const cv::Mat& image, 
     h.keys_un = &frame.mvKeysUn;
     h.descriptors = &frame.mDescriptors;
     h.depth = &depth;
-    h.predicted_Tcw = &predicted_Tcw;
+    const cv::Mat pose = pose_known ? detail::pose_matrix(predicted_Tcw) : cv::Mat();
+    h.predicted_Tcw = &pose;
     const std::vector<std::uint8_t>* keep = culler.cull(h);
     if (!keep) return frame.N;
     const long n = cv_adapter::compact(*keep, frame.mDescriptors, frame.mvKeys, frame.mvKeysUn, frame.mvuRight,
