@@ -184,34 +184,72 @@ struct Totals {
 
 double share(std::size_t a, std::size_t b) { return b ? static_cast<double>(a) / static_cast<double>(b) : 0.0; }
 
-int label_dataset(const Args& args) {
+/// Opens the dataset (images, depth, ground truth; no boxes) and loads its frames with their poses.
+bool load_frames(const Args& args, vo::DatasetSource* source, std::vector<truth::TruthFrame>* frames,
+                 std::string* error) {
   vo::DatasetOptions options;
   options.dir = args.dataset;
   options.detections = "none";  // the labeller uses no boxes
-  vo::DatasetSource source;
-  std::string error;
-  if (!source.open(options, &error)) return std::fprintf(stderr, "dyncull_motion_truth: %s\n", error.c_str()), 1;
-  if (source.index().groundtruth_path.empty())
-    return std::fprintf(stderr, "dyncull_motion_truth: %s: no groundtruth.txt\n", args.dataset.c_str()), 1;
-  const eval::TrajectoryReadResult<double> gt = eval::read_tum_trajectory<double>(source.index().groundtruth_path);
-  if (!gt.ok()) return std::fprintf(stderr, "dyncull_motion_truth: %s\n", gt.reason.c_str()), 1;
-  const int n = args.frames > 0 ? std::min(args.frames, source.size()) : source.size();
-  std::vector<truth::TruthFrame> frames(static_cast<std::size_t>(n));
+  if (!source->open(options, error)) return false;
+  if (source->index().groundtruth_path.empty()) {
+    *error = args.dataset + ": no groundtruth.txt";
+    return false;
+  }
+  const eval::TrajectoryReadResult<double> gt = eval::read_tum_trajectory<double>(source->index().groundtruth_path);
+  if (!gt.ok()) {
+    *error = gt.reason;
+    return false;
+  }
+  const int n = args.frames > 0 ? std::min(args.frames, source->size()) : source->size();
+  frames->assign(static_cast<std::size_t>(n), truth::TruthFrame{});
   for (int i = 0; i < n; ++i) {
     vo::SequenceFrame f;
-    if (!source.load(i, &f, &error)) return std::fprintf(stderr, "dyncull_motion_truth: %s\n", error.c_str()), 1;
-    truth::TruthFrame& t = frames[static_cast<std::size_t>(i)];
+    if (!source->load(i, &f, error)) return false;
+    truth::TruthFrame& t = (*frames)[static_cast<std::size_t>(i)];
     t.gray = f.gray.clone();
     if (cv::countNonZero(f.depth_m) > 0) t.depth_m = f.depth_m.clone();
     t.has_pose = pose_at(gt.trajectory, f.timestamp, &t.world_from_cam);
   }
+  return true;
+}
+
+/// The summary's lines on the known pixels outside every person box, and the strip of the four frames
+/// with the most of them labelled moving.
+std::string outside_boxes_report(const Args& args, const std::vector<truth::TruthFrame>& frames,
+                                 const eval::SequenceDetections& boxes, const Totals& totals,
+                                 std::vector<std::pair<std::size_t, int>> outside_by_frame) {
+  std::ostringstream md;
+  md << "- known pixels outside every person box labelled moving: "
+     << vo::fmt(100 * share(totals.moving_outside_people, totals.known_outside_people), "%.2f %%") << "\n";
+  std::sort(outside_by_frame.rbegin(), outside_by_frame.rend());
+  std::vector<vo::StripFrame> strip;
+  for (std::size_t k = 0; k < outside_by_frame.size() && k < 4; ++k) {
+    const std::size_t i = static_cast<std::size_t>(outside_by_frame[k].second);
+    const cv::Mat labels = cv::imread(args.out + "/" + frame_file(i), cv::IMREAD_GRAYSCALE);
+    const std::vector<Detection<float>>& b = boxes.per_frame[i];
+    const std::string path = args.out + "/outside_boxes_" + frame_file(i);
+    cv::imwrite(path, overlay(frames[i].gray, labels, b, moving_outside_people(labels, b)));
+    strip.push_back({path, "frame " + std::to_string(i) + ": " + std::to_string(outside_by_frame[k].first) +
+                               " moving px outside person boxes (yellow)"});
+  }
+  if (vo::write_frame_strip(args.out + "/outside_boxes_strip.png", strip, 360, 2, 16))
+    md << "\n![moving pixels outside person boxes](outside_boxes_strip.png)\n";
+  return md.str();
+}
+
+int label_dataset(const Args& args) {
+  vo::DatasetSource source;
+  std::vector<truth::TruthFrame> frames;
+  std::string error;
+  if (!load_frames(args, &source, &frames, &error))
+    return std::fprintf(stderr, "dyncull_motion_truth: %s\n", error.c_str()), 1;
   // Boxes only to report where the moving pixels fall, never to decide.
-  eval::SequenceDetections boxes;
   const std::string det_dir = args.dataset + "/detections";
-  const bool has_boxes = std::filesystem::exists(det_dir) &&
-                         (boxes = eval::read_sequence_detections(det_dir, source.index(), source.camera().width,
-                                                                 source.camera().height))
-                             .ok();
+  const bool has_dir = std::filesystem::exists(det_dir);
+  const eval::SequenceDetections boxes =
+      has_dir ? eval::read_sequence_detections(det_dir, source.index(), source.camera().width, source.camera().height)
+              : eval::SequenceDetections{};
+  const bool has_boxes = has_dir && boxes.ok();
   std::filesystem::create_directories(args.out);
   std::ofstream index(args.out + "/index.txt");
   index << "# motion truth: stamp file (0 static, 255 moving, 128 unknown)\n";
@@ -219,51 +257,34 @@ int label_dataset(const Args& args) {
   Totals totals;
   std::vector<std::pair<std::size_t, int>> outside_by_frame;  // moving pixels outside person boxes, frame
   const auto t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < n; ++i) {
-    const truth::FrameTruth f = labeller.label(frames, i, source.camera());
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const truth::FrameTruth f = labeller.label(frames, static_cast<int>(i), source.camera());
     totals.add(f);
-    const std::string file = frame_file(static_cast<std::size_t>(i));
-    cv::imwrite(args.out + "/" + file, f.labels);
+    cv::imwrite(args.out + "/" + frame_file(i), f.labels);
     char stamp[32];
-    std::snprintf(stamp, sizeof stamp, "%.6f", source.index().frames[static_cast<std::size_t>(i)].timestamp);
-    index << stamp << " " << file << "\n";
-    if (has_boxes) {
-      const std::vector<Detection<float>>& b = boxes.per_frame[static_cast<std::size_t>(i)];
-      const cv::Mat outside = moving_outside_people(f.labels, b);
-      const cv::Mat known_outside = (f.labels != truth::kUnknown) & ~in_person_boxes(f.labels.size(), b);
-      totals.known_outside_people += static_cast<std::size_t>(cv::countNonZero(known_outside));
-      const std::size_t m = static_cast<std::size_t>(cv::countNonZero(outside));
-      totals.moving_outside_people += m;
-      outside_by_frame.emplace_back(m, i);
-    }
+    std::snprintf(stamp, sizeof stamp, "%.6f", source.index().frames[i].timestamp);
+    index << stamp << " " << frame_file(i) << "\n";
+    if (!has_boxes) continue;
+    const std::vector<Detection<float>>& b = boxes.per_frame[i];
+    const cv::Mat known_outside = (f.labels != truth::kUnknown) & ~in_person_boxes(f.labels.size(), b);
+    const std::size_t m = static_cast<std::size_t>(cv::countNonZero(moving_outside_people(f.labels, b)));
+    totals.known_outside_people += static_cast<std::size_t>(cv::countNonZero(known_outside));
+    totals.moving_outside_people += m;
+    outside_by_frame.emplace_back(m, static_cast<int>(i));
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream md;
   auto med = [](std::vector<double> v) { return truth::detail::median(std::move(v)); };
-  md << "Motion truth of `" << args.dataset << "`: " << n << " frames in " << vo::fmt(seconds, "%.0f") << " s.\n\n"
+  md << "Motion truth of `" << args.dataset << "`: " << frames.size() << " frames in " << vo::fmt(seconds, "%.0f")
+     << " s.\n\n"
      << "- pixels with depth labelled known: " << vo::fmt(100 * share(totals.known, totals.with_depth), "%.1f %%") << "\n"
      << "- known pixels labelled moving: " << vo::fmt(100 * share(totals.moving, totals.known), "%.1f %%") << "\n"
      << "- ground-truth pose refined on " << totals.pairs_fitted << " of " << totals.pairs
      << " neighbour pairs; median refinement " << vo::fmt(med(totals.correction_mm), "%.1f") << " mm and "
      << vo::fmt(med(totals.correction_deg), "%.3f") << " deg; median static residual after it "
      << vo::fmt(med(totals.static_px), "%.2f") << " px\n";
-  if (has_boxes) {
-    md << "- known pixels outside every person box labelled moving: "
-       << vo::fmt(100 * share(totals.moving_outside_people, totals.known_outside_people), "%.2f %%") << "\n";
-    std::sort(outside_by_frame.rbegin(), outside_by_frame.rend());
-    std::vector<vo::StripFrame> strip;
-    for (std::size_t k = 0; k < outside_by_frame.size() && k < 4; ++k) {
-      const int i = outside_by_frame[k].second;
-      const cv::Mat labels = cv::imread(args.out + "/" + frame_file(static_cast<std::size_t>(i)), cv::IMREAD_GRAYSCALE);
-      const std::vector<Detection<float>>& b = boxes.per_frame[static_cast<std::size_t>(i)];
-      const std::string path = args.out + "/outside_boxes_" + frame_file(static_cast<std::size_t>(i));
-      cv::imwrite(path, overlay(frames[static_cast<std::size_t>(i)].gray, labels, b, moving_outside_people(labels, b)));
-      strip.push_back({path, "frame " + std::to_string(i) + ": " + std::to_string(outside_by_frame[k].first) +
-                                 " moving px outside person boxes (yellow)"});
-    }
-    if (vo::write_frame_strip(args.out + "/outside_boxes_strip.png", strip, 360, 2, 16))
-      md << "\n![moving pixels outside person boxes](outside_boxes_strip.png)\n";
-  }
+  if (has_boxes) md << outside_boxes_report(args, frames, boxes, totals, outside_by_frame);
+  else if (has_dir) md << "- detections not read (" << boxes.reason << "): no report on the person boxes\n";
   std::ofstream(args.out + "/summary.md") << md.str();
   std::printf("%s", md.str().c_str());
   return 0;
