@@ -26,5 +26,5 @@ for arg in "$@"; do
   previous=$arg
 done
 if [[ -f "$out/family_summary.csv" ]] || compgen -G "$out/*_poses.csv" >/dev/null; then
-  python3 "$root/scripts/figures.py" "$out" "${summary_only[@]}"
+  "$root/scripts/figures.sh" "$out" "${summary_only[@]}"
 fi

@@ -109,13 +109,13 @@ fi
 # given with --suite / --real may predate them).
 mkdir -p "$root/docs/images"
 if [[ -z "$real_only" ]]; then
-  python3 "$root/scripts/figures.py" "$suite" --summary-only
+  "$root/scripts/figures.sh" "$suite" --summary-only
   for f in family_summary.png frame_strip.png; do
     [[ -f "$suite/$f" ]] && cp "$suite/$f" "$root/docs/images/$f"
   done
 fi
 if [[ -n "$real" ]]; then
-  if compgen -G "$real/*_poses.csv" >/dev/null; then python3 "$root/scripts/figures.py" "$real"; fi
+  if compgen -G "$real/*_poses.csv" >/dev/null; then "$root/scripts/figures.sh" "$real"; fi
   for f in trajectories.png ate_over_time.png frame_strip.png; do
     [[ -f "$real/crowd_part1_$f" ]] && cp "$real/crowd_part1_$f" "$root/docs/images/bonn_crowd_part1_$f"
   done
