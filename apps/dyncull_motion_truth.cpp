@@ -265,9 +265,9 @@ int label_dataset(const Args& args) {
     std::snprintf(stamp, sizeof stamp, "%.6f", source.index().frames[i].timestamp);
     index << stamp << " " << frame_file(i) << "\n";
     if (!has_boxes) continue;
-    const std::vector<Detection<float>>& b = boxes.per_frame[i];
-    const cv::Mat known_outside = (f.labels != truth::kUnknown) & ~in_person_boxes(f.labels.size(), b);
-    const std::size_t m = static_cast<std::size_t>(cv::countNonZero(moving_outside_people(f.labels, b)));
+    const cv::Mat outside_people = ~in_person_boxes(f.labels.size(), boxes.per_frame[i]);
+    const cv::Mat known_outside = (f.labels != truth::kUnknown) & outside_people;
+    const std::size_t m = static_cast<std::size_t>(cv::countNonZero((f.labels == truth::kMoving) & outside_people));
     totals.known_outside_people += static_cast<std::size_t>(cv::countNonZero(known_outside));
     totals.moving_outside_people += m;
     outside_by_frame.emplace_back(m, static_cast<int>(i));
