@@ -10,6 +10,12 @@
 #include <exception>
 #include <utility>
 
+#ifdef __linux__
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
 namespace dyncull {
 namespace host {
 
@@ -40,6 +46,14 @@ const DetectedBox* continued_from(const DetectedBox& box, const std::vector<Dete
     }
   }
   return best;
+}
+
+// The calling thread at the lowest scheduling priority (Linux: a thread's own nice value), so that on a
+// machine of few cores the detector takes only the CPU time that tracking and mapping leave.
+void yield_cpu_to_tracking() {
+#ifdef __linux__
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+#endif
 }
 
 }  // namespace
@@ -94,6 +108,7 @@ void LiveDetection::detect_into(const cv::Mat& image, long index, Detected* out)
 }
 
 void LiveDetection::run() {
+  yield_cpu_to_tracking();
   Detected d;
   for (;;) {
     long index = -1;

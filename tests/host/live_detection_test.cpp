@@ -34,6 +34,12 @@
 #include <utility>
 #include <vector>
 
+#ifdef __linux__
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
 namespace dyncull {
 namespace {
 
@@ -49,6 +55,15 @@ cv::Mat numbered_frame(int number) {
   return m;
 }
 
+// The calling thread's own nice value on Linux (per thread there), else -100.
+int thread_nice() {
+#ifdef __linux__
+  return getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)));
+#else
+  return -100;
+#endif
+}
+
 // One person box 100 px wide whose left edge is 10 px per frame number: a walker moving right at 10 px per frame.
 // `hold` keeps detections waiting until release(); `delay_ms` slows each; `fail_from` fails from that
 // frame on (`throw_instead`: throws).
@@ -62,7 +77,8 @@ class StandIn : public host::FrameDetector {
     int fail_from = 1 << 30;
     bool throw_instead = false;
     std::vector<int> seen;
-    int entered = 0;  // detections started (before the hold)
+    int entered = 0;         // detections started (before the hold)
+    int detector_nice = -100;  // the detecting thread's nice value (Linux), or -100
     void release() {
       std::lock_guard<std::mutex> lock(mutex);
       hold = false;
@@ -75,6 +91,7 @@ class StandIn : public host::FrameDetector {
     {
       std::unique_lock<std::mutex> lock(c_->mutex);
       ++c_->entered;
+      c_->detector_nice = thread_nice();
       c_->cv.notify_all();
       c_->cv.wait(lock, [this] { return !c_->hold; });
       c_->seen.push_back(number);
@@ -196,6 +213,21 @@ TEST(LiveDetection, ADetectorSlowerThanTheFramesNeverHoldsTracking) {
   EXPECT_LT(live.finished(), 35u);  // frames were skipped: the detector takes the newest, never each one
   EXPECT_GE(oldest, 2);             // boxes older than the previous frame: the detector is behind
 }
+
+#ifdef __linux__
+// On two cores the detector shares the CPU with tracking and mapping: its thread runs at the lowest
+// priority so that tracking's time per frame does not grow with it; the tracking thread keeps its own.
+TEST(LiveDetection, TheDetectorThreadYieldsTheCpuToTracking) {
+  StandIn::Control c;
+  const int tracking_nice = thread_nice();
+  LiveDetection live(stand_in(&c), LiveDetectionOptions());
+  live.frame(0, numbered_frame(0));
+  wait_finished(live, 1);
+  std::lock_guard<std::mutex> lock(c.mutex);
+  EXPECT_EQ(c.detector_nice, 19);
+  EXPECT_EQ(thread_nice(), tracking_nice);
+}
+#endif
 
 TEST(LiveDetection, SynchronousGivesEachFramesOwnBoxes) {
   StandIn::Control c;

@@ -1,6 +1,7 @@
 /// @file live_detection.hpp
-/// A detector beside the tracking thread: frames are handed to a detector on its own thread and the
-/// tracker, never waiting, gets the newest finished boxes carried to its frame (shifted by each box's
+/// A detector beside the tracking thread: frames are handed to a detector on its own thread (at the
+/// lowest priority on Linux, so that it takes the CPU tracking leaves) and the tracker, never waiting,
+/// gets the newest finished boxes carried to its frame (shifted by each box's
 /// velocity between the last two detections, grown with their age), with that age in frames; or, in the
 /// synchronous form, each frame's own boxes. C++11 header (standard library and opencv2/core.hpp);
 /// compiled into dyncull::host. (Not culling/box_tracker.hpp's tracker: it takes an update's boxes as the
