@@ -8,8 +8,9 @@
 #       [--detector CFG,WEIGHTS|MODEL.onnx]
 #       copies ORB-SLAM2, applies the patches, builds (Pangolin headless too unless --pangolin-prefix), trains
 #       a vocabulary when ORBvoc.txt is absent, runs rgbd_tum (viewer off) once per variant and run in its own
-#       folder, evaluates the ATE with dyncull_eval and writes OUT/orbslam2_summary.csv; with --page, writes
-#       the page's "In ORB-SLAM2" section (default page: none).
+#       folder at the recorded rate, and once more per variant not held to it (DYNCULL_FREE_RUN=1, runs/VARIANT/free:
+#       the frames per second the whole system sustains), evaluates the ATE with dyncull_eval and writes
+#       OUT/orbslam2_summary.csv; with --page, writes the page's "In ORB-SLAM2" section (default page: none).
 #   scripts/orbslam2.sh --families LIST|all --out DIR [--motions xyz,halfsphere] [--frames 300] [--runs N]
 #       the same on dyncull's scene families: each family and motion written once as a TUM-format sequence
 #       (write_tum_sequence --family, seed 1, the simulated detector's boxes in detections_json/), run, and
@@ -107,45 +108,28 @@ build_orbslam2
 find_vocabulary "$work/ORB_SLAM2" "$thirdparty/ORB_SLAM2/Vocabulary/ORBvoc.txt"
 [[ "$mode" == build ]] && { log "built $rgbd_tum"; exit 0; }
 
-# --- one sequence: settings, associations, runs, evaluation ---------------------------------------------
-run_sequence() {
-  local seq=$1 dest=$2 variant run dir detections associations settings=()
-  mkdir -p "$dest"
-  python3 "$root/scripts/orbslam2_sequence.py" prepare "$seq" "$dest" --dyncull-eval "$dyncull_prefix/bin/dyncull_eval"
-  detections=$(detections_of "$seq")
-  for variant in "${variant_list[@]}"; do
-    associations="$dest/associations.txt"
-    if [[ "$variant" == culler_live* && -f "$dest/associations_color.txt" ]]; then
-      associations="$dest/associations_color.txt"
-    fi
-    mapfile -t settings < <(variant_environment "$variant" "$detections")
-    for ((run = 1; run <= runs; run++)); do
-      dir="$dest/runs/$variant/run$run"
-      rm -rf "$dir"
-      mkdir -p "$dir"
-      log "$(basename "$seq"): $variant run $run of $runs ($(basename "$associations"))"
-      (cd "$dir" && env "${settings[@]}" DYNCULL_LOG="$dir/culler_frames.csv" \
-        "$rgbd_tum" "$vocabulary" "$dest/orbslam2_settings.yaml" "$seq" "$associations" \
-        >"$dir/rgbd_tum.log" 2>&1) || log "$variant run $run: rgbd_tum exited with status $? (see $dir/rgbd_tum.log)"
-      "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" --json \
-        --poses-csv "$dir/poses.csv" \
-        >"$dir/ate.json" 2>"$dir/ate.err" || true
-    done
-  done
+# --- runs (run_sequence in orbslam_common.sh): rgbd_tum on the associations -----------------------------
+example=$rgbd_tum example_log=rgbd_tum.log uses_associations=1
+summarise_sequence() { sequence_tool summarise "$1" "$2"; }
+
+# A path as the page shows it: under $DYNCULL_DATA_DIR when it is there, not this machine's folders.
+data_relative() {
+  local data
+  data=$(cd "${DYNCULL_DATA_DIR:-$root/../shared/data}" 2>/dev/null && pwd) || { echo "$1"; return; }
+  echo "${1//$data/\$DYNCULL_DATA_DIR}"
 }
-summarise_sequence() { python3 "$root/scripts/orbslam2_sequence.py" summarise "$1" "$2"; }
 
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 if [[ -n "$sequence" ]]; then
-  run_sequence "$sequence" "$out"
-  python3 "$root/scripts/orbslam2_sequence.py" summarise "$sequence" "$out" --vocabulary "$vocabulary" \
-    --command "scripts/orbslam2.sh --sequence \$DYNCULL_DATA_DIR/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --out DIR --runs $runs" \
+  run_sequence "$sequence" "$out" free
+  sequence_tool summarise "$sequence" "$out" --vocabulary "$vocabulary" \
+    --command "scripts/orbslam2.sh --sequence \$DYNCULL_DATA_DIR/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --out DIR --runs $runs --variants $variants${detector:+ --detector $(data_relative "$detector")}" \
     ${page:+--page "$page"}
 fi
 if [[ -n "$families" ]]; then
   run_families
-  python3 "$root/scripts/orbslam2_sequence.py" families "$out" \
+  sequence_tool families "$out" \
     --command "scripts/orbslam2.sh --families $families --motions $motions --frames $frames --out DIR --runs $runs" \
     ${page:+--page "$page"}
 fi

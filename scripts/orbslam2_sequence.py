@@ -24,7 +24,8 @@ needs matplotlib).
   and orbslam3_families.csv: the same columns and `sensor`; a monocular run is read from mono_tum.log,
   its frames are rgb.txt's (mono_tum reads the colour list itself) and its ATE is after Sim(3) alignment
   (the script evaluates it with --scale). ORB-SLAM3's maps (Atlas) beyond the first are counted in the
-  run's note. No page section is written for ORB-SLAM3 yet.
+  run's note. The page's sections are written by orbslam_page.py ("In ORB-SLAM3, RGB-D", "In ORB-SLAM3,
+  monocular", "Scene families in ORB-SLAM3" for ORB-SLAM3).
 
 Lost frames: ORB-SLAM2 leaves a frame out of CameraTrajectory.txt when it was lost (and every frame before
 its map exists), without a message; they are counted as association lines minus trajectory lines.
@@ -32,12 +33,13 @@ its map exists), without a message; they are counted as association lines minus 
 import argparse
 import json
 import os
-import platform
 import re
 import statistics
 import struct
 import subprocess
 import sys
+
+import orbslam_page
 
 # culler: boxes from the detections folder; culler_live: a detector running beside the tracker (newest
 # finished boxes); culler_live_sync: the detector waited for on every frame.
@@ -230,6 +232,12 @@ def read_run(directory, frames, log_name="rgbd_tum.log"):
     m = re.search(r"mean tracking time: ([0-9.eE+-]+)", text)
     if m:
         row["track_ms"] = "%.2f" % (1000 * float(m.group(1)))
+    m = re.search(r"95th percentile tracking time: ([0-9.eE+-]+)", text)
+    if m:
+        row["track_ms_p95"] = "%.2f" % (1000 * float(m.group(1)))
+    m = re.search(r"frames per second: ([0-9.eE+-]+) \(free run\)", text)
+    if m:
+        row["fps"] = "%.1f" % float(m.group(1))
     row["fewest_kept"] = fewest_kept(os.path.join(directory, "culler_frames.csv"))
     m = re.search(r"features ([0-9.]+) -> ([0-9.]+) per frame", text)
     if m:
@@ -271,8 +279,8 @@ def fewest_kept(path):
     return min(kept) if kept else ""
 
 
-# fps and track_ms_p95 stay empty until the example reports its per-frame times; detector_ms and
-# box_age_frames come from the host's summary line (live variants only).
+# track_ms_p95 and fps come from the patched example's last lines (fps only from the run not held to the
+# recorded rate, run "free"); detector_ms and box_age_frames from the host's summary line (live variants).
 COLUMNS = ["variant", "run", "ate_rmse_m", "ate_pairs", "lost_frames", "frames", "track_ms", "track_median_ms",
            "track_ms_p95", "fps", "cull_ms", "detector_ms", "box_age_frames", "features", "features_kept",
            "fewest_kept", "note"]
@@ -298,9 +306,10 @@ def summarise(sequence, out, vocabulary, command, page, host="orbslam2", sensor=
         if not os.path.isdir(vdir):
             continue
         runs = sorted((int(d[3:]) for d in os.listdir(vdir) if re.fullmatch(r"run[0-9]+", d)))
-        for r in runs:
-            row = read_run(os.path.join(vdir, "run%d" % r), frames, log_name)
-            row.update(variant=variant, run=r, frames=frames, sensor=sensor)
+        names = ["run%d" % r for r in runs] + (["free"] if os.path.isdir(os.path.join(vdir, "free")) else [])
+        for name in names:
+            row = read_run(os.path.join(vdir, name), frames, log_name)
+            row.update(variant=variant, run=name[3:] if name != "free" else name, frames=frames, sensor=sensor)
             rows.append(row)
     with open(os.path.join(out, "%s_summary.csv" % host), "w") as f:
         f.write(",".join(columns) + "\n")
@@ -310,145 +319,51 @@ def summarise(sequence, out, vocabulary, command, page, host="orbslam2", sensor=
     if mono:
         table = table.replace("ATE RMSE, cm", "ATE RMSE after Sim(3) alignment, cm")
     print(table)
-    if page and host == "orbslam2":
-        write_page(page, table, rows, sequence, out, vocabulary, command)
+    if page:
+        orbslam_page.write_sequence_section(page, host, sensor, table, rows, sequence, out, vocabulary, command,
+                                            numbers, VARIANTS)
 
 
 def numbers(rows, variant, column):
-    return [float(r[column]) for r in rows if r["variant"] == variant and r[column] != ""]
+    """A column's values over a variant's runs at the recorded rate (the free run is apart)."""
+    return [float(r[column]) for r in rows if r["variant"] == variant and r[column] != "" and r.get("run") != "free"]
 
 
-def summary_table(rows):
-    lines = ["| Variant | Runs | ATE RMSE, cm: median (range) | Lost frames: median (range) | Tracking ms per frame, mean: median (range) | Culling ms per frame | Features kept per frame, mean |",
-             "|---|---|---|---|---|---|---|"]
+def summary_table(all_rows):
+    """Medians over the runs at the recorded rate; the last column is the run not held to it."""
+    rows = [r for r in all_rows if r["run"] != "free"]
+    lines = ["| Variant | Runs | ATE RMSE, cm: median (range) | Lost frames: median (range) | Tracking ms per frame, "
+             "mean: median (range) | Tracking ms, 95th percentile: median | Culling ms per frame | Detector ms per "
+             "detection | Box age, frames | Features kept per frame, mean | Free run: frames per second (ATE, cm) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for variant in VARIANTS:
         mine = [r for r in rows if r["variant"] == variant]
         if not mine:
             continue
         failed = sum(1 for r in mine if r["ate_rmse_m"] == "")
         runs = "%d" % len(mine) + (" (%d without an ATE)" % failed if failed else "")
-        cull = numbers(rows, variant, "cull_ms")
-        kept = numbers(rows, variant, "features_kept")
-        lines.append("| %s | %s | %s | %s | %s | %s | %s |" % (
+        lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             variant, runs, median_range(numbers(rows, variant, "ate_rmse_m"), 100.0),
             median_range(numbers(rows, variant, "lost_frames"), 1.0, 0),
             median_range(numbers(rows, variant, "track_ms"), 1.0, 1),
-            "%.2f" % statistics.median(cull) if cull and variant != "stock" else "-",
-            "%.0f" % statistics.median(kept) if kept else "n/a"))
+            median_cell(numbers(rows, variant, "track_ms_p95"), "%.1f"),
+            median_cell(numbers(rows, variant, "cull_ms"), "%.2f") if variant != "stock" else "-",
+            median_cell(numbers(rows, variant, "detector_ms"), "%.1f", "-"),
+            median_cell(numbers(rows, variant, "box_age_frames"), "%.2f", "-"),
+            median_cell(numbers(rows, variant, "features_kept"), "%.0f"),
+            free_cell([r for r in all_rows if r["variant"] == variant and r["run"] == "free"])))
     return "\n".join(lines)
 
 
-def ratio_line(rows):
-    stock = numbers(rows, "stock", "ate_rmse_m")
-    out = []
-    for variant in ("box_only", "culler"):
-        v = numbers(rows, variant, "ate_rmse_m")
-        if stock and v:
-            out.append("%s / stock median ATE: %.2f" % (variant, statistics.median(v) / statistics.median(stock)))
-    for variant in ("box_only", "culler"):
-        fewest = numbers(rows, variant, "fewest_kept")
-        if fewest:
-            out.append("%s keeps %d features in its leanest frame (fewest over its runs)" % (variant, min(fewest)))
-    ts, tc = numbers(rows, "stock", "track_ms"), numbers(rows, "culler", "track_ms")
-    if ts and tc:
-        out.append("culler / stock median tracking time: %.2f" % (statistics.median(tc) / statistics.median(ts)))
-    return "; ".join(out)
+def median_cell(values, fmt, empty="n/a"):
+    return fmt % statistics.median(values) if values else empty
 
 
-def timing_note(rows):
-    """How far tracking times spread within one variant, and the culler's own share of stock's time."""
-    spreads = []
-    for variant in VARIANTS:
-        t = numbers(rows, variant, "track_ms")
-        if len(t) > 1:
-            spreads.append((max(t) - min(t)) / statistics.median(t))
-    ts, cull = numbers(rows, "stock", "track_ms"), numbers(rows, "culler", "cull_ms")
-    parts = []
-    if spreads:
-        parts.append("Tracking times of one variant spread over up to %.0f %% of their median between runs here: "
-                     "the runs replay at the recorded rate beside whatever else runs on the machine, so the "
-                     "difference between the variants' tracking times is within that noise" % (100 * max(spreads)))
-    if ts and cull:
-        parts.append("the culler's own time, %.2f ms per frame (median of its runs), is %.1f %% of stock's median "
-                     "tracking time" % (statistics.median(cull), 100 * statistics.median(cull) / statistics.median(ts)))
-    return ("; ".join(parts) + ".") if parts else ""
-
-
-def median_runs(out, rows):
-    """Per variant, the run with the median ATE that has dyncull_eval's poses.csv (its pairs, aligned as the
-    ATE aligns them): [(variant, run, ate_m, poses path)]."""
-    chosen = []
-    for variant in VARIANTS:
-        mine = sorted((float(r["ate_rmse_m"]), int(r["run"])) for r in rows if r["variant"] == variant and r["ate_rmse_m"])
-        if not mine:
-            continue
-        ate, run = mine[(len(mine) - 1) // 2]
-        poses = os.path.join(out, "runs", variant, "run%d" % run, "poses.csv")
-        if os.path.exists(poses):
-            chosen.append((variant, run, ate, poses))
-    return chosen
-
-
-def plot_trajectories(name, out, rows, path):
-    """scripts/figures.py's trajectory panels (matplotlib) of each variant's median run. Returns the runs drawn."""
-    chosen = median_runs(out, rows)
-    if chosen:
-        import figures  # matplotlib: only when there is something to draw
-        runs = {}
-        for variant, run, _, poses in chosen:
-            runs.update(figures.read_poses(poses, "%s (run %d)" % (variant, run)))
-        figures.plot_trajectories(runs, "ORB-SLAM2 on %s" % name, path)
-    return chosen
-
-
-def machine():
-    cpu = ""
-    try:
-        cpu = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        cpu = re.search(r"Model name:\s*(.*)", cpu).group(1)
-    except (OSError, AttributeError):
-        cpu = platform.processor()
-    return "%s, %d cores" % (cpu, os.cpu_count() or 0)
-
-
-def write_page(page, table, rows, sequence, out, vocabulary, command):
-    name = os.path.basename(sequence.rstrip("/"))
-    voc = os.path.basename(vocabulary) if vocabulary else "?"
-    trained = "synthetic" in voc
-    image = "images/orbslam2_%s_trajectories.svg" % name
-    os.makedirs(os.path.join(os.path.dirname(os.path.abspath(page)), "images"), exist_ok=True)
-    drawn = plot_trajectories(name, out, rows, os.path.join(os.path.dirname(os.path.abspath(page)), image))
-    section = "\n".join([
-        "## In ORB-SLAM2",
-        "",
-        "ORB-SLAM2 (raulmur/ORB_SLAM2 at f2e6f51, RGB-D, `rgbd_tum` with the viewer off) with the culler patch of",
-        "[integration.md](integration.md#orb-slam2-the-patch), on `%s`. One build; the variant is chosen at run" % name,
-        "time (`DYNCULL_MODE`): **stock** culls nothing (the culler is not called), **box_only** removes every",
-        "feature inside a person box (the YOLO forks' way), **culler** is the recommended preset. Detections are",
-        "the sequence's own `detections/` (matched by timestamp). ORB-SLAM2 is multi-threaded and not",
-        "deterministic, so every variant ran several times; ATE is against the sequence's camera ground truth",
-        "(`dyncull_eval`, SE(3) alignment, the pairs ORB-SLAM2 wrote). A lost frame is a frame missing from",
-        "ORB-SLAM2's trajectory (it leaves lost frames out without a message), counted against the %d" % rows[0]["frames"] if rows else "",
-        "associated frames. Tracking time is what `rgbd_tum` prints per run (mean over frames, culling included);",
-        "culling time is the glue's own mean per frame.",
-        "",
-        table,
-        "",
-        (ratio_line(rows) + ".") if ratio_line(rows) else "",
-        "",
-        timing_note(rows),
-        "",
-        ("![Ground truth and ORB-SLAM2's aligned trajectories (the median-ATE run of each variant), top view](%s)" % image) if drawn else "",
-        "",
-        "Vocabulary: `%s`%s." % (voc, ", trained by the script with ORB-SLAM2's bundled DBoW2 (k = 10, L = 5) on "
-                                       "synthetic frames of dyncull's scene (480 frames, four camera motions), "
-                                       "because the published ORBvoc.txt is not available here; no evaluated frame "
-                                       "was used to train it" if trained else ""),
-        "",
-        "Machine: %s. Command: `%s` (per-run logs, trajectories and `orbslam2_summary.csv` in its output folder)." % (machine(), command),
-        "",
-    ])
-    replace_section(page, "## In ORB-SLAM2", section)
+def free_cell(free):
+    if not free or not free[0]["fps"]:
+        return "n/a"
+    ate = free[0]["ate_rmse_m"]
+    return "%s (%s)" % (free[0]["fps"], "%.2f" % (100 * float(ate)) if ate else "no ATE")
 
 
 def read_summary(path):
@@ -502,47 +417,15 @@ def families(out, command, page, host="orbslam2"):
             no_more_lost += 1
         cell = lambda v: ranges.get(v, "n/a")
         table.append("| %s | %d | %s | %s | %s | %s | %s |" % (name, runs, cell("stock"), cell("box_only"), cell("culler"),
-                                                                ratio or "n/a", "; ".join(lost[v] for v in VARIANTS)))
+                                                                ratio or "n/a", "; ".join(lost[v] for v in VARIANTS[:3])))
     with open(os.path.join(out, "%s_families.csv" % host), "w") as f:
         f.write("\n".join(csv) + "\n")
     text = "\n".join(table)
     print(text)
-    if not page or host != "orbslam2":
-        return
-    within = sum(1 for r in ratios if r <= 0.5)
-    section = "\n".join([
-        "## Scene families in ORB-SLAM2",
-        "",
-        "The same ORB-SLAM2 build and variants as above, on every scene family with the xyz and halfsphere",
-        "camera motions, written as TUM-format sequences by `write_tum_sequence --family NAME` (seed 1) with the",
-        "simulated detector's boxes (`detections_json/`). ATE and lost frames: median (range) over the runs; lost",
-        "frames as above.",
-        "The vocabulary was trained on frames of the same synthetic room (another seed, the walking family), so",
-        "it fits these scenes better than it fits the real sequence.",
-        "",
-        text,
-        "",
-        "Culler at most 0.5x stock's median ATE on %d of %d sequences; culler below box-only on %d of %d; culler "
-        "losing no more frames than stock (medians) on %d of %d. Where a variant lost frames, its ATE covers only "
-        "the frames it tracked: read the two columns together." % (
-            within, len(ratios), wins, len(names), no_more_lost, len(names)),
-        "",
-        "Command: `%s`." % command,
-        "",
-    ])
-    replace_section(page, "## Scene families in ORB-SLAM2", section)
-
-
-def replace_section(page, heading, section):
-    text = open(page).read() if os.path.exists(page) else "# Results\n"
-    m = re.search(r"^" + re.escape(heading) + r"\n.*?(?=^## |\Z)", text, flags=re.S | re.M)
-    if m:
-        text = text[:m.start()] + section + "\n" + text[m.end():]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section
-    with open(page, "w") as f:
-        f.write(text.rstrip("\n") + "\n")
-    print("orbslam2_sequence.py: wrote the %s section of %s" % (heading[3:], page), file=sys.stderr)
+    if page:
+        within = sum(1 for r in ratios if r <= 0.5)
+        orbslam_page.write_families_section(page, host, text, (within, len(ratios), wins, len(names), no_more_lost),
+                                            command)
 
 
 def main():

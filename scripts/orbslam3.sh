@@ -13,7 +13,9 @@
 #       `sensor`).
 #   scripts/orbslam3.sh --families LIST|all --out DIR [--motions xyz,halfsphere] [--frames 300] [--runs N]
 #       the same on dyncull's scene families (write_tum_sequence --family, seed 1): one orbslam3_summary.csv
-#       per family and motion under OUT/families/, and OUT/orbslam3_families.csv (no page section yet)
+#       per family and motion under OUT/families/, and OUT/orbslam3_families.csv
+#   With --page FILE, each writes its section of the page ("In ORB-SLAM3, RGB-D", "In ORB-SLAM3, monocular",
+#   "Scene families in ORB-SLAM3"; default page: none).
 #   scripts/orbslam3.sh --build-only       builds everything, runs nothing
 #   scripts/orbslam3.sh --compile-check    applies the patches to a copy of ORB-SLAM3 and compiles what the
 #       culler patch changes with ORB-SLAM3's flags against dyncull's install: src/Atlas.cc whole, and the
@@ -204,57 +206,34 @@ build_orbslam3
 find_vocabulary "$(vocabulary_tree)" "$thirdparty/ORB_SLAM3/Vocabulary/ORBvoc.txt"
 [[ "$mode" == build ]] && { log "built $rgbd_tum and $mono_tum"; exit 0; }
 
-# --- one sequence: settings, associations, runs, evaluation ---------------------------------------------
-run_sequence() {
-  local seq=$1 dest=$2 variant run dir detections associations settings=() example eval_options=()
-  mkdir -p "$dest"
-  python3 "$root/scripts/orbslam2_sequence.py" prepare "$seq" "$dest" --host orbslam3 \
-    --dyncull-eval "$dyncull_prefix/bin/dyncull_eval"
-  detections=$(detections_of "$seq")
-  example=$rgbd_tum
-  if [[ "$sensor" == mono ]]; then example=$mono_tum; eval_options=(--scale); fi
-  for variant in "${variant_list[@]}"; do
-    associations="$dest/associations.txt"
-    if [[ "$variant" == culler_live* && -f "$dest/associations_color.txt" ]]; then
-      associations="$dest/associations_color.txt"
-    fi
-    mapfile -t settings < <(variant_environment "$variant" "$detections")
-    for ((run = 1; run <= runs; run++)); do
-      dir="$dest/runs/$variant/run$run"
-      rm -rf "$dir"
-      mkdir -p "$dir"
-      log "$(basename "$seq"): $sensor, $variant run $run of $runs"
-      if [[ "$sensor" == rgbd ]]; then
-        (cd "$dir" && env "${settings[@]}" DYNCULL_LOG="$dir/culler_frames.csv" \
-          "$example" "$vocabulary" "$dest/orbslam3_settings.yaml" "$seq" "$associations" \
-          >"$dir/rgbd_tum.log" 2>&1) || log "$variant run $run: rgbd_tum exited with status $? (see $dir/rgbd_tum.log)"
-      else
-        (cd "$dir" && env "${settings[@]}" DYNCULL_LOG="$dir/culler_frames.csv" \
-          "$example" "$vocabulary" "$dest/orbslam3_settings.yaml" "$seq" \
-          >"$dir/mono_tum.log" 2>&1) || log "$variant run $run: mono_tum exited with status $? (see $dir/mono_tum.log)"
-        # mono_tum's every tracked frame of the largest map (EuRoC: nanoseconds) as a TUM trajectory.
-        [[ ! -f "$dir/CameraTrajectory_EuRoC.txt" ]] ||
-          awk '!/^#/ && NF == 8 { printf "%.6f %s %s %s %s %s %s %s\n", $1 / 1e9, $2, $3, $4, $5, $6, $7, $8 }' \
-            "$dir/CameraTrajectory_EuRoC.txt" >"$dir/CameraTrajectory.txt"
-      fi
-      "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" "${eval_options[@]}" --json \
-        --poses-csv "$dir/poses.csv" \
-        >"$dir/ate.json" 2>"$dir/ate.err" || true
-    done
-  done
-}
+# --- runs (run_sequence in orbslam_common.sh): the example of the sensor -----------------------------------
+if [[ "$sensor" == rgbd ]]; then
+  example=$rgbd_tum example_log=rgbd_tum.log uses_associations=1
+else
+  example=$mono_tum example_log=mono_tum.log eval_options=(--scale)
+  # mono_tum writes every tracked frame of the largest map (EuRoC: nanoseconds); the ATE reads TUM.
+  after_run() {
+    [[ ! -f "$1/CameraTrajectory_EuRoC.txt" ]] ||
+      awk '!/^#/ && NF == 8 { printf "%.6f %s %s %s %s %s %s %s\n", $1 / 1e9, $2, $3, $4, $5, $6, $7, $8 }' \
+        "$1/CameraTrajectory_EuRoC.txt" >"$1/CameraTrajectory.txt"
+  }
+fi
 summarise_sequence() {
-  python3 "$root/scripts/orbslam2_sequence.py" summarise "$1" "$2" --host orbslam3 --sensor "$sensor" "${@:3}"
+  sequence_tool summarise "$1" "$2" --host orbslam3 --sensor "$sensor" "${@:3}"
 }
 
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 if [[ -n "$sequence" ]]; then
   run_sequence "$sequence" "$out"
-  summarise_sequence "$sequence" "$out" --vocabulary "$vocabulary"
+  summarise_sequence "$sequence" "$out" --vocabulary "$vocabulary" \
+    --command "scripts/orbslam3.sh --sequence \$DYNCULL_DATA_DIR/$(basename "$(dirname "$sequence")")/$(basename "$sequence") --sensor $sensor --out DIR --runs $runs --variants $variants" \
+    ${page:+--page "$page"}
 fi
 if [[ -n "$families" ]]; then
   [[ "$sensor" == rgbd ]] || log "the scene families run with --sensor $sensor"
   run_families
-  python3 "$root/scripts/orbslam2_sequence.py" families "$out" --host orbslam3
+  sequence_tool families "$out" --host orbslam3 \
+    --command "scripts/orbslam3.sh --families $families --motions $motions --frames $frames --out DIR --runs $runs" \
+    ${page:+--page "$page"}
 fi

@@ -250,6 +250,59 @@ family_sequence() {
   echo "$seq"
 }
 
+# orbslam2_sequence.py with the Python that has matplotlib (for the page's trajectory figure): Debian's,
+# which scripts/install-deps.sh serves, before another python3 first on the PATH (as scripts/figures.sh).
+sequence_tool() {
+  local python
+  for python in /usr/bin/python3 python3; do
+    if "$python" -c 'import matplotlib' 2>/dev/null; then break; fi
+  done
+  "$python" "$root/scripts/orbslam2_sequence.py" "$@"
+}
+
+# --- runs: the host script sets example (the TUM example's path), example_log (its log's name), and for
+# RGB-D runs uses_associations=1; optional: eval_options (dyncull_eval's, e.g. --scale) and after_run DIR
+# (turns the example's trajectory into DIR/CameraTrajectory.txt when it writes another format).
+# run_once VARIANT RUN_NAME [SETTING...]: the example once in DEST/runs/VARIANT/RUN_NAME (run_sequence's
+# seq, dest, associations and settings), then its ATE.
+eval_options=()
+run_once() {
+  local variant=$1 name=$2 dir="$dest/runs/$1/$2" lists=()
+  shift 2
+  [[ -z "${uses_associations:-}" ]] || lists=("$associations")
+  rm -rf "$dir"
+  mkdir -p "$dir"
+  log "$(basename "$seq"): $variant $name ($(basename "${lists[0]:-$seq/rgb.txt}"))"
+  (cd "$dir" && env "${settings[@]}" "$@" DYNCULL_LOG="$dir/culler_frames.csv" \
+    "$example" "$vocabulary" "$dest/${host}_settings.yaml" "$seq" "${lists[@]}" >"$dir/$example_log" 2>&1) ||
+    log "$variant $name: $(basename "$example") exited with status $? (see $dir/$example_log)"
+  if declare -F after_run >/dev/null; then after_run "$dir"; fi
+  "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" "${eval_options[@]}" \
+    --json --poses-csv "$dir/poses.csv" >"$dir/ate.json" 2>"$dir/ate.err" || true
+}
+
+# run_sequence SEQ DEST [free]: every variant --runs times at the recorded rate; with "free", once more not
+# held to it (DYNCULL_FREE_RUN=1, in runs/VARIANT/free), for the frames per second the system sustains.
+# The live variants track on the colour frames (associations_color.txt) when the sequence has them.
+run_sequence() {
+  local seq=$1 dest=$2 free=${3:-} variant run detections associations settings=()
+  mkdir -p "$dest"
+  sequence_tool prepare "$seq" "$dest" --host "$host" \
+    --dyncull-eval "$dyncull_prefix/bin/dyncull_eval"
+  detections=$(detections_of "$seq")
+  for variant in "${variant_list[@]}"; do
+    associations="$dest/associations.txt"
+    if [[ "$variant" == culler_live* && -f "$dest/associations_color.txt" ]]; then
+      associations="$dest/associations_color.txt"
+    fi
+    mapfile -t settings < <(variant_environment "$variant" "$detections")
+    for ((run = 1; run <= runs; run++)); do
+      run_once "$variant" "run$run"
+    done
+    [[ -z "$free" ]] || run_once "$variant" free DYNCULL_FREE_RUN=1
+  done
+}
+
 # Every family and motion of --families: run_sequence SEQ DEST for each, then the script's summary.
 run_families() {
   local family motion seq
