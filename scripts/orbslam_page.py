@@ -39,7 +39,7 @@ def write_sequence_section(page, host, sensor, table, rows, sequence, out, vocab
     system, version, link = HOSTS[host]
     mono = sensor == "mono"
     present = [v for v in variants if any(r["variant"] == v for r in rows)]
-    image = "images/%s_%s%s_trajectories.svg" % (host, "mono_" if mono else "", name)
+    image = "images/%s_%s%s_trajectories.png" % (host, "mono_" if mono else "", name)
     os.makedirs(os.path.join(os.path.dirname(os.path.abspath(page)), "images"), exist_ok=True)
     drawn = plot_trajectories("%s on %s" % (system, name), out, rows, variants,
                               os.path.join(os.path.dirname(os.path.abspath(page)), image))
@@ -51,11 +51,11 @@ def write_sequence_section(page, host, sensor, table, rows, sequence, out, vocab
         + "; ".join(VARIANT_TEXT[v] for v in present) + ".",
         images_sentence(present, mono),
         "%s is multi-threaded and not deterministic, so every variant ran several times; ATE is against the "
-        "sequence's camera ground truth (`dyncull_eval`, %s alignment, the pairs %s wrote)."
-        % (system, "Sim(3): scale, rotation and translation, as a monocular map has no metric scale" if mono
-           else "SE(3)", system),
+        "sequence's camera ground truth (`dyncull_eval`, %s, the pairs %s wrote)."
+        % (system, "Sim(3) alignment: scale too, as a monocular map has no metric scale" if mono
+           else "SE(3) alignment", system),
         lost_sentence(host, mono, rows),
-        timing_sentence(example, present),
+        timing_sentence(example, present, any(r["run"] == "free" for r in rows)),
     ])
     figure = ("![Ground truth and %s's aligned trajectories (the median-ATE run of each variant), top view](%s)"
               % (system, image)) if drawn else ""
@@ -93,16 +93,16 @@ def lost_sentence(host, mono, rows):
     return text
 
 
-def timing_sentence(example, present):
+def timing_sentence(example, present, free):
     text = ("Tracking time is what `%s` prints per run (mean and 95th percentile over frames, culling%s "
             "included); culling time is the glue's own mean per frame." % (
                 example, " and a synchronous detector" if "culler_live_sync" in present else ""))
     if any(v.startswith("culler_live") for v in present):
         text += (" Detector time is per detection, on its thread, and box age the frames between a frame and the "
                  "one its boxes were detected on.")
-    text += (" These runs replay at the recorded rate; where the last column has figures, one more run per variant "
-             "(`DYNCULL_FREE_RUN=1`) fed frames as fast as the system took them, for the frames per second it "
-             "sustains end to end (image loading included).")
+    text += " These runs replay at the recorded rate"
+    text += ("; one more run per variant (`DYNCULL_FREE_RUN=1`, the last column) fed frames as fast as the system "
+             "took them, for the frames per second it sustains end to end (image loading included)." if free else ".")
     return text
 
 
