@@ -322,6 +322,7 @@ def summarise(sequence, out, vocabulary, command, page, host="orbslam2", sensor=
     if page:
         orbslam_page.write_sequence_section(page, host, sensor, table, rows, sequence, out, vocabulary, command,
                                             numbers, VARIANTS)
+    return table
 
 
 def numbers(rows, variant, column):

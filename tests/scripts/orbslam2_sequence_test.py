@@ -3,7 +3,8 @@
 associate.py (closest first, each stamp once, none beyond 0.02 s); the settings file written from camera.txt and the image size;
 the trajectory figure takes each variant's median run as dyncull_eval aligned it; a run's lost frames are counted against the
 associations (ORB-SLAM2 leaves them out of its trajectory); the summary has a row per variant and run with
-the required columns, and a run without a trajectory is reported, not dropped."""
+the required columns, and a run without a trajectory is reported, not dropped; the 95th percentile of tracking
+time is read from every run and the frames per second from the free run only, which the medians leave out."""
 import json
 import os
 import shutil
@@ -15,6 +16,7 @@ import zlib
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
 import orbslam2_sequence as seq  # noqa: E402
+import orbslam_page  # noqa: E402
 
 
 def write_png(path, width, height):
@@ -113,6 +115,27 @@ class Sequence(unittest.TestCase):
         row = dict(zip(header, lines[1].split(",")))
         self.assertEqual((row["variant"], row["detector_ms"], row["box_age_frames"]), ("culler_live", "41.5", "1.50"))
 
+    def test_free_run_gives_frames_per_second_apart_from_the_recorded_rate_runs(self):
+        seq.prepare(self.dir, self.dir, DYNCULL_EVAL)
+        for name, mean, p95, fps in (("run1", "0.020", "0.031", "29.9 (recorded rate)"),
+                                     ("free", "0.025", "0.040", "52.25 (free run)")):
+            run = os.path.join(self.dir, "runs", "culler", name)
+            os.makedirs(run)
+            with open(os.path.join(run, "rgbd_tum.log"), "w") as f:
+                f.write("median tracking time: %s\nmean tracking time: %s\n95th percentile tracking time: %s\n"
+                        "frames per second: %s\n" % (mean, mean, p95, fps))
+        table = seq.summarise(self.dir, self.dir, "", "cmd", "")
+        lines = open(os.path.join(self.dir, "orbslam2_summary.csv")).read().splitlines()
+        header = lines[0].split(",")
+        rows = {r["run"]: r for r in (dict(zip(header, line.split(","))) for line in lines[1:])}
+        self.assertEqual((rows["1"]["track_ms_p95"], rows["1"]["fps"]), ("31.00", ""))  # recorded rate: no fps
+        self.assertEqual((rows["free"]["track_ms_p95"], rows["free"]["fps"]), ("40.00", "52.2"))
+        # The medians are the recorded-rate runs'; the free run has its own column.
+        self.assertEqual(seq.numbers(list(rows.values()), "culler", "track_ms"), [20.0])
+        self.assertIn("| culler | 1 (1 without an ATE) | n/a | 2 (2-2) | 20.0 (20.0-20.0) | 31.0 |", table)
+        self.assertTrue(table.splitlines()[0].endswith("| Free run: frames per second (ATE, cm) |"))
+        self.assertTrue(table.splitlines()[2].endswith("| 52.2 (no ATE) |"))
+
 
 class Trajectories(unittest.TestCase):
     """The trajectory figure shows each variant's median-ATE run as dyncull_eval aligned it (its poses.csv)."""
@@ -134,7 +157,7 @@ class Trajectories(unittest.TestCase):
         shutil.rmtree(self.dir)
 
     def test_median_run_of_each_variant(self):
-        chosen = seq.median_runs(self.dir, self.rows)
+        chosen = orbslam_page.median_runs(self.dir, self.rows, seq.VARIANTS)
         self.assertEqual([(v, r, a) for v, r, a, _ in chosen], [("stock", 3, 0.2), ("culler", 1, 0.02)])
         self.assertTrue(chosen[0][3].endswith(os.path.join("runs", "stock", "run3", "poses.csv")))
 
@@ -144,7 +167,7 @@ class Trajectories(unittest.TestCase):
         except ImportError:
             self.skipTest("python3-matplotlib is not installed (scripts/install-deps.sh installs it)")
         path = os.path.join(self.dir, "trajectories.svg")
-        self.assertEqual(len(seq.plot_trajectories("seq", self.dir, self.rows, path)), 2)
+        self.assertEqual(len(orbslam_page.plot_trajectories("seq", self.dir, self.rows, seq.VARIANTS, path)), 2)
         self.assertIn("<svg", open(path).read())
 
 
