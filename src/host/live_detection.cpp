@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -60,7 +61,7 @@ void yield_cpu_to_tracking() {
 
 LiveDetection::LiveDetection(std::unique_ptr<FrameDetector> detector, const LiveDetectionOptions& options)
     : detector_(std::move(detector)), options_(options), stop_(false), has_pending_(false), has_result_(false),
-      pending_index_(-1), finished_(0), failures_(0), newest_failed_(false), failed_index_(-1), failed_ms_(0) {
+      first_offered_(false), pending_index_(-1), finished_(0), failures_(0), newest_failed_(false), failed_index_(-1), failed_ms_(0) {
   if (detector_ && !options_.synchronous) thread_ = std::thread(&LiveDetection::run, this);
 }
 
@@ -121,12 +122,23 @@ void LiveDetection::run() {
       has_pending_ = false;
     }
     detect_into(working_, index, &d);
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::swap(result_, d);
-    has_result_ = true;
-    ++finished_;
-    if (!result_.ok) ++failures_;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::swap(result_, d);
+      has_result_ = true;
+      ++finished_;
+      if (!result_.ok) ++failures_;
+    }
+    result_ready_.notify_all();
   }
+}
+
+// The first frame offered waits for its own boxes (bounded): the host builds its first map from it.
+void LiveDetection::wait_for_first_result(std::unique_lock<std::mutex>* lock) {
+  first_offered_ = true;
+  const double ms = options_.first_frame_wait_ms;
+  const std::chrono::milliseconds limit(ms > 0 ? static_cast<long>(std::min(ms, 60000.0)) : 0);  // NaN: 0
+  result_ready_.wait_for(*lock, limit, [this] { return has_result_; });
 }
 
 void LiveDetection::adopt(const Detected& d) {
@@ -197,16 +209,17 @@ const LiveBoxes& LiveDetection::frame(long index, const cv::Mat& image) noexcept
       }
     } else {
       if (usable) image.copyTo(spare_);  // outside the lock: the detector thread may be reading working_
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (has_result_) {
-        adopt(result_);
-        has_result_ = false;
-      }
+      std::unique_lock<std::mutex> lock(mutex_);
       if (usable) {
         std::swap(pending_frame_, spare_);
         pending_index_ = index;
         has_pending_ = true;
         wake_.notify_one();
+        if (!first_offered_) wait_for_first_result(&lock);
+      }
+      if (has_result_) {
+        adopt(result_);
+        has_result_ = false;
       }
     }
     carry_to(index);

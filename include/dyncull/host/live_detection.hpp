@@ -47,7 +47,11 @@ struct LiveDetectionOptions {
   bool frames_rgb;            ///< frames arrive in RGB order: swapped to BGR for the detector
   double grow_px_per_frame;   ///< a carried box grows by this much on every side per frame of age
   double max_speed_px;        ///< a box velocity above this (pixels per frame) is not trusted: no shift
-  LiveDetectionOptions() : synchronous(false), frames_rgb(false), grow_px_per_frame(4.0), max_speed_px(40.0) {}
+  /// The first frame waits up to this long for its own boxes (0: not at all), once: the host's map starts
+  /// from that frame, and a map started on unculled people keeps their points.
+  double first_frame_wait_ms;
+  LiveDetectionOptions()
+      : synchronous(false), frames_rgb(false), grow_px_per_frame(4.0), max_speed_px(40.0), first_frame_wait_ms(2000) {}
 };
 
 /// The boxes the culler gets at one frame.
@@ -71,8 +75,9 @@ class LiveDetection {
   LiveDetection& operator=(const LiveDetection&) = delete;
 
   /// Offers frame `index` (indices increase) and returns the newest finished boxes carried to it. An
-  /// empty or unreadable frame is not offered (the reason says so). Never throws; never waits in the
-  /// asynchronous form (except for the detector thread's hand-over of a finished result, microseconds).
+  /// empty or unreadable frame is not offered (the reason says so). Never throws. In the asynchronous form
+  /// it waits only once, on the first frame offered, for that frame's boxes (at most first_frame_wait_ms);
+  /// after that only for the detector thread's hand-over of a finished result (microseconds).
   const LiveBoxes& frame(long index, const cv::Mat& image) noexcept;
 
   /// Detections finished so far, and how many failed.
@@ -89,6 +94,7 @@ class LiveDetection {
     Detected() : index(-1), ok(false), ms(0) {}
   };
   void run();
+  void wait_for_first_result(std::unique_lock<std::mutex>* lock);
   void detect_into(const cv::Mat& image, long index, Detected* out);
   void adopt(const Detected& d);
   void carry_to(long index);
@@ -96,8 +102,8 @@ class LiveDetection {
   std::unique_ptr<FrameDetector> detector_;
   LiveDetectionOptions options_;
   mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stop_, has_pending_, has_result_;
+  std::condition_variable wake_, result_ready_;
+  bool stop_, has_pending_, has_result_, first_offered_;
   long pending_index_;
   cv::Mat pending_frame_, working_, spare_, converted_;  // the newest offered frame, the one being detected
   Detected result_;                 // finished by the thread, not yet adopted
