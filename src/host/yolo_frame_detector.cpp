@@ -18,6 +18,22 @@ namespace host {
 #if defined(DYNCULL_HAS_OPENCV_DNN)
 namespace {
 
+// A Darknet cfg's own input size ([net] width and height, what the network was trained at) in place of
+// the adapter's default: Yolo-Fastest's 320 x 320 takes 0.6x the time of 416 x 416, so live boxes are
+// younger when they reach the tracker. Left at the default when the cfg gives none or cannot be read
+// (opening the detector then names the problem).
+void use_trained_input_size(cv_adapter::YoloDetectorOptions* o) {
+  std::string text, why;
+  cv_adapter::DarknetLayout layout;
+  if (o->model.size() < 4 || o->model.compare(o->model.size() - 4, 4, ".cfg") != 0) return;
+  if (!text::read_small_file(o->model, cv_adapter::kMaxYoloCfgBytes, &text, &why)) return;
+  if (!cv_adapter::darknet_layout(text, &layout, &why)) return;
+  if (layout.input_width % 32 != 0 || layout.input_height % 32 != 0) return;
+  if (layout.input_width <= 0 || layout.input_height <= 0) return;
+  o->input_width = layout.input_width;
+  o->input_height = layout.input_height;
+}
+
 class YoloFrameDetector : public FrameDetector {
  public:
   bool open(const cv_adapter::YoloDetectorOptions& options, std::string* reason) {
@@ -84,6 +100,7 @@ std::unique_ptr<FrameDetector> open_yolo_detector(const std::string& spec, std::
     cv_adapter::YoloDetectorOptions o;
     o.model = model;
     o.weights = weights;
+    use_trained_input_size(&o);
     if (!d->open(o, reason)) return nullptr;
     return std::unique_ptr<FrameDetector>(std::move(d));
   } catch (const std::exception& e) {

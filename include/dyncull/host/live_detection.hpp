@@ -36,8 +36,8 @@ class FrameDetector {
   virtual bool detect(const cv::Mat& frame, std::vector<DetectedBox>* boxes, std::string* reason) = 0;
 };
 
-/// The YOLO detector of opencv/yolo_detector.hpp (416 x 416 plain resize, confidence >= 0.25, NMS per
-/// class at IoU 0.45) for `spec` "CFG,WEIGHTS" or "MODEL.onnx", opened and run once on a blank frame. Null
+/// The YOLO detector of opencv/yolo_detector.hpp (plain resize to a Darknet cfg's own input size, which
+/// is Yolo-Fastest's 320 x 320, else 416 x 416; confidence >= 0.25, NMS per class at IoU 0.45) for `spec` "CFG,WEIGHTS" or "MODEL.onnx", opened and run once on a blank frame. Null
 /// with `*reason` naming the file and why when the spec, the files or the network cannot be used, or
 /// when dyncull was built without OpenCV's dnn module.
 std::unique_ptr<FrameDetector> open_yolo_detector(const std::string& spec, std::string* reason);

@@ -32,6 +32,8 @@ struct DarknetLayout {
     int anchors = 0;  ///< entries of mask= (anchors per grid cell)
   };
   std::vector<Head> heads;  ///< [yolo] layers in cfg order (OpenCV's outputs, one per head); may be empty
+  int input_width = 0;      ///< [net] width= and height=: the input the network was trained at (0: not given)
+  int input_height = 0;
 
   /// Bytes of a weights file of this layout: the header (major, minor, revision as int32, then "seen"
   /// as int64 from version 0.2 on, else int32) and the floats.
@@ -121,9 +123,14 @@ inline bool darknet_layout(std::string_view cfg, DarknetLayout* layout, std::str
   if (!detail::cfg_sections(cfg, &sections, why)) return false;
   if (sections.empty() || (sections[0].type != "net" && sections[0].type != "network"))
     return (*why = "cfg: the first section is not [net]", false);
-  long channels = 0;
+  long channels = 0, width = 0, height = 0;
   if (!detail::cfg_int(sections[0], "channels", 3, 1, 4096, &channels))
     return (*why = "cfg [net]: channels must be in [1, 4096]", false);
+  if (!detail::cfg_int(sections[0], "width", 0, 0, 4096, &width) ||
+      !detail::cfg_int(sections[0], "height", 0, 0, 4096, &height))
+    return (*why = "cfg [net]: width and height must be in [0, 4096]", false);
+  layout->input_width = static_cast<int>(width);
+  layout->input_height = static_cast<int>(height);
   constexpr long kMaxFilters = 1 << 16;
   std::vector<long> out;       // output channels per layer
   std::vector<long> filters;   // filters of a convolution, 0 for other layers
