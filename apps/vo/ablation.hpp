@@ -36,6 +36,7 @@ inline std::vector<AblationSwitch> ablation_switches() {
   const bool overlaps = defaults.depth_mask.assign_overlaps_by_depth;
   const double margin = defaults.depth_mask.overlap_high_level_margin_m;
   const bool low_override = defaults.depth_mask.low_override_by_depth;
+  const double head_band = defaults.depth_mask.head_band_fraction;
   const bool mask_votes = defaults.subbox.object_mask_votes_only;
   const bool static_evidence = defaults.subbox.static_needs_evidence;
   const bool verifies_candidates = defaults.subbox.verifies_candidates;
@@ -83,6 +84,8 @@ inline std::vector<AblationSwitch> ablation_switches() {
       [=](P& o) { o.depth_mask.overlap_high_level_margin_m = margin; });
   add("low_override_by_depth", "depth_mask.low_override_by_depth back to its default",
       [=](P& o) { o.depth_mask.low_override_by_depth = low_override; });
+  add("head_band", "depth_mask.head_band_fraction back to its default (no head band)",
+      [=](P& o) { o.depth_mask.head_band_fraction = head_band; });
   add("subbox_mask_votes", "subbox.object_mask_votes_only back to its default",
       [=](P& o) { o.subbox.object_mask_votes_only = mask_votes; });
   add("subbox_static_evidence", "subbox.static_needs_evidence back to its default",

@@ -538,7 +538,7 @@ std::string ablated_fields(const vo::StrategySpec& s) {
     << static_cast<int>(o.depth_mask.missing_depth) << " " << o.depth_mask.eps_m << " "
     << o.moving_consistency.max_epipolar_distance_in_boxes_px << " " << o.reprojection.max_depth_residual_sigmas << " "
     << o.depth_mask.assign_overlaps_by_depth << " " << o.depth_mask.overlap_high_level_margin_m << " "
-    << o.depth_mask.low_override_by_depth << " " << o.subbox.object_mask_votes_only << o.subbox.static_needs_evidence
+    << o.depth_mask.low_override_by_depth << " " << o.depth_mask.head_band_fraction << " " << o.subbox.object_mask_votes_only << o.subbox.static_needs_evidence
     << o.subbox.verifies_candidates << " " << o.subbox.min_evidence_frames << o.subbox.short_baseline_keeps_last_vote;
   return t.str();
 }

@@ -65,7 +65,7 @@ template <class T>
 void perturb(fuzz::Input& in, PipelineOptions<T>* o) {
   const int count = in.range(0, 6);
   for (int c = 0; c < count; ++c) {
-    switch (in.range(0, 33)) {
+    switch (in.range(0, 35)) {
       case 0: o->tracker.enabled = in.flag(); break;
       case 1: o->depth_mask.enabled = in.flag(); break;
       case 2: o->probability.enabled = in.flag(); break;
@@ -99,6 +99,8 @@ void perturb(fuzz::Input& in, PipelineOptions<T>* o) {
       case 30: o->tracker.max_missed_frames = in.range(-5, 100); break;
       case 31: o->static_history.min_frames = in.range(-5, 20); break;
       case 32: o->depth_mask.assign_overlaps_by_depth = in.flag(); break;
+      case 33: o->depth_mask.head_band_fraction = in.value(-1, 2); break;
+      case 34: o->depth_mask.head_band_depth_tolerance_m = in.value(-1, 5); break;
       default: o->depth_mask.low_override_by_depth = in.flag(); break;
     }
   }

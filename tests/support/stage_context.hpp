@@ -187,6 +187,7 @@ Parts parts_of(const detail::PipelineWork<T>& w) {
                       .add(s.in_object)
                       .add(s.object_box_bits)
                       .add(s.masks)
+                      .add(s.head_band_box)
                       .str();
   const auto& pr = w.probability;
   p["probability"] = Bytes().add(pr.ok).add(pr.labels).add(pr.reasons).add(pr.levels).add(pr.prev).str();

@@ -93,12 +93,23 @@ struct DepthMaskStageOptions : DepthMaskOptions {
   /// covering its centre: occluded_centre_search) as the object's: a walker passing in front of a TV is
   /// not on it. Without a depth there the shelter stands.
   bool low_override_by_depth = false;
+  /// Head band: detectors often cut a walker's head off the top of its box. A feature in the band of this
+  /// fraction of the box's height above a high-level box (its columns) belongs to that person when its
+  /// depth lies within head_band_depth_tolerance_m of the box's object depth d_c (the background above a
+  /// box is usually farther); it then follows the top row of the box's sub-box vote. 0 = no band.
+  double head_band_fraction = 0;
+  double head_band_depth_tolerance_m = 0.3;
 
-  /// DepthMaskOptions::validate, then overlap_high_level_margin_m finite and in [0, 1e4] m.
+  /// DepthMaskOptions::validate, then overlap_high_level_margin_m finite and in [0, 1e4] m, the head band's
+  /// fraction in [0, 1] and its tolerance in [0, 1e4] m.
   Status validate(std::string* reason = nullptr) const {
     if (DepthMaskOptions::validate(reason) != Status::Ok) return Status::InvalidInput;
     if (!detail::finite_in(overlap_high_level_margin_m, 0, 1e4))
       return detail::invalid_option(reason, "overlap_high_level_margin_m", "must be finite and in [0, 1e4] m");
+    if (!detail::finite_in(head_band_fraction, 0, 1))
+      return detail::invalid_option(reason, "head_band_fraction", "must be finite and in [0, 1]");
+    if (!detail::finite_in(head_band_depth_tolerance_m, 0, 1e4))
+      return detail::invalid_option(reason, "head_band_depth_tolerance_m", "must be finite and in [0, 1e4] m");
     if (reason) reason->clear();
     return Status::Ok;
   }

@@ -98,8 +98,9 @@ PipelineOptions<T> zhang_2023() {
 }
 
 /// Recommended: the box rule with the low-level shelter of Zhu et al. 2024 and Zhang et al. 2023, limited
-/// to each object's depth band (DLD-SLAM eq. 1-2), verified per region by the geometric check fitted outside
-/// the boxes (DFD-SLAM eq. 1-3 with SG-SLAM's RGB-D reprojection where the caller gives 3-D points) and
+/// to each object's depth band (DLD-SLAM eq. 1-2) and reaching above a person's box at its depth, verified
+/// per region by the geometric check fitted outside the boxes (DFD-SLAM eq. 1-3 with SG-SLAM's RGB-D
+/// reprojection where the caller gives 3-D points) and
 /// DFD-SLAM's sub-box vote, with a tracker for missed boxes, each track's static history and the survivor guard.
 /// Inputs: prev_keypoints and points_3d measured in the front end's keyframe (a slow mover builds up a
 /// measurable displacement only over several frames), evidence_frames = frames since that keyframe, and
@@ -128,6 +129,8 @@ PipelineOptions<T> recommended() {
   o.depth_mask.overlap_high_level_margin_m = 0.15;
   // A TV box shelters only what is at the TV's depth, not a walker passing in front of it.
   o.depth_mask.low_override_by_depth = true;
+  // A detector often cuts a walker's head off its box: features above the box at the person's depth join it.
+  o.depth_mask.head_band_fraction = 0.15;
 
   o.probability.enabled = false;
   o.moving_consistency.enabled = true;

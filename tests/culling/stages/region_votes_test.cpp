@@ -204,5 +204,40 @@ TYPED_TEST(RegionVotesStageTest, DisabledVotesNothing) {
   EXPECT_FALSE(s.w.votes.ok);
 }
 
+
+// A feature in a box's head band (the semantic stage's head_band_box) follows the top-row cell of its
+// column: culled above a dynamic cell, left to the box's static verdict above a static one.
+TYPED_TEST(RegionVotesStageTest, HeadBandFeaturesFollowTheTopRowOfTheirColumn) {
+  using T = TypeParam;
+  VoteScene<T> s;
+  for (std::size_t i = 0; i < 10; ++i) s.w.geometric.labels[i] = L::Dynamic;  // top-left cell flagged too
+  // The box's top moves to row 10 (its cells keep their features) and two features sit above it on row 2,
+  // at x 10 (column 0) and 50 (column 1), marked as the semantic stage marks a head band's.
+  s.w.regions.dyn_boxes[0].box.y0 = T(10);
+  s.w.regions.boxes[0].box.y0 = T(10);
+  s.f.add(T(10), T(2));
+  s.f.add(T(50), T(2));
+  const std::size_t n = s.f.size();
+  for (auto* v : {&s.w.semantic.in_dyn_box, &s.w.semantic.in_object}) v->resize(n, 1);
+  s.w.semantic.labels.resize(n, L::Dynamic);
+  s.w.semantic.reasons.resize(n, R::DepthMask);
+  s.w.geometric.labels.resize(n, L::Static);
+  s.w.geometric.source.resize(n, R::Epipolar);
+  s.w.semantic.head_band_box.assign(n, -1);
+  s.w.semantic.head_band_box[n - 2] = 0;
+  s.w.semantic.head_band_box[n - 1] = 0;
+  const PipelineOptions<T> o;
+  PipelineResult<T> r = test::fresh_result(o, n);
+  SubBoxMemory memory;
+  s.vote(o, &r, &memory);
+  ASSERT_TRUE(s.w.votes.ok) << r.subbox.reason;
+  ASSERT_EQ(s.w.votes.subbox.cells[0], 1u) << "premise: the top-left cell is dynamic";
+  ASSERT_EQ(s.w.votes.subbox.cells[1], 0u) << "premise: the top-middle cell is static";
+  EXPECT_EQ(s.w.votes.subbox.labels[n - 2], L::Dynamic);
+  EXPECT_EQ(s.w.votes.subbox.reasons[n - 2], R::SubBox);
+  EXPECT_EQ(s.w.votes.subbox.labels[n - 1], L::Static);
+  EXPECT_EQ(s.w.votes.subbox.reasons[n - 1], R::None);
+}
+
 }  // namespace
 }  // namespace dyncull

@@ -158,5 +158,61 @@ TYPED_TEST(SemanticStageTest, DisabledBoxRuleLeavesTheMaskAlone) {
   EXPECT_EQ(w.semantic.reasons[5], R::InvalidInput);
 }
 
+
+/// A walker whose box the detector cut below the head: the person (1 m) reaches rows 2-9 above the box top
+/// (row 10); background 3 m. Features: 0 (30, 6) on the head, 1 (18, 6) above the box on the background,
+/// 2 (30, 20) on the body, 3 (54, 6) on the head's row beside the box.
+template <class T>
+test::StageFrame<T> cut_head_scene() {
+  test::StageFrame<T> f(64, 48);
+  f.fill_depth(3.f);
+  f.paint_depth(20, 2, 40, 40, 1.f);
+  f.paint_depth(50, 2, 58, 10, 1.f);  // something at the walker's depth beside the box
+  f.detect(0, T(16), T(10), T(44), T(44));
+  f.add(T(30), T(6));
+  f.add(T(18), T(6));
+  f.add(T(30), T(20));
+  f.add(T(54), T(6));
+  return f;
+}
+
+TYPED_TEST(SemanticStageTest, HeadBandClaimsOnlyFeaturesAtThePersonsDepthAboveItsBox) {
+  using T = TypeParam;
+  const auto f = cut_head_scene<T>();
+  auto o = box_rule_with_depth_mask<T>();
+  detail::PipelineWork<T> w;
+  w.regions.boxes = f.detections;
+  w.regions.dyn_boxes = f.detections;
+  w.regions.dyn_box_source = {0};
+  w.regions.box_track_id = {-1};
+  w.regions.dyn_box_track_id = {-1};
+  PipelineResult<T> r = test::fresh_result(o, f.size());
+  detail::classify_by_boxes(f.frame(), o, w.regions, &w.semantic, &r);
+  ASSERT_TRUE(r.depth_mask.ran()) << r.depth_mask.reason;
+  EXPECT_EQ(w.semantic.labels, (std::vector<L>{L::Static, L::Static, L::Dynamic, L::Static})) << "no band: the box alone";
+
+  o.depth_mask.head_band_fraction = 0.25;  // 8.5 px above the 34 px box: rows 1.5-10
+  r = test::fresh_result(o, f.size());
+  detail::classify_by_boxes(f.frame(), o, w.regions, &w.semantic, &r);
+  const auto& s = w.semantic;
+  // The head (1 m, the box's d_c) joins the person; the background above the box (2 m further) and the
+  // surface at the walker's depth outside the box's columns stay static.
+  EXPECT_EQ(s.labels, (std::vector<L>{L::Dynamic, L::Static, L::Dynamic, L::Static}));
+  EXPECT_EQ(s.reasons, (std::vector<R>{R::DepthMask, R::None, R::DepthMask, R::None}));
+  EXPECT_EQ(s.in_dyn_box, (std::vector<std::uint8_t>{1, 0, 1, 0}));
+  EXPECT_EQ(s.in_object[0], 1u);
+  EXPECT_EQ(s.object_box_bits[0], 1u);
+  EXPECT_EQ(s.head_band_box, (std::vector<std::int32_t>{0, -1, -1, -1}));
+
+  o.depth_mask.head_band_depth_tolerance_m = 0.0;  // the head's depth must equal d_c: still 1 m
+  r = test::fresh_result(o, f.size());
+  detail::classify_by_boxes(f.frame(), o, w.regions, &w.semantic, &r);
+  EXPECT_EQ(w.semantic.labels[0], L::Dynamic);
+  o.depth_mask.head_band_fraction = 0.1;  // 3.4 px: rows 6.6-10 miss the head feature at row 6
+  r = test::fresh_result(o, f.size());
+  detail::classify_by_boxes(f.frame(), o, w.regions, &w.semantic, &r);
+  EXPECT_EQ(w.semantic.labels[0], L::Static);
+}
+
 }  // namespace
 }  // namespace dyncull

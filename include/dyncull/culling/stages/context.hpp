@@ -42,6 +42,7 @@ struct SemanticEvidence {
   std::vector<std::uint8_t> in_dyn_box, in_object;
   std::vector<std::uint32_t> object_box_bits;  ///< per feature: the dynamic boxes whose depth mask holds it
   bool masks = false;                          ///< the depth masks ran (in_object, object_box_bits valid)
+  std::vector<std::int32_t> head_band_box;     ///< per feature: the dynamic box whose head band holds it, -1
   std::vector<Detection<T>> shelter_boxes;     ///< scratch of the low-level shelter check
   DepthMaskResult mask, shelter_mask;         ///< the depth masks' results (the shelter check's: scratch)
   DepthMaskScratch mask_scratch;

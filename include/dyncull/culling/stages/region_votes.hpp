@@ -1,7 +1,8 @@
 /// @file region_votes.hpp
 /// Stage 6 of the culling pipeline: region votes over the dynamic-class boxes, the sub-box refinement
 /// (DFD-SLAM 2024 Algorithm 1) on the geometric evidence, with cell-level coherent motion before the
-/// vote, and on too short a baseline the box rule or a tracked box's last vote deciding.
+/// vote, features of a box's head band following its top row, and on too short a baseline the box rule or
+/// a tracked box's last vote deciding.
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
@@ -24,6 +25,27 @@ struct RegionVotesSlice {
   RegionVotesSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
       : subbox(o.subbox), coherent_motion(o.coherent_motion), boxes_tracked(o.tracker.enabled) {}
 };
+
+/// A feature in a box's head band (SemanticEvidence::head_band_box) follows the cell of the box's top row
+/// in its column: dynamic there, it is culled with the person; a static top row keeps it.
+template <class T, class Keypoints>
+void subbox_follow_head_bands(const Keypoints& kp, const std::vector<Detection<T>>& boxes,
+                              const std::vector<std::int32_t>& band_box, int grid, SubBoxResult<T>* out) {
+  SubBoxResult<T>& r = *out;
+  const std::size_t cells_per_box = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
+  if (!r.ok() || band_box.size() != r.labels.size() || r.cells.size() < boxes.size() * cells_per_box) return;
+  for (std::size_t i = 0; i < band_box.size(); ++i) {
+    if (band_box[i] < 0 || r.labels[i] == FeatureLabel::Dynamic) continue;
+    const auto b = static_cast<std::size_t>(band_box[i]);
+    const Box<T>& box = boxes[b].box;
+    const int col = subbox_index(point_x<T>(kp[i]), box.x0, box.x1, grid);
+    if (r.cells[b * cells_per_box + static_cast<std::size_t>(col)] == 0) continue;
+    r.labels[i] = FeatureLabel::Dynamic;
+    r.reasons[i] = CullReason::SubBox;
+    ++r.num_dynamic;
+    --r.num_static;
+  }
+}
 
 /// out->subbox: this frame's sub-box labels (valid when out->ok); out->evidence: the geometric labels with
 /// the coherent cells' features flagged (when out->coherent_ran). Reports into r.coherent_motion, r.subbox.
@@ -55,6 +77,7 @@ void vote_regions(const Frame& frame, const NonDeduced<RegionVotesSlice<T>>& opt
     if (recalled > 0) {
       apply_subbox_states(kp, geometric.labels, regions.dyn_boxes, v.remembered_cells, options.subbox,
                           &v.subbox, in_object, box_bits);
+      subbox_follow_head_bands(kp, regions.dyn_boxes, semantic.head_band_box, options.subbox.grid, &v.subbox);
       r->subbox.status = v.subbox.status;
       r->subbox.num_dynamic = v.subbox.num_dynamic;
     }
@@ -93,6 +116,7 @@ void vote_regions(const Frame& frame, const NonDeduced<RegionVotesSlice<T>>& opt
       }
     }
     refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits);
+    subbox_follow_head_bands(kp, regions.dyn_boxes, semantic.head_band_box, options.subbox.grid, &v.subbox);
     if (options.subbox.short_baseline_keeps_last_vote && options.subbox.min_evidence_frames > 0 &&
         options.boxes_tracked && r->tracker.ran() && v.subbox.ok())
       last_votes->remember_states(regions.dyn_box_track_id, v.subbox, options.subbox, frame_index,

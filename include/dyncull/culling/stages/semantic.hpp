@@ -1,7 +1,8 @@
 /// @file semantic.hpp
 /// Stages 2-3 of the culling pipeline: the box rule (Zhu et al. 2024 Table 2; Zhang et al. 2023
 /// Algorithm 1; motion levels of RTD-SLAM 2024 §III.D), limited to each object's depth band by the depth
-/// mask (DLD-SLAM 2024 eq. 1-2), with overlapping masks and low-level shelters decided by depth.
+/// mask (DLD-SLAM 2024 eq. 1-2), with overlapping masks, low-level shelters and a person's head cut off
+/// its box decided by depth.
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
@@ -136,6 +137,52 @@ void assign_overlaps_by_depth(const Keypoints& kp, const DepthView<Raw>& depth, 
     }
   }
 }
+
+/// DepthMaskStageOptions::head_band_fraction: a feature the boxes left static (outside every dynamic-class
+/// box) that lies in the band above a high-level box, within the box's columns, with a depth within the
+/// tolerance of the box's object depth d_c, is labelled as that person (nearest d_c among the bands holding
+/// it): Dynamic, in the box and its object mask, its index in `band_box`. Returns how many were.
+template <class T, class Keypoints, class Raw>
+std::size_t claim_head_bands(const Keypoints& kp, const DepthView<Raw>& depth, const DepthMaskResult& dm,
+                             const std::vector<Detection<T>>& dyn_boxes, const MotionLevelTable& levels,
+                             const DepthMaskStageOptions& options, SemanticEvidence<T>* s) {
+  const std::size_t n = s->labels.size();
+  s->head_band_box.assign(n, -1);
+  if (!(options.head_band_fraction > 0)) return 0;
+  const std::size_t nb = std::min<std::size_t>({dyn_boxes.size(), dm.boxes.size(), 32});
+  std::size_t claimed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s->in_dyn_box[i] || s->labels[i] != FeatureLabel::Static || s->reasons[i] != CullReason::None) continue;
+    int u = 0, v = 0;
+    if (!keypoint_in_image<T>(kp, i, depth.width, depth.height, &u, &v)) continue;
+    const double d = depth.depth_m(u, v);
+    if (!(d > 0)) continue;  // without depth nothing says it is the person rather than the wall
+    const double x = static_cast<double>(point_x<T>(kp[i])), y = static_cast<double>(point_y<T>(kp[i]));
+    std::int32_t best = -1;
+    double best_gap = options.head_band_depth_tolerance_m;
+    for (std::size_t k = 0; k < nb; ++k) {
+      const Box<T>& b = dyn_boxes[k].box;
+      const double top = static_cast<double>(b.y0), band = options.head_band_fraction * static_cast<double>(b.y1 - b.y0);
+      const double dc = dm.boxes[k].d_c_m;
+      if (levels.level(dyn_boxes[k].class_id) != MotionLevel::High || !dm.boxes[k].ok() || !(dc > 0)) continue;
+      if (!(y < top && y >= top - band && x >= static_cast<double>(b.x0) && x <= static_cast<double>(b.x1))) continue;
+      const double gap = std::abs(d - dc);
+      if (gap <= best_gap) {
+        best = static_cast<std::int32_t>(k);
+        best_gap = gap;
+      }
+    }
+    if (best < 0) continue;
+    s->labels[i] = FeatureLabel::Dynamic;
+    s->reasons[i] = CullReason::DepthMask;
+    s->in_dyn_box[i] = 1;
+    s->in_object[i] = 1;
+    s->object_box_bits[i] = std::uint32_t(1) << best;
+    s->head_band_box[i] = best;
+    ++claimed;
+  }
+  return claimed;
+}
 }  // namespace detail
 namespace detail {
 
@@ -168,6 +215,7 @@ void classify_by_boxes(const Frame& frame, const NonDeduced<SemanticSlice<T>>& o
   s.in_object.assign(n, 1);
   s.rule_ok = false;
   s.masks = false;
+  s.head_band_box.assign(n, -1);
   if (options.box_rule.enabled) {
     apply_box_rule(kp, regions.boxes, options.levels, options.box_rule, &s.rule, &s.rule_scratch);
     r->box_rule.status = s.rule.status;
@@ -221,6 +269,8 @@ void classify_by_boxes(const Frame& frame, const NonDeduced<SemanticSlice<T>>& o
       s.in_dyn_box[i] = 1;
     }
   }
+  if (options.box_rule.enabled)
+    claim_head_bands(kp, frame.depth, dm, regions.dyn_boxes, options.levels, options.depth_mask, &s);
 }
 
 }  // namespace detail
