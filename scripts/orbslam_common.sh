@@ -273,9 +273,11 @@ run_once() {
   rm -rf "$dir"
   mkdir -p "$dir"
   log "$(basename "$seq"): $variant $name ($(basename "${lists[0]:-$seq/rgb.txt}"))"
+  local status=0
   (cd "$dir" && env "${settings[@]}" "$@" DYNCULL_LOG="$dir/culler_frames.csv" \
     "$example" "$vocabulary" "$dest/${host}_settings.yaml" "$seq" "${lists[@]}" >"$dir/$example_log" 2>&1) ||
-    log "$variant $name: $(basename "$example") exited with status $? (see $dir/$example_log)"
+    status=$?
+  ((status == 0)) || log "$variant $name: $(basename "$example") exited with status $status (see $dir/$example_log)"
   if declare -F after_run >/dev/null; then after_run "$dir"; fi
   "$dyncull_prefix/bin/dyncull_eval" "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" "${eval_options[@]}" \
     --json --poses-csv "$dir/poses.csv" >"$dir/ate.json" 2>"$dir/ate.err" || true
