@@ -61,7 +61,8 @@ void yield_cpu_to_tracking() {
 
 LiveDetection::LiveDetection(std::unique_ptr<FrameDetector> detector, const LiveDetectionOptions& options)
     : detector_(std::move(detector)), options_(options), stop_(false), has_pending_(false), has_result_(false),
-      first_offered_(false), pending_index_(-1), finished_(0), failures_(0), newest_failed_(false), failed_index_(-1), failed_ms_(0) {
+      first_offered_(false), pending_index_(-1), finished_(0), failures_(0), newest_failed_(false),
+      failed_index_(-1), failed_ms_(0) {
   if (detector_ && !options_.synchronous) thread_ = std::thread(&LiveDetection::run, this);
 }
 
@@ -136,8 +137,8 @@ void LiveDetection::run() {
 // The first frame offered waits for its own boxes (bounded): the host builds its first map from it.
 void LiveDetection::wait_for_first_result(std::unique_lock<std::mutex>* lock) {
   first_offered_ = true;
-  const double ms = options_.first_frame_wait_ms;
-  const std::chrono::milliseconds limit(ms > 0 ? static_cast<long>(std::min(ms, 60000.0)) : 0);  // NaN: 0
+  const double ms = options_.first_frame_wait_ms > 0 ? std::min(options_.first_frame_wait_ms, 60000.0) : 0;  // NaN: 0
+  const std::chrono::milliseconds limit(static_cast<long>(ms));  // checked: ms in [0, 60000]
   result_ready_.wait_for(*lock, limit, [this] { return has_result_; });
 }
 

@@ -28,8 +28,9 @@ void use_trained_input_size(cv_adapter::YoloDetectorOptions* o) {
   if (o->model.size() < 4 || o->model.compare(o->model.size() - 4, 4, ".cfg") != 0) return;
   if (!text::read_small_file(o->model, cv_adapter::kMaxYoloCfgBytes, &text, &why)) return;
   if (!cv_adapter::darknet_layout(text, &layout, &why)) return;
-  if (layout.input_width % 32 != 0 || layout.input_height % 32 != 0) return;
-  if (layout.input_width <= 0 || layout.input_height <= 0) return;
+  const bool usable = layout.input_width > 0 && layout.input_height > 0 && layout.input_width % 32 == 0 &&
+                      layout.input_height % 32 == 0;  // YOLO's strides
+  if (!usable) return;
   o->input_width = layout.input_width;
   o->input_height = layout.input_height;
 }
