@@ -202,6 +202,15 @@ TEST(SequenceCamera, FromCommandLineListOrTumName) {
   EXPECT_NE(c.reason.find("names none of TUM's cameras"), std::string::npos) << c.reason;
 }
 
+// A NUL byte ends a file name early: ".\0..." is no path to the current folder but text, refused as text.
+TEST(SequenceCamera, SpecWithANulByteIsNoPath) {
+  const eval::CameraResult c = eval::camera_from_spec(std::string(".\0kinect", 8));
+  EXPECT_EQ(c.status, Status::InvalidInput);
+  EXPECT_EQ(c.reason.find("is a directory"), std::string::npos) << c.reason;
+  EXPECT_LT(c.reason.size(), 600u);
+  EXPECT_NE(text::regular_file_problem(std::string("camera.txt\0x", 12)).find("contains a NUL byte"), std::string::npos);
+}
+
 // A camera no lens has runs to the end with a wrong answer: refused where it enters, naming the value.
 TEST_F(SequenceFolder, AbsurdCamerasAreRefusedNamingTheValue) {
   auto file_reason = [&](const std::string& text) {

@@ -58,9 +58,11 @@ constexpr std::uint64_t kMaxCameraFileBytes = std::uint64_t(1) << 16;  ///< came
 /// a FIFO, a device, a socket, missing, or a file of the kernel's (procfs, sysfs, /dev), whose size says
 /// nothing about what a read returns. Only the file's status and name are read, so this never blocks.
 inline std::string regular_file_problem(const std::string& path) {
+  const std::string shown = quote_path(path);
+  // The system reads a name only up to its first NUL: such a path would open another file.
+  if (path.find('\0') != std::string::npos) return shown + ": contains a NUL byte, which no file name can";
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
-  const std::string shown = quote_path(path);
   using std::filesystem::file_type;
   switch (st.type()) {
     case file_type::regular: break;

@@ -361,7 +361,8 @@ inline CameraResult tum_camera(const std::string& name) {
 /// (depth 5000 units per metre); else a TUM name (tum_camera).
 inline CameraResult camera_from_spec(const std::string& spec, const SequenceOptions& options = {}) {
   std::error_code ec;
-  if (std::filesystem::exists(spec, ec)) return read_camera_file(spec, options);
+  // A NUL byte ends a file name early (".\0..." would name the current folder): such a spec is no path.
+  if (spec.find('\0') == std::string::npos && std::filesystem::exists(spec, ec)) return read_camera_file(spec, options);
   const std::vector<std::string_view> f = detail::fields_of(spec);
   const std::string shown = "camera " + text::quote_token(spec);  // user text: escaped and cut to 32 characters
   double first = 0;
