@@ -101,7 +101,7 @@ BENCHMARK(BM_MovingConsistency_StillCamera)->Arg(0)->Arg(1)->Unit(benchmark::kMi
 // The floor: F-RANSAC on all valid tracks plus one batch eq. 3 pass (what the check must not exceed by 1.2x).
 void BM_MovingConsistency_PartsFloor(benchmark::State& state) {
   const Data& d = data();
-  FundamentalOptions<float> fo = MovingConsistencyOptions<float>{}.fundamental;
+  const FundamentalOptions<float> fo = MovingConsistencyOptions<float>{}.fundamental_fit();
   std::vector<float> dist(d.cur.size());
   for (auto _ : state) {
     const auto f = estimate_fundamental_ransac(d.prev, d.cur, fo);

@@ -103,7 +103,7 @@ void BM_MultiView_Grow_Dyncull(benchmark::State& state) {
   std::size_t set = 0;
   for (auto _ : state) {
     std::fill(mask.pixels.begin(), mask.pixels.end(), std::uint8_t(0));
-    set = grow_multiview_regions(r, depth, MultiViewOptions<float>{}, &mask, &stack);
+    set = grow_multiview_regions(r, depth, &mask, &stack);
     benchmark::DoNotOptimize(mask.pixels.data());
   }
   state.counters["seeds"] = double(r.num_dynamic);
@@ -135,14 +135,15 @@ void BM_MultiView_Grow_PeerCvFloodFill(benchmark::State& state) {
       // Fixed range relative to the seed pixel's own value; the window is set so it covers the same
       // [d' - 0.2, d' + 0.2] interval as ours.
       const float at_seed = depth_m.at<float>(seed);
-      const float lo = at_seed - (seed_d - o.region_depth_tolerance_m), hi = (seed_d + o.region_depth_tolerance_m) - at_seed;
+      const float tol = float(MultiViewOptions<float>::kRegionDepthToleranceM);
+      const float lo = at_seed - (seed_d - tol), hi = (seed_d + tol) - at_seed;
       cv::floodFill(depth_m, mask, seed, cv::Scalar(), nullptr, cv::Scalar(std::max(0.f, lo)), cv::Scalar(std::max(0.f, hi)), flags);
     }
     benchmark::DoNotOptimize(mask.data);
   }
   Mask ours(d.scene.width, d.scene.height);
   std::vector<std::uint32_t> stack;
-  grow_multiview_regions(r, depth, o, &ours, &stack);
+  grow_multiview_regions(r, depth, &ours, &stack);
   std::size_t differ = 0, set = 0;
   for (int v = 0; v < d.scene.height; ++v)
     for (int u = 0; u < d.scene.width; ++u) {

@@ -113,13 +113,13 @@ TYPED_TEST(CoherentMotionTest, SmallOffsetsNoiseAndSparseCellsAreNotMotion) {
     EXPECT_EQ(r.num_cells_flagged, 0u);
   }
   {
-    // A noise estimate of 0 (or NaN: no fit) falls back to the floor min_noise_px.
+    // A noise estimate of 0 (or NaN: no fit) falls back to the floor kMinNoisePx.
     auto s = make_cell_scene<T>(20, 0.25, Vec2<double>(0.7, 0.4));
     CoherentMotionResult<T> r;
     flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0), o, s.labels.data(), &r);
-    EXPECT_NEAR(double(r.noise_px), double(o.min_noise_px), 1e-6);
+    EXPECT_NEAR(double(r.noise_px), double(T(CoherentMotionOptions<T>::kMinNoisePx)), 1e-6);
     flag_coherent_cells(s.points, s.residuals, s.boxes, 3, std::numeric_limits<T>::quiet_NaN(), o, s.labels.data(), &r);
-    EXPECT_NEAR(double(r.noise_px), double(o.min_noise_px), 1e-6);
+    EXPECT_NEAR(double(r.noise_px), double(T(CoherentMotionOptions<T>::kMinNoisePx)), 1e-6);
   }
 }
 
@@ -162,7 +162,7 @@ TYPED_TEST(CoherentMotionTest, BadInputGetsAReason) {
   EXPECT_EQ(r.status, Status::InvalidInput);
   EXPECT_FALSE(r.reason.empty());
   bad = CoherentMotionOptions<T>{};
-  bad.min_noise_px = std::numeric_limits<T>::quiet_NaN();
+  bad.min_median_px = std::numeric_limits<T>::quiet_NaN();
   flag_coherent_cells(s.points, s.residuals, s.boxes, 3, T(0.25), bad, s.labels.data(), &r);
   EXPECT_EQ(r.status, Status::InvalidInput);
   flag_coherent_cells(s.points, s.residuals, s.boxes, 9, T(0.25), CoherentMotionOptions<T>{}, s.labels.data(), &r);

@@ -208,10 +208,6 @@ TYPED_TEST(Detections, OptionsAreValidatedWithTheFieldNamed) {
       {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = T(1.5); }},
       {"min_confidence", [](DetectionOptions<T>* o) { o->min_confidence = T(-0.1); }},
       {"min_confidence_person", [](DetectionOptions<T>* o) { o->min_confidence_person = std::numeric_limits<T>::quiet_NaN(); }},
-      {"letterbox.scale", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.scale = T(0); }},
-      {"letterbox.scale", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.scale = std::numeric_limits<T>::quiet_NaN(); }},
-      {"letterbox.pad_x", [](DetectionOptions<T>* o) { o->letterbox = Letterbox<T>::centred(640, 480, 640, 640); o->letterbox.pad_x = std::numeric_limits<T>::infinity(); }},
-      {"letterbox.input_height", [](DetectionOptions<T>* o) { o->letterbox.input_width = 640; o->letterbox.input_height = 0; }},
   };
   const std::vector<YoloBox<T>> yolo = {{0, T(0.5), T(0.5), T(0.2), T(0.2), T(0.9)}};
   const std::vector<Detection<T>> px = {{Box<T>{T(10), T(10), T(100), T(100)}, 0, T(0.9)}};
@@ -242,6 +238,34 @@ TYPED_TEST(Detections, OptionsAreValidatedWithTheFieldNamed) {
   ASSERT_EQ(whole.detections.size(), 1u);
   EXPECT_EQ(whole.detections[0].box.x0, T(0));
   EXPECT_EQ(whole.detections[0].box.x1, T(639));
+}
+
+// The letterbox belongs to the detector's output: the YOLO conversion refuses a broken one, naming it.
+TYPED_TEST(Detections, LetterboxIsValidatedWithTheFieldNamed) {
+  using T = TypeParam;
+  struct Case {
+    const char* field;
+    void (*spoil)(Letterbox<T>*);
+  };
+  const Case cases[] = {
+      {"letterbox.scale", [](Letterbox<T>* lb) { lb->scale = T(0); }},
+      {"letterbox.scale", [](Letterbox<T>* lb) { lb->scale = std::numeric_limits<T>::quiet_NaN(); }},
+      {"letterbox.pad_x", [](Letterbox<T>* lb) { lb->pad_x = std::numeric_limits<T>::infinity(); }},
+      {"letterbox.input_height", [](Letterbox<T>* lb) { lb->input_height = 0; }},
+  };
+  const std::vector<YoloBox<T>> yolo = {{0, T(0.5), T(0.5), T(0.2), T(0.2), T(0.9)}};
+  for (const Case& c : cases) {
+    Letterbox<T> lb = Letterbox<T>::centred(640, 480, 640, 640);
+    c.spoil(&lb);
+    const DetectionsResult<T> a = convert_yolo_detections(yolo, 640, 480, DetectionOptions<T>{}, lb);
+    EXPECT_EQ(a.status, Status::InvalidInput) << c.field;
+    EXPECT_NE(a.reason.find(c.field), std::string::npos) << a.reason;
+    EXPECT_TRUE(a.detections.empty());
+  }
+  const DetectionsResult<T> boxed =
+      convert_yolo_detections(yolo, 640, 480, DetectionOptions<T>{}, Letterbox<T>::centred(640, 480, 640, 640));
+  ASSERT_TRUE(boxed.ok()) << boxed.reason;
+  EXPECT_EQ(boxed.detections.size(), 1u);
 }
 
 TEST(YoloParser, ParsesLinesAndReportsLineNumbers) {

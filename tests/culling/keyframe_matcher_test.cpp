@@ -343,8 +343,6 @@ TYPED_TEST(KeyframeMatcherTyped, BadOptionsCameraAndPoseAreReported) {
       {"ratio", [](KeyframeMatchOptions& o) { o.ratio = 0; }},
       {"ratio", [](KeyframeMatchOptions& o) { o.ratio = 1.5; }},
       {"ratio", [](KeyframeMatchOptions& o) { o.ratio = std::nan(""); }},
-      {"grid_cell_px", [](KeyframeMatchOptions& o) { o.grid_cell_px = 0.5; }},
-      {"grid_cell_px", [](KeyframeMatchOptions& o) { o.grid_cell_px = std::nan(""); }},
       {"max_candidates", [](KeyframeMatchOptions& o) { o.max_candidates = 0; }},
       {"max_candidates", [](KeyframeMatchOptions& o) { o.max_candidates = std::size_t(1) << 21; }},
   };
@@ -454,18 +452,11 @@ TEST(KeyframeMatcher, MutualCheckRejectsAKeypointAnotherPointPrefers) {
   KeyframeMatchOptions o;
   o.ratio = 1.0;
   o.radius_unpredicted_px = 27;  // A sees c0 only; B sees c0 and c1
-  o.mutual_check = true;
-  auto r = dyncull::match_to_keyframe(kf, none, DescriptorRows(kf_desc.data(), 2), cur, DescriptorRows(cur_desc.data(), 2),
-                                      cam, nullptr, o);
+  const auto r = dyncull::match_to_keyframe(kf, none, DescriptorRows(kf_desc.data(), 2), cur,
+                                            DescriptorRows(cur_desc.data(), 2), cam, nullptr, o);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.keyframe_index[0], -1);  // A -> c0, but c0's nearest is B
   EXPECT_EQ(r.keyframe_index[1], 1);   // B <-> c1
-  o.mutual_check = false;
-  r = dyncull::match_to_keyframe(kf, none, DescriptorRows(kf_desc.data(), 2), cur, DescriptorRows(cur_desc.data(), 2),
-                                 cam, nullptr, o);
-  EXPECT_EQ(r.keyframe_index[0], 0);
-  EXPECT_EQ(r.distance[0], 30);
-  EXPECT_EQ(r.keyframe_index[1], 1);
 }
 
 TEST(KeyframeMatcher, RowsViewAndStridedRowsAreRead) {
@@ -661,7 +652,7 @@ std::vector<int> oracle(const std::vector<Vec2<T>>& kf, const std::vector<Vec3<T
     const int c = best_cur[k];
     if (c < 0 || best_d[k] > o.max_hamming) continue;
     if (second[k] != std::numeric_limits<int>::max() && !(double(best_d[k]) <= o.ratio * double(second[k]))) continue;
-    if (o.mutual_check && cur_best[std::size_t(c)] != int(k)) continue;
+    if (cur_best[std::size_t(c)] != int(k)) continue;
     if (out[std::size_t(c)] >= 0 && dist[std::size_t(c)] <= best_d[k]) continue;
     out[std::size_t(c)] = int(k);
     dist[std::size_t(c)] = best_d[k];
@@ -712,8 +703,6 @@ TYPED_TEST(KeyframeMatcherTyped, RandomInputMatchesTheBruteForceOracle) {
     o.radius_unpredicted_px = rng.uniform(1, 60);
     o.max_hamming = int(rng.index(120));
     o.ratio = rng.uniform(0.5, 1.0);
-    o.mutual_check = rng.index(2) == 0;
-    o.grid_cell_px = rng.uniform(1, 50);
     dyncull::PinholeCamera<T> cam{T(300), T(310), T(100), T(75), 200, 150};
     const auto pose = pose_from<T>(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2),
                                    rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3));

@@ -90,7 +90,7 @@ TYPED_TEST(MultiViewTest, RegionGrowingLabelsCurrentFeaturesOnTheWalkingPerson) 
   ASSERT_TRUE(r.ok()) << r.reason;
   Mask mask;
   std::vector<std::uint32_t> stack;
-  const std::size_t pixels = grow_multiview_regions(r, scene.depth_view(), options, &mask, &stack);
+  const std::size_t pixels = grow_multiview_regions(r, scene.depth_view(), &mask, &stack);
   EXPECT_GT(pixels, 1000u);
   std::vector<std::uint8_t> predicted(scene.size());
   for (std::size_t i = 0; i < scene.size(); ++i)
@@ -113,7 +113,7 @@ TYPED_TEST(MultiViewTest, ScanlineRegionGrowingMatchesPixelwiseFloodFill) {
   ASSERT_GT(r.num_dynamic, 0u);
   Mask fast;
   std::vector<std::uint32_t> stack;
-  const std::size_t n_fast = grow_multiview_regions(r, scene.depth_view(), options, &fast, &stack);
+  const std::size_t n_fast = grow_multiview_regions(r, scene.depth_view(), &fast, &stack);
   // Oracle: plain 4-neighbour breadth-first fill with the documented joining rule.
   const int W = scene.width, H = scene.height;
   Mask ref(W, H);
@@ -132,7 +132,7 @@ TYPED_TEST(MultiViewTest, ScanlineRegionGrowingMatchesPixelwiseFloodFill) {
       for (int k = 0; k < 4; ++k) {
         if (nx[k] < 0 || ny[k] < 0 || nx[k] >= W || ny[k] >= H || ref.test(nx[k], ny[k])) continue;
         const double d = double(scene.depth[static_cast<std::size_t>(ny[k] * W + nx[k])]);
-        if (!(d > 0) || std::abs(d - seed) > double(options.region_depth_tolerance_m)) continue;
+        if (!(d > 0) || std::abs(d - seed) > double(T(MultiViewOptions<T>::kRegionDepthToleranceM))) continue;
         ref.pixels[static_cast<std::size_t>(ny[k] * W + nx[k])] = 1;
         ++n_ref;
         queue.emplace_back(nx[k], ny[k]);
@@ -161,7 +161,7 @@ TYPED_TEST(MultiViewTest, Uint16RegionGrowingMatchesPixelwiseFloodFill) {
   ASSERT_GT(r.num_dynamic, 0u);
   Mask fast;
   std::vector<std::uint32_t> stack;
-  const std::size_t n_fast = grow_multiview_regions(r, view, options, &fast, &stack);
+  const std::size_t n_fast = grow_multiview_regions(r, view, &fast, &stack);
   const int W = scene.width, H = scene.height;
   Mask ref(W, H);
   for (std::size_t i = 0; i < r.labels.size(); ++i) {
@@ -169,7 +169,7 @@ TYPED_TEST(MultiViewTest, Uint16RegionGrowingMatchesPixelwiseFloodFill) {
     const int su = int(std::lround(double(r.projected[i].x()))), sv = int(std::lround(double(r.projected[i].y())));
     if (ref.test(su, sv)) continue;
     const double seed = double(r.measured_depth_m[i]);
-    const double tol = double(options.region_depth_tolerance_m);
+    const double tol = double(T(MultiViewOptions<T>::kRegionDepthToleranceM));
     std::vector<std::pair<int, int>> queue{{su, sv}};
     ref.pixels[static_cast<std::size_t>(sv * W + su)] = 1;
     for (std::size_t q = 0; q < queue.size(); ++q) {

@@ -55,9 +55,9 @@ TYPED_TEST(PipelineInputsTest, NestedReasonNamesTheStageAndTheField) {
   using T = TypeParam;
   std::string why;
   PipelineOptions<T> o = presets::recommended<T>();
-  o.depth_mask.histogram_bin_m = std::numeric_limits<double>::quiet_NaN();
+  o.depth_mask.eps_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_EQ(why, "depth_mask.histogram_bin_m must be positive and finite (at least 0.001 m)");
+  EXPECT_EQ(why, "depth_mask.eps_m must be finite and in [0, 1e4] m");
   o = presets::recommended<T>();
   o.moving_consistency.refit_iterations = 1000000;
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
@@ -448,11 +448,11 @@ TYPED_TEST(PipelineInputsTest, PropertyRandomFramesGiveAStatusOrDefinedLabels) {
   std::size_t checked = 0, stages_ran = 0;  // frames whose labels were checked; stages that ran in them
   for (int trial = 0; trial < 300; ++trial) {
     PipelineOptions<T> o = bases[rng.index(5)];
-    o.moving_consistency.fundamental.ransac.max_iterations = 50;
-    o.reprojection.pnp.ransac.max_iterations = 50;
+    o.moving_consistency.max_ransac_iterations = 50;
+    o.reprojection.max_ransac_iterations = 50;
     switch (rng.index(8)) {  // now and then one absurd option
       case 0: o.guard.min_fraction = wild<double>(rng, 0, 1); break;
-      case 1: o.depth_mask.histogram_max_m = wild<double>(rng, 0, 20); break;
+      case 1: o.depth_mask.max_object_depth_extent_m = wild<double>(rng, 0, 20); break;
       case 2: o.subbox.dilation_radius_px = static_cast<int>(rng.index(4)) * (INT_MAX / 3); break;
       case 3: o.multiview.max_reference_keyframes = rng.index(2) ? std::numeric_limits<std::size_t>::max() : rng.index(5); break;
       case 4: o.multiview.search_radius_px = static_cast<int>(rng.index(3)) * (INT_MAX / 2); break;

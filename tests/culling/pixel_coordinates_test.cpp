@@ -100,7 +100,7 @@ TYPED_TEST(PixelCoordinates, MultiViewRegionIsNotSeededAtAWrappedPixel) {
   result.measured_depth_m = {T(1), T(1)};
   Mask mask;
   std::vector<std::uint32_t> stack;
-  EXPECT_EQ(grow_multiview_regions(result, depth, MultiViewOptions<T>{}, &mask, &stack), 0u);
+  EXPECT_EQ(grow_multiview_regions(result, depth, &mask, &stack), 0u);
   EXPECT_EQ(mask.count(), 0u);
 }
 

@@ -98,13 +98,16 @@ TEST(Presets, RecommendedBandTakesInTheFarSideOfACloseWalker) {
 
 TEST(Presets, DefaultsOfTheGeometricOptions) {
   const MovingConsistencyOptions<double> m;
-  EXPECT_DOUBLE_EQ(m.fundamental.ransac.max_residual, 1.0);
-  EXPECT_DOUBLE_EQ(m.fundamental.ransac.confidence, 0.99);
-  EXPECT_FALSE(m.fundamental.check_homography_degeneracy);
+  EXPECT_DOUBLE_EQ(m.fundamental_fit().ransac.max_residual, 1.0);
+  EXPECT_DOUBLE_EQ(m.fundamental_fit().ransac.confidence, 0.99);
+  EXPECT_EQ(m.fundamental_fit().ransac.max_iterations, 10000u);
+  EXPECT_FALSE(m.fundamental_fit().check_homography_degeneracy);
   EXPECT_EQ(m.min_tracks_outside_boxes, 20u);
   const ReprojectionCheckOptions<double> p;
   EXPECT_DOUBLE_EQ(p.max_residual_px, 3.0);
-  EXPECT_DOUBLE_EQ(p.pnp.ransac.max_residual, 2.0);
+  EXPECT_DOUBLE_EQ(p.pose_fit().ransac.max_residual, 2.0);
+  EXPECT_EQ(p.pose_fit().ransac.max_iterations, 300u);
+  EXPECT_TRUE(p.pose_fit().refinement.huber);
   EXPECT_EQ(p.min_tracks_outside_boxes, 20u);
   EXPECT_FALSE(presets::none<double>().reprojection.enabled);
   const SubBoxOptions<double> s;
@@ -114,7 +117,7 @@ TEST(Presets, DefaultsOfTheGeometricOptions) {
   const MultiViewOptions<double> v;
   EXPECT_DOUBLE_EQ(v.depth_threshold_m, 0.4);
   EXPECT_DOUBLE_EQ(v.max_parallax_deg, 30.0);
-  EXPECT_DOUBLE_EQ(v.region_depth_tolerance_m, 0.2);
+  EXPECT_DOUBLE_EQ(MultiViewOptions<double>::kRegionDepthToleranceM, 0.2);
 }
 
 }  // namespace

@@ -147,7 +147,6 @@ TYPED_TEST(StageInputsTest, MultiViewPropertyStatusOrFiniteOutputs) {
     o.depth_threshold_m = maybe_wild(rng, T(0.4));
     o.max_parallax_deg = maybe_wild(rng, T(30));
     o.border_px = maybe_wild(rng, T(0));
-    o.region_depth_tolerance_m = maybe_wild(rng, T(0.2));
     MultiViewResult<T> r;
     check_multiview(points, depths, ref, cur, view, camera, o, &r);
     if (r.status != Status::Ok && r.status != Status::TooFewPoints) {
@@ -162,7 +161,7 @@ TYPED_TEST(StageInputsTest, MultiViewPropertyStatusOrFiniteOutputs) {
     }
     Mask mask;
     std::vector<std::uint32_t> stack;
-    const std::size_t set = grow_multiview_regions(r, view, o, &mask, &stack);
+    const std::size_t set = grow_multiview_regions(r, view, &mask, &stack);
     EXPECT_LE(set, static_cast<std::size_t>(w * h)) << trial;
   }
   EXPECT_GT(checked, 30u) << "trials that reached the output checks";
@@ -343,18 +342,18 @@ TEST(DepthMaskInputs, OptionsNameTheBadField) {
   std::string why;
   DepthMaskOptions o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
-  o.histogram_max_m = 1e12;
-  expect_names_field(o, "histogram_max_m");
+  o.max_object_depth_extent_m = 1e12;
+  expect_names_field(o, "max_object_depth_extent_m");
   o = DepthMaskOptions{};
-  o.histogram_bin_m = std::numeric_limits<double>::quiet_NaN();
+  o.eps_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(o.validate(&why), Status::InvalidInput);
-  EXPECT_EQ(why, "histogram_bin_m must be positive and finite (at least 0.001 m)");
+  EXPECT_EQ(why, "eps_m must be finite and in [0, 1e4] m");
   const std::vector<std::uint16_t> raw(64, 5000);
   const auto view = tum_depth_view(raw.data(), 8, 8);
   const DepthMaskResult r =
       depth_mask(view, std::vector<Box<float>>{Box<float>{0.f, 0.f, 7.f, 7.f}}, std::vector<Vec2<float>>(3), o);
   EXPECT_EQ(r.status, Status::InvalidInput);
-  EXPECT_NE(r.reason.find("histogram_bin_m"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("eps_m"), std::string::npos) << r.reason;
   EXPECT_EQ(r.labels.size(), 3u);
 }
 
@@ -410,13 +409,8 @@ void depth_mask_property(std::uint64_t seed) {
     o.missing_depth = static_cast<MissingDepth>(rng.index(3));
     o.occluded_centre_search = rng.index(2) == 0;
     o.eps_m = maybe_wild(rng, 0.3);
-    o.histogram_bin_m = maybe_wild(rng, 0.1);
-    o.histogram_max_m = maybe_wild(rng, 12.0);
-    o.histogram_stride_px = maybe_wild_int(rng, 0);
     o.max_object_depth_extent_m = maybe_wild(rng, 1.5);
     o.min_valid_fraction = maybe_wild(rng, 0.05);
-    o.centre_patch_radius_px = maybe_wild_int(rng, 2);
-    o.corner_search_px = maybe_wild_int(rng, -1);
     Mask mask(w, h);
     const DepthMaskResult r = depth_mask(view, boxes, points, o, mask.view());
     ASSERT_EQ(r.labels.size(), n);
@@ -483,7 +477,7 @@ TYPED_TEST(StageInputsTest, MovingConsistencyPropertyStatusOrDefinedLabels) {
       if (i < n && rng.index(12) == 0) prev[i] = Vec2<T>(wild<T>(rng, 0, 640), wild<T>(rng, 0, 480));
     }
     MovingConsistencyOptions<T> o;
-    o.fundamental.ransac.max_iterations = 100;
+    o.max_ransac_iterations = 100;
     o.max_epipolar_distance_px = maybe_wild(rng, T(1));
     o.max_epipolar_distance_in_boxes_px = maybe_wild(rng, T(0.5));
     o.refit_iterations = rng.index(5) == 0 ? maybe_wild_int(rng, 2) : 2;
@@ -532,7 +526,7 @@ TYPED_TEST(StageInputsTest, ReprojectionPropertyStatusOrDefinedLabels) {
     DepthView<float> view{depth.data(), 640, 480, 0, 1.f, 0.f, 1e30f};
     if (rng.index(10) == 0) view.units_per_metre = wild<float>(rng, -1, 1);
     ReprojectionCheckOptions<T> o;
-    o.pnp.ransac.max_iterations = 50;
+    o.max_ransac_iterations = 50;
     o.max_residual_px = maybe_wild(rng, T(3));
     o.max_residual_in_boxes_px = maybe_wild(rng, T(1.5));
     o.max_depth_residual_sigmas = rng.index(3) == 0 ? T(3) : maybe_wild(rng, T(0));
@@ -555,8 +549,8 @@ TYPED_TEST(StageInputsTest, ReprojectionOptionsNameTheBadField) {
   std::string why;
   ReprojectionCheckOptions<T> o;
   EXPECT_EQ(o.validate(&why), Status::Ok) << why;
-  o.pnp.ransac.max_iterations = 0;
-  expect_names_field(o, "pnp");
+  o.max_ransac_iterations = 0;
+  expect_names_field(o, "max_ransac_iterations");
 }
 
 // ---- coherent motion, dynamic probability, static history, sub-box memory ----
@@ -580,7 +574,6 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
     const int grid = rng.index(4) == 0 ? maybe_wild_int(rng, 3) : 1 + static_cast<int>(rng.index(8));
     o.min_points = rng.index(6);
     o.sigmas = maybe_wild(rng, T(10));
-    o.min_noise_px = maybe_wild(rng, T(0.2));
     o.min_median_px = maybe_wild(rng, T(0.5));
     CoherentMotionResult<T> r;
     flag_coherent_cells(points, residuals, boxes, grid, wild<T>(rng, 0, 2), o, labels.data(), &r);
@@ -611,9 +604,6 @@ TYPED_TEST(StageInputsTest, DynamicProbabilityPropertyStatusOrFiniteOutputs) {
     DynamicProbabilityOptions<T> o;
     o.weight_semantic = maybe_wild(rng, T(0.4));
     o.threshold = maybe_wild(rng, T(0.55));
-    o.min_motion_threshold_px = maybe_wild(rng, T(1.5));
-    o.mad_scale = maybe_wild(rng, T(3));
-    o.min_reference_features = rng.index(10);
     EgoMotion<T> ego;
     ego.model = static_cast<FlowModel>(rng.index(3));
     if (ego.model != FlowModel::MeanFlow)

@@ -80,14 +80,14 @@ void perturb(fuzz::Input& in, PipelineOptions<T>* o) {
       case 11: o->guard.min_survivors = in.u32(); break;
       case 12: o->multiview.max_reference_keyframes = in.flag() ? in.u8() : static_cast<std::size_t>(in.u64()); break;
       case 13: o->edge_evidence.radius_px = static_cast<int>(in.u32()); break;
-      case 14: o->edge_evidence.depth_step_ratio = in.value(-1, 1); break;
+      case 14: o->coherent_motion.min_median_px = in.scalar<T>(-1, 10); break;
       case 15: o->edge_evidence.enabled = in.flag(); break;
       case 16: o->subbox.min_evidence_frames = in.range(-5, 100); break;
-      case 17: o->depth_mask.histogram_bin_m = in.value(-1, 1); break;
-      case 18: o->depth_mask.histogram_max_m = in.value(-1, 1e13); break;
+      case 17: o->moving_consistency.max_ransac_iterations = in.range(0, 200); break;
+      case 18: o->reprojection.max_ransac_iterations = in.range(0, 200); break;
       case 19: o->depth_mask.eps_m = in.value(-1, 5); break;
-      case 20: o->depth_mask.centre_patch_radius_px = static_cast<int>(in.u32()); break;
-      case 21: o->depth_mask.histogram_stride_px = static_cast<int>(in.u32()); break;
+      case 20: o->depth_mask.min_valid_fraction = in.value(-1, 2); break;
+      case 21: o->depth_mask.max_object_depth_extent_m = in.value(-1, 1e13); break;
       case 22: o->subbox.grid = in.range(-2, 12); break;
       case 23: o->subbox.dilation_radius_px = static_cast<int>(in.u32()); break;
       case 24: o->subbox.sigma1 = in.scalar<T>(-1, 2); break;
@@ -111,10 +111,8 @@ void run(fuzz::Input& in) {
   PipelineOptions<T> options = preset<T>(in.range(0, 6));
   // RANSAC on random tracks runs to its iteration cap (10000 by default, 90 % of the time here): a
   // lower cap gives several times more inputs per second; the sampling loop is not what this checks.
-  for (RansacOptions* ransac : {&options.moving_consistency.fundamental.ransac, &options.reprojection.pnp.ransac}) {
-    ransac->max_iterations = std::min<std::size_t>(ransac->max_iterations, 200);
-    ransac->min_iterations = std::min(ransac->min_iterations, ransac->max_iterations);
-  }
+  for (std::size_t* cap : {&options.moving_consistency.max_ransac_iterations, &options.reprojection.max_ransac_iterations})
+    *cap = std::min<std::size_t>(*cap, 200);
   bool options_valid = true;
   if constexpr (has_validate<PipelineOptions<T>>::value) {
     perturb(in, &options);

@@ -28,9 +28,7 @@ void check(std::string_view text, int width, int height, const Letterbox<T>& let
   for (const YoloParseError& e : r.errors) DYNCULL_FUZZ_CHECK(e.line >= 1 && e.message.size() < 250);
   for (const YoloBox<T>& b : r.boxes) DYNCULL_FUZZ_CHECK(b.class_id >= 0 && b.class_id <= 1000000);
 
-  DetectionOptions<T> options;
-  options.letterbox = letterbox;
-  const DetectionsResult<T> c = convert_yolo_detections<T>(r.boxes, width, height, options);
+  const DetectionsResult<T> c = convert_yolo_detections<T>(r.boxes, width, height, DetectionOptions<T>{}, letterbox);
   DYNCULL_FUZZ_CHECK(c.ok());
   DYNCULL_FUZZ_CHECK(c.rejections.size() == r.boxes.size());
   DYNCULL_FUZZ_CHECK(c.detections.size() == c.num_kept && c.source_index.size() == c.num_kept);

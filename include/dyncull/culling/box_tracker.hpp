@@ -24,27 +24,26 @@ namespace dyncull {
 
 template <class T>
 struct BoxTrackerOptions {
-  /// A detection continues a track when its IoU with the track's predicted box reaches this.
-  T min_iou = T(0.3);
+  /// A detection continues a track when its IoU with the track's predicted box reaches this: at 30 Hz the
+  /// same walker's boxes overlap far more, two people side by side far less.
+  static constexpr double kMinIou = 0.3;
   /// Growth of a carried box per missed frame, on every side (Dynamic-VINS: 10 px).
   T grow_px_per_frame = T(10);
   /// A track is dropped after more than this many consecutive frames without a detection.
   int max_missed_frames = 2;
-  /// Velocity average: v = (1 - a) v_old + a v_new (a = 1: last displacement only).
-  T velocity_smoothing = T(0.5);
+  /// Velocity average: v = (1 - a) v_old + a v_new, with a = 0.5: a detector's box jitters by a few pixels.
+  static constexpr double kVelocitySmoothing = 0.5;
 
-  /// Ok, or InvalidInput naming the first bad field: min_iou and velocity_smoothing in [0, 1],
-  /// grow_px_per_frame finite and >= 0, max_missed_frames in [0, 1000].
+  /// Ok, or InvalidInput naming the first bad field: grow_px_per_frame finite and >= 0, max_missed_frames
+  /// in [0, 1000].
   Status validate(std::string* reason = nullptr) const {
     auto bad = [&](const char* why) {
       if (reason) *reason = why;
       return Status::InvalidInput;
     };
-    if (!(min_iou >= T(0) && min_iou <= T(1))) return bad("min_iou must be in [0, 1]");
     if (!(grow_px_per_frame >= T(0)) || !std::isfinite(grow_px_per_frame))
       return bad("grow_px_per_frame must be finite and >= 0");
     if (max_missed_frames < 0 || max_missed_frames > 1000) return bad("max_missed_frames must be in [0, 1000]");
-    if (!(velocity_smoothing >= T(0) && velocity_smoothing <= T(1))) return bad("velocity_smoothing must be in [0, 1]");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -149,7 +148,7 @@ class BoxTracker {
       for (std::size_t t = 0; t < tracks_.size(); ++t) {
         if (detections[d].class_id != tracks_[t].detection.class_id) continue;  // only the track's class continues it
         const T o = iou(detections[d].box, predicted_[t]);
-        if (o >= options_.min_iou) pairs_.push_back(Pair{o, d, t});
+        if (o >= T(BoxTrackerOptions<T>::kMinIou)) pairs_.push_back(Pair{o, d, t});
       }
     }
     std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) {
@@ -176,7 +175,8 @@ class BoxTracker {
         // Velocity from the last real detection, spread over the frames it was missed.
         const Vec2<T> shift = (detections[d].box.centre() - old.last_centre) / T(old.missed + 1);
         tb = old;
-        tb.velocity = (T(1) - options_.velocity_smoothing) * old.velocity + options_.velocity_smoothing * shift;
+        const T a = T(BoxTrackerOptions<T>::kVelocitySmoothing);
+        tb.velocity = (T(1) - a) * old.velocity + a * shift;
         ++tb.hits;
         ++r->num_matched;
       } else {

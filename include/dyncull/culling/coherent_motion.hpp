@@ -27,25 +27,23 @@ namespace dyncull {
 
 /// Options. The test: |median residual vector| > sigmas * 1.2533 * noise / sqrt(N) and > min_median_px,
 /// with N the cell's features with a residual and noise the per-component sd of a static track's residual
-/// (at least min_noise_px). 1.2533 sigma / sqrt(N) is the standard error of a median of N Gaussian samples.
+/// (at least kMinNoisePx). 1.2533 sigma / sqrt(N) is the standard error of a median of N Gaussian samples.
 template <class T>
 struct CoherentMotionOptions {
   std::size_t min_points = 4;   ///< fewer features with a residual: the cell is not tested
   /// Far above a statistical 3: the residuals of a still object near the camera share an offset too (the
   /// map points' error and the pose fitted on the far background), which the noise does not model.
   T sigmas = T(10);
-  T min_noise_px = T(0.2);      ///< floor of the noise: LK and map points rarely do better at 640x480
+  static constexpr double kMinNoisePx = 0.2;  ///< floor of the noise: LK and map points rarely do better at 640x480
   T min_median_px = T(0.5);     ///< a shared offset below this is never motion
 
-  /// InvalidInput naming the first field out of its range: min_points >= 1, sigmas and
-  /// min_noise_px positive and finite, min_median_px finite and >= 0.
+  /// InvalidInput naming the first field out of its range: min_points >= 1, sigmas positive and finite,
+  /// min_median_px finite and >= 0.
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
     if (min_points < 1) return invalid_option(reason, "min_points", "must be >= 1");
     if (!(sigmas > T(0)) || !std::isfinite(sigmas)) return invalid_option(reason, "sigmas", "must be positive and finite");
-    if (!(min_noise_px > T(0)) || !std::isfinite(min_noise_px))
-      return invalid_option(reason, "min_noise_px", "must be positive and finite");
     if (!finite_in(min_median_px, 0, 1e30)) return invalid_option(reason, "min_median_px", "must be finite and >= 0");
     if (reason) reason->clear();
     return Status::Ok;
@@ -185,7 +183,8 @@ void flag_coherent_cells(const Points& points, detail::NonDeduced<ArrayView<Vec2
     return;
   const int g = grid;
   const std::size_t cells_per_box = static_cast<std::size_t>(g * g);
-  r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, options.min_noise_px) : options.min_noise_px;
+  const T min_noise = T(CoherentMotionOptions<T>::kMinNoisePx);
+  r.noise_px = std::isfinite(noise_px) ? std::max(noise_px, min_noise) : min_noise;
   r.scratch_order.resize(n);
   r.scratch_cell.resize(n);
   r.scratch_start.resize(cells_per_box + 1);

@@ -138,12 +138,12 @@ struct CullerCoreOptions {
   double keyframe_min_matched_ratio = 0.3;
   KeyframeMatchOptions matching{};
   /// Keyframe depth used for its 3-D points: the TUM sensor's reliable range, and no point within
-  /// depth_edge_radius_px of a depth step above max_depth_step_ratio (it back-projects half on the object,
-  /// half behind it). Radius 0 switches the edge test off.
+  /// kDepthEdgeRadiusPx of a depth step above kMaxDepthStepRatio (it back-projects half on the object,
+  /// half behind it). Why you would change the range: a sensor with another one.
   float min_depth_m = 0.4f;
   float max_depth_m = 8.f;
-  int depth_edge_radius_px = 1;
-  double max_depth_step_ratio = 0.05;
+  static constexpr int kDepthEdgeRadiusPx = 1;
+  static constexpr double kMaxDepthStepRatio = 0.05;
   /// The camera has lens distortion: every frame must carry CullerFrame::undistorted_keypoints, which the
   /// geometry (matching, epipolar and reprojection checks, back-projection) uses.
   bool camera_has_distortion = false;
@@ -166,9 +166,6 @@ struct CullerCoreOptions {
       return bad("keyframe_min_matched_ratio must be in [0, 1]");
     if (!(min_depth_m >= 0.f) || !std::isfinite(min_depth_m) || !(max_depth_m > min_depth_m))
       return bad("min_depth_m must be finite and >= 0, max_depth_m above it");
-    if (depth_edge_radius_px < 0 || depth_edge_radius_px > 64) return bad("depth_edge_radius_px must be in [0, 64]");
-    if (!(max_depth_step_ratio >= 0) || !std::isfinite(max_depth_step_ratio))
-      return bad("max_depth_step_ratio must be finite and >= 0");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -618,7 +615,7 @@ class CullerCore {
     keyframe_world_points_.assign(n, Vec3<T>(nan, nan, nan));
     keyframe_has_depth_ = !depth.empty();
     if (keyframe_has_depth_) {
-      const int r = options_.depth_edge_radius_px;
+      constexpr int r = CullerCoreOptions<T>::kDepthEdgeRadiusPx;
       for (std::size_t i = 0; i < n; ++i) {
         // Depth where the keypoint is in the image (as detected), ray through its undistorted position.
         int x = 0, y = 0;
@@ -626,7 +623,7 @@ class CullerCore {
         if (x < r || y < r || x >= depth.width - r || y >= depth.height - r) continue;
         const float z = depth.depth_m(x, y);
         if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
-        if (r > 0 && depth_step_near(depth, x, y, r, options_.max_depth_step_ratio)) continue;
+        if (depth_step_near(depth, x, y, r, CullerCoreOptions<T>::kMaxDepthStepRatio)) continue;
         const Vec2<T>& p = keyframe_px_[i];
         if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
         keyframe_cam_points_[i] = camera_.backproject(p, static_cast<T>(z));

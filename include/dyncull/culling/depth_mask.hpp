@@ -9,7 +9,7 @@
 ///   DepthMaskResult depth_mask(const DepthView<Raw>&, const Boxes& boxes /* Box<T> or Detection<T> */,
 ///                              const Points& points, const DepthMaskOptions&, MaskView out = {});
 ///   -> per-box info (thresholds, outcome, pixel counts) + per-point labels / reasons / box index.
-/// `out` (optional, same size as the depth image) is OR-ed with `mask_value` where the mask is set;
+/// `out` (optional, same size as the depth image) is OR-ed with `kMaskValue` where the mask is set;
 /// the caller clears it once per frame. Point labels never need the raster.
 #pragma once
 
@@ -77,28 +77,25 @@ struct DepthMaskOptions {
 
   // ---- robust mode ----
   /// d_c = lower median of the valid depths in a (2r+1)^2 window at the centre (Kinect holes).
-  int centre_patch_radius_px = 2;
-  /// A corner without depth is replaced by the first valid depth walking diagonally inwards, at
-  /// most this many steps (< 0: half the box's shorter side). Covers the band without depth
-  /// along the image border.
-  int corner_search_px = -1;
+  static constexpr int kCentrePatchRadiusPx = 2;
+  // A corner without depth is replaced by the first valid depth walking diagonally inwards, at most half
+  // the box's shorter side: it covers the band without depth along the image border.
   /// Box pixels without a depth measurement. Nearest (default): on the real TUM frame the standing
   /// person's box holds 26.8k such pixels, 9.8k of them background (border band, ceiling); masking all
   /// of them (InMask, the choice before) gave IoU 0.800 against the whole box's 0.829, Nearest gives
   /// 0.864 (sitting person 0.657 -> 0.658). InMask suits a caller who never wants an unknown pixel kept.
   MissingDepth missing_depth = MissingDepth::Nearest;
-  /// Histogram fallback (rule not applicable): bins of this width from 0 to histogram_max_m,
-  /// over every histogram_stride_px-th row and column. 0 (default) = auto: the smallest stride that
-  /// samples at most histogram_target_samples pixels (it is a statistic; a 300 x 200 box uses every
-  /// 3rd row and column, small boxes every pixel), so the fallback costs about one pass over the box.
-  double histogram_bin_m = 0.1;
-  int histogram_stride_px = 0;
-  int histogram_target_samples = 4096;
-  double histogram_max_m = 12.0;
+  /// Histogram fallback (rule not applicable): bins of this width from 0 to kHistogramMaxM, over every
+  /// k-th row and column with the smallest stride k that samples at most kHistogramTargetSamples pixels (it
+  /// is a statistic; a 300 x 200 box uses every 3rd row and column, small boxes every pixel), so the
+  /// fallback costs about one pass over the box.
+  static constexpr double kHistogramBinM = 0.1;
+  static constexpr int kHistogramTargetSamples = 4096;
+  static constexpr double kHistogramMaxM = 12.0;  ///< beyond the range of RGB-D sensors
   /// A bin is occupied when it holds at least this fraction of the box's valid pixels.
-  double histogram_occupied_fraction = 0.002;
+  static constexpr double kHistogramOccupiedFraction = 0.002;
   /// The foreground cluster ends after this many consecutive unoccupied bins.
-  int histogram_max_gap_bins = 1;
+  static constexpr int kHistogramMaxGapBins = 1;
   /// ... and never reaches further than this behind d_c (depth extent of one object).
   double max_object_depth_extent_m = 1.5;
   /// Below this fraction of box pixels with depth the whole box is masked.
@@ -106,19 +103,17 @@ struct DepthMaskOptions {
   /// Occluded centre (robust mode, several boxes): when box b's centre lies in another box a and b's
   /// d_c is a's object depth (a walker in front of a seated person), d_c measures the occluder and b's
   /// band would leave b's own object out. Then b's d_c is re-estimated from b's pixels outside a: if
-  /// fewer than occluded_centre_max_fraction of them lie within eps of d_c, d_c becomes the fullest bin
+  /// fewer than kOccludedCentreMaxFraction of them lie within eps of d_c, d_c becomes the fullest bin
   /// of the nearest window of 3 histogram bins behind the occluder that holds at least
-  /// occluded_cluster_fraction of them. false (default): DLD-SLAM's centre sample.
+  /// kOccludedClusterFraction of them. false (default): DLD-SLAM's centre sample.
   bool occluded_centre_search = false;
-  double occluded_centre_max_fraction = 0.15;
-  double occluded_cluster_fraction = 0.15;
+  static constexpr double kOccludedCentreMaxFraction = 0.15;
+  static constexpr double kOccludedClusterFraction = 0.15;
 
-  std::uint8_t mask_value = 255;
+  static constexpr std::uint8_t kMaskValue = 255;  ///< OR-ed into the caller's mask image where the mask is set
 
   /// InvalidInput naming the first field out of its range: enums in range; depths in metres finite, >= 0
-  /// and at most 1e4; histogram_bin_m >= 1 mm and histogram_max_m in (0, 1e4] with at most 65536 bins;
-  /// fractions in [0, 1]; strides, radii and gaps >= 0 (a stride at most 65536, a centre patch radius at
-  /// most 7); histogram_target_samples >= 1.
+  /// and at most 1e4; fractions in [0, 1].
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -126,27 +121,9 @@ struct DepthMaskOptions {
     if (static_cast<int>(missing_depth) > 2)
       return invalid_option(reason, "missing_depth", "must be Nearest, InMask or OutOfMask");
     if (!finite_in(eps_m, 0, 1e4)) return invalid_option(reason, "eps_m", "must be finite and in [0, 1e4] m");
-    if (centre_patch_radius_px < 0 || centre_patch_radius_px > 7)
-      return invalid_option(reason, "centre_patch_radius_px", "must be in [0, 7]");
-    if (!finite_in(histogram_bin_m, 1e-3, 1e4))
-      return invalid_option(reason, "histogram_bin_m", "must be positive and finite (at least 0.001 m)");
-    if (!(histogram_max_m > 0) || !finite_in(histogram_max_m, 0, 1e4))
-      return invalid_option(reason, "histogram_max_m", "must be positive, finite and at most 1e4 m");
-    if (histogram_max_m / histogram_bin_m > 65536.0)
-      return invalid_option(reason, "histogram_max_m", "over histogram_bin_m must be at most 65536 bins");
-    if (histogram_stride_px < 0 || histogram_stride_px > 65536)
-      return invalid_option(reason, "histogram_stride_px", "must be in [0, 65536] (0 = auto)");
-    if (histogram_target_samples < 1) return invalid_option(reason, "histogram_target_samples", "must be >= 1");
-    if (!finite_in(histogram_occupied_fraction, 0, 1))
-      return invalid_option(reason, "histogram_occupied_fraction", "must be in [0, 1]");
-    if (histogram_max_gap_bins < 0) return invalid_option(reason, "histogram_max_gap_bins", "must be >= 0");
     if (!finite_in(max_object_depth_extent_m, 0, 1e4))
       return invalid_option(reason, "max_object_depth_extent_m", "must be finite and in [0, 1e4] m");
     if (!finite_in(min_valid_fraction, 0, 1)) return invalid_option(reason, "min_valid_fraction", "must be in [0, 1]");
-    if (!finite_in(occluded_centre_max_fraction, 0, 1))
-      return invalid_option(reason, "occluded_centre_max_fraction", "must be in [0, 1]");
-    if (!finite_in(occluded_cluster_fraction, 0, 1))
-      return invalid_option(reason, "occluded_cluster_fraction", "must be in [0, 1]");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -713,12 +690,12 @@ void box_corner_and_centre_depths(const DepthView<Raw>& v, const RawRange<Raw>& 
   const int x0 = rc.c0, y0 = rc.r0, x1 = rc.c1 - 1, y1 = rc.r1 - 1;
   const int cu = (x0 + x1) / 2, cv = (y0 + y1) / 2;  // integer centre, as DLD-SLAM's reference code
   if (o.mode == DepthMaskMode::Robust) {
-    const int steps = o.corner_search_px >= 0 ? o.corner_search_px : std::min(rc.width(), rc.height()) / 2;
+    const int steps = std::min(rc.width(), rc.height()) / 2;
     corner[0] = walk_inwards(v, range, x0, y0, 1, 1, steps, rc);
     corner[1] = walk_inwards(v, range, x1, y0, -1, 1, steps, rc);
     corner[2] = walk_inwards(v, range, x0, y1, 1, -1, steps, rc);
     corner[3] = walk_inwards(v, range, x1, y1, -1, -1, steps, rc);
-    *dc = patch_lower_median(v, range, cu, cv, o.centre_patch_radius_px, rc);
+    *dc = patch_lower_median(v, range, cu, cv, DepthMaskOptions::kCentrePatchRadiusPx, rc);
     return;
   }
   const int cx[4] = {x0, x1, x0, x1}, cy[4] = {y0, y0, y1, y1};
@@ -730,22 +707,19 @@ void box_corner_and_centre_depths(const DepthView<Raw>& v, const RawRange<Raw>& 
   *dc = raw_valid(d, range) ? static_cast<double>(d) : 0.0;
 }
 
-/// The histogram of the rect's depths sampled every `step` pixels (histogram_stride_px, or the stride
-/// giving about histogram_target_samples), in bins of bin_raw; bin nb counts the pixels without depth.
+/// The histogram of the rect's depths sampled every `step` pixels (the stride giving about
+/// kHistogramTargetSamples), in bins of bin_raw; bin nb counts the pixels without depth.
 /// Returns the samples taken. Neighbouring pixels mostly fall in the same bin, so a single histogram
 /// serialises on its own increments (store to load forwarding): four interleaved copies, summed after,
 /// let them overlap.
 template <class Raw>
 std::size_t depth_histogram(const DepthView<Raw>& v, const RawRange<Raw>& range, const PixelRect& rc,
-                            const DepthMaskOptions& o, double bin_raw, int nb, std::vector<std::uint32_t>* histogram) {
+                            double bin_raw, int nb, std::vector<std::uint32_t>* histogram) {
   const std::size_t nh = static_cast<std::size_t>(nb) + 1;
   std::vector<std::uint32_t>& hist4 = *histogram;
   hist4.assign(4 * nh, 0u);
-  int step = o.histogram_stride_px;
-  if (step <= 0) {
-    const double per_sample = static_cast<double>(rc.area()) / std::max(1, o.histogram_target_samples);
-    step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
-  }
+  const double per_sample = static_cast<double>(rc.area()) / DepthMaskOptions::kHistogramTargetSamples;
+  const int step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
   const float inv_bin = static_cast<float>(1.0 / bin_raw);
   const float vlo = static_cast<float>(range.lo), vhi = static_cast<float>(range.hi);
   // Bin index clamped in float before the conversion (a valid float depth may be 1e20 m).
@@ -776,15 +750,15 @@ std::size_t depth_histogram(const DepthView<Raw>& v, const RawRange<Raw>& range,
 }
 
 /// The last bin of the foreground cluster: from d_c's bin (or, without d_c, the nearest bin holding 5 %
-/// of the valid pixels) onwards over bins holding histogram_occupied_fraction of them, across gaps of at
-/// most histogram_max_gap_bins, no deeper than max_object_depth_extent_m behind the seed. `seed_raw`
+/// of the valid pixels) onwards over bins holding kHistogramOccupiedFraction of them, across gaps of at
+/// most kHistogramMaxGapBins, no deeper than max_object_depth_extent_m behind the seed. `seed_raw`
 /// receives the seed depth.
 inline int foreground_cluster_end(const std::uint32_t* hist, int nb, std::size_t valid, double dc, double bin_raw,
                                   double upm, const DepthMaskOptions& o, double* seed_raw) {
   const float inv_bin = static_cast<float>(1.0 / bin_raw);
   // checked: a fraction in [0, 1] (validate) of the valid pixel count, which fits 32 bits.
   const auto occupied = static_cast<std::uint32_t>(
-      std::max(1.0, std::ceil(o.histogram_occupied_fraction * static_cast<double>(valid))));  // checked: above
+      std::max(1.0, std::ceil(DepthMaskOptions::kHistogramOccupiedFraction * static_cast<double>(valid))));  // checked: above
   int start = -1;
   if (dc > 0) {
     start = detail::clamped_bin(dc * inv_bin, nb);
@@ -801,7 +775,7 @@ inline int foreground_cluster_end(const std::uint32_t* hist, int nb, std::size_t
     if (hist[static_cast<std::size_t>(b)] >= occupied) {
       end = b;
       gap = 0;
-    } else if (++gap > o.histogram_max_gap_bins) {
+    } else if (++gap > DepthMaskOptions::kHistogramMaxGapBins) {
       break;
     }
   }
@@ -857,10 +831,10 @@ void plan_box(const DepthView<Raw>& v, const RawRange<Raw>& range, const Box<T>&
     info.reason = "rule does not apply (d_max - d_c <= eps)";
   } else {
     // Histogram fallback: the foreground cluster that holds d_c (or the nearest big cluster).
-    const double bin_raw = std::max(o.histogram_bin_m, 1e-3) * upm;
-    const int nb = clamped_int(std::ceil(o.histogram_max_m / std::max(o.histogram_bin_m, 1e-3)), 1,
+    const double bin_raw = DepthMaskOptions::kHistogramBinM * upm;
+    const int nb = clamped_int(std::ceil(DepthMaskOptions::kHistogramMaxM / DepthMaskOptions::kHistogramBinM), 1,
                                std::numeric_limits<int>::max() - 1);
-    const std::size_t sampled = depth_histogram(v, range, rc, o, bin_raw, nb, histogram);
+    const std::size_t sampled = depth_histogram(v, range, rc, bin_raw, nb, histogram);
     const std::uint32_t* hist = histogram->data();
     const std::size_t valid = sampled - hist[static_cast<std::size_t>(nb)];
     info.num_valid_pixels = valid;
@@ -888,13 +862,13 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
   const int cu = (rb.c0 + rb.c1 - 1) / 2, cv = (rb.r0 + rb.r1 - 1) / 2;
   if (!(cu >= ra.c0 && cu < ra.c1 && cv >= ra.r0 && cv < ra.r1)) return false;
   if (!(a.d_c_m > 0 && b->d_c_m > 0) || std::abs(a.d_c_m - b->d_c_m) > o.eps_m) return false;
-  // Samples of b outside a, about 4096 of them, in a histogram of 0.1 m bins up to histogram_max_m.
+  // Samples of b outside a, about 4096 of them, in a histogram of 0.1 m bins up to kHistogramMaxM.
   const double upm = static_cast<double>(v.units_per_metre);
-  const double bin_m = std::max(o.histogram_bin_m, 1e-3);
-  const int nb = clamped_int(std::ceil(o.histogram_max_m / bin_m), 3, std::numeric_limits<int>::max());
+  const double bin_m = DepthMaskOptions::kHistogramBinM;
+  const int nb = clamped_int(std::ceil(DepthMaskOptions::kHistogramMaxM / bin_m), 3, std::numeric_limits<int>::max());
   std::vector<std::uint32_t>& hist = *histogram;
   hist.assign(static_cast<std::size_t>(nb), 0u);
-  const double per_sample = static_cast<double>(rb.area()) / std::max(1, o.histogram_target_samples);
+  const double per_sample = static_cast<double>(rb.area()) / DepthMaskOptions::kHistogramTargetSamples;
   const int step = clamped_int(std::ceil(std::sqrt(per_sample)), 1, std::numeric_limits<int>::max());
   std::size_t valid = 0, near_centre = 0;
   for (int y = rb.r0; y < rb.r1; y += step) {
@@ -909,9 +883,10 @@ bool replan_occluded_centre(const DepthView<Raw>& v, const RawRange<Raw>& range,
       ++hist[static_cast<std::size_t>(clamped_bin(m / bin_m, nb))];
     }
   }
-  if (valid < 50 || static_cast<double>(near_centre) >= o.occluded_centre_max_fraction * static_cast<double>(valid))
+  if (valid < 50 ||
+      static_cast<double>(near_centre) >= DepthMaskOptions::kOccludedCentreMaxFraction * static_cast<double>(valid))
     return false;
-  const double need = o.occluded_cluster_fraction * static_cast<double>(valid);
+  const double need = DepthMaskOptions::kOccludedClusterFraction * static_cast<double>(valid);
   const int first = std::min(nb - 3, clamped_bin((a.d_c_m + o.eps_m) / bin_m, nb) + 1);
   for (int k = std::max(0, first); k + 2 < nb; ++k) {
     const double in_window = static_cast<double>(hist[static_cast<std::size_t>(k)]) + hist[static_cast<std::size_t>(k + 1)] +
@@ -986,7 +961,7 @@ DepthMaskBoxInfo depth_mask_box(const DepthView<Raw>& depth, const Box<T>& box, 
   std::vector<std::uint32_t> histogram;
   detail::plan_box(depth, range, box, options, &histogram, &info, &band);
   if (info.ok() && !out.empty())
-    info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, band, options.mask_value, out);
+    info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, band, DepthMaskOptions::kMaskValue, out);
   return info;
 }
 
@@ -1089,7 +1064,7 @@ void depth_mask(const DepthView<Raw>& depth, const Boxes& boxes, const Points& p
     for (std::size_t b = 0; b < r.boxes.size(); ++b) {
       DepthMaskBoxInfo& info = r.boxes[b];
       if (!info.ok()) continue;
-      info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, bands[b], options.mask_value, out);
+      info.num_mask_pixels = detail::rasterise_band(depth, range, info.rect, bands[b], DepthMaskOptions::kMaskValue, out);
       r.num_mask_pixels += info.num_mask_pixels;
     }
   }

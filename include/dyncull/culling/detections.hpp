@@ -5,7 +5,8 @@
 ///
 /// API:
 ///   Box<T> yolo_to_pixel_box(const YoloBox<T>&, int width, int height, const Letterbox<T>& = {});
-///   DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>&, int w, int h, const DetectionOptions<T>&);
+///   DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>&, int w, int h, const DetectionOptions<T>&,
+///                                               const Letterbox<T>& = {});
 ///   DetectionsResult<T> filter_detections(const std::vector<Detection<T>>& pixel_boxes, int w, int h, const DetectionOptions<T>&);
 ///   YoloParseResult<T> parse_yolo_lines(std::string_view text, const std::string& source = "");  // "class cx cy w h [conf]" per line
 ///   add_yolo_line(line, line_chars, line_no, source, &result); finish_yolo_lines(&result);  // the same, streamed
@@ -57,6 +58,24 @@ struct Letterbox {
     lb.pad_y = (T(in_h) - lb.scale * T(image_height)) / T(2);
     return lb;
   }
+
+  /// Ok, or InvalidInput naming the first bad field: a letterbox in use (input_width or input_height set)
+  /// needs both sizes positive, a finite scale > 0 and finite pads.
+  Status validate(std::string* reason = nullptr) const {
+    auto bad = [&](const char* why) {
+      if (reason) *reason = why;
+      return Status::InvalidInput;
+    };
+    if (input_width != 0 || input_height != 0) {
+      if (input_width <= 0) return bad("letterbox.input_width must be positive when a letterbox is set");
+      if (input_height <= 0) return bad("letterbox.input_height must be positive when a letterbox is set");
+      if (!(scale > T(0)) || !std::isfinite(scale)) return bad("letterbox.scale must be positive and finite");
+      if (!std::isfinite(pad_x)) return bad("letterbox.pad_x must be finite");
+      if (!std::isfinite(pad_y)) return bad("letterbox.pad_y must be finite");
+    }
+    if (reason) reason->clear();
+    return Status::Ok;
+  }
 };
 
 /// Why a detection was dropped.
@@ -86,15 +105,13 @@ struct DetectionOptions {
   /// (SG-SLAM: 0.1 for person vs 0.985 for other classes).
   T min_confidence_person = T(0.25);
   int person_class_id = 0;
-  Letterbox<T> letterbox;
 
   T threshold_for(int class_id) const {
     return class_id == person_class_id ? min_confidence_person : min_confidence;
   }
 
   /// Ok, or InvalidInput naming the first bad field: box_padding_px finite; min_confidence and
-  /// min_confidence_person in [0, 1]; a letterbox in use (input_width or input_height set) needs both sizes
-  /// positive, a finite scale > 0 and finite pads.
+  /// min_confidence_person in [0, 1].
   Status validate(std::string* reason = nullptr) const {
     auto bad = [&](const std::string& why) {
       if (reason) *reason = why;
@@ -104,14 +121,6 @@ struct DetectionOptions {
     if (!std::isfinite(box_padding_px)) return bad("box_padding_px must be finite");
     if (!unit(min_confidence)) return bad("min_confidence must be in [0, 1]");
     if (!unit(min_confidence_person)) return bad("min_confidence_person must be in [0, 1]");
-    if (letterbox.input_width != 0 || letterbox.input_height != 0) {
-      if (letterbox.input_width <= 0) return bad("letterbox.input_width must be positive when a letterbox is set");
-      if (letterbox.input_height <= 0) return bad("letterbox.input_height must be positive when a letterbox is set");
-      if (!(letterbox.scale > T(0)) || !std::isfinite(letterbox.scale))
-        return bad("letterbox.scale must be positive and finite");
-      if (!std::isfinite(letterbox.pad_x)) return bad("letterbox.pad_x must be finite");
-      if (!std::isfinite(letterbox.pad_y)) return bad("letterbox.pad_y must be finite");
-    }
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -193,26 +202,29 @@ void finish(DetectionsResult<T>* r, int width, int height) {
 }
 }  // namespace detail
 
-/// Converts, filters, pads and clips YOLO boxes. Rejected boxes do not make the call fail: status
+/// Converts, filters, pads and clips YOLO boxes, undoing the letterbox the detector fitted the image
+/// into (none: the boxes are normalised to the image). Rejected boxes do not make the call fail: status
 /// stays Ok and `reason` / `rejections` say what was dropped. InvalidInput (no boxes kept, no
-/// rejections listed) for a bad image size or options that fail DetectionOptions::validate.
+/// rejections listed) for a bad image size, options that fail DetectionOptions::validate or a letterbox
+/// that fails Letterbox::validate.
 template <class T>
 DetectionsResult<T> convert_yolo_detections(const std::vector<YoloBox<T>>& boxes, int width, int height,
-                                            const DetectionOptions<T>& options = {}) {
+                                            const DetectionOptions<T>& options = {},
+                                            const Letterbox<T>& letterbox = {}) {
   DetectionsResult<T> r;
   r.num_input = boxes.size();
   if (width <= 0 || height <= 0) {
     detail::finish(&r, width, height);
     return r;
   }
-  if (options.validate(&r.reason) != Status::Ok) {
+  if (options.validate(&r.reason) != Status::Ok || letterbox.validate(&r.reason) != Status::Ok) {
     r.status = Status::InvalidInput;
     return r;
   }
   r.rejections.reserve(boxes.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const YoloBox<T>& b = boxes[i];
-    Box<T> px = yolo_to_pixel_box(b, width, height, options.letterbox);
+    Box<T> px = yolo_to_pixel_box(b, width, height, letterbox);
     // w, h are tested on the normalised input too: a NaN/negative size must not survive the letterbox.
     BoxRejection why = !(std::isfinite(b.cx) && std::isfinite(b.cy) && std::isfinite(b.w) && std::isfinite(b.h))
                            ? BoxRejection::NonFinite

@@ -56,32 +56,26 @@ struct DynamicProbabilityOptions {
   T threshold = T(0.55);
 
   /// Adaptive threshold t of eq. 5 (the paper never defines it): over the reference features'
-  /// residuals r, t = max(min_motion_threshold_px, median(r) + mad_scale * 1.4826 * MAD(r)):
-  /// the spread of the background's own flow (LK noise, parallax) plus a floor in pixels.
-  T min_motion_threshold_px = T(1.5);
-  T mad_scale = T(3);
+  /// residuals r, t = max(kMinMotionThresholdPx, median(r) + kMadScale * 1.4826 * MAD(r)):
+  /// the spread of the background's own flow (LK noise, parallax, 3 sigma) plus a floor in pixels.
+  static constexpr double kMinMotionThresholdPx = 1.5;
+  static constexpr double kMadScale = 3;
   /// Fewer reference features than this: all features form the reference (most of a frame is
-  /// static), and t = fallback_motion_threshold_px.
-  std::size_t min_reference_features = 8;
-  T fallback_motion_threshold_px = T(3);
+  /// static), and t = kFallbackMotionThresholdPx.
+  static constexpr std::size_t kMinReferenceFeatures = 8;
+  static constexpr double kFallbackMotionThresholdPx = 3;
 
   /// InvalidInput naming the first field out of its range: weights finite, >= 0 and summing to 1 (within
-  /// 1e-3); threshold finite; the pixel thresholds and mad_scale finite and >= 0.
+  /// 1e-3); threshold finite.
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
-    constexpr double kBig = 1e30;
     if (!finite_in(weight_semantic, 0, 1)) return invalid_option(reason, "weight_semantic", "must be in [0, 1]");
     if (!finite_in(weight_motion, 0, 1)) return invalid_option(reason, "weight_motion", "must be in [0, 1]");
     if (!finite_in(weight_temporal, 0, 1)) return invalid_option(reason, "weight_temporal", "must be in [0, 1]");
     if (!(std::abs(weight_semantic + weight_motion + weight_temporal - T(1)) < T(1e-3)))
       return invalid_option(reason, "weight_semantic + weight_motion + weight_temporal", "must be 1");
     if (!std::isfinite(threshold)) return invalid_option(reason, "threshold", "must be finite");
-    if (!finite_in(min_motion_threshold_px, 0, kBig))
-      return invalid_option(reason, "min_motion_threshold_px", "must be finite and >= 0");
-    if (!finite_in(mad_scale, 0, kBig)) return invalid_option(reason, "mad_scale", "must be finite and >= 0");
-    if (!finite_in(fallback_motion_threshold_px, 0, kBig))
-      return invalid_option(reason, "fallback_motion_threshold_px", "must be finite and >= 0");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -237,10 +231,10 @@ void dp_flow(const Prev& prev_points, const Curr& curr_points, const EgoMotion<T
 }
 
 /// The reference set of eq. 4: features with flow in no mask or in a low-level one; every feature with
-/// flow when fewer than min_reference_features are left.
+/// flow when fewer than kMinReferenceFeatures are left.
 template <class T>
-void dp_reference_set(const std::vector<MotionLevel>& levels, const DynamicProbabilityOptions<T>& o,
-                      DynamicProbabilityScratch<T>* scratch, DynamicProbabilityResult<T>* r) {
+void dp_reference_set(const std::vector<MotionLevel>& levels, DynamicProbabilityScratch<T>* scratch,
+                      DynamicProbabilityResult<T>* r) {
   const std::size_t n = levels.size();
   auto is_reference = [](MotionLevel l) { return l == MotionLevel::Ignore || l == MotionLevel::Low; };
   std::vector<std::size_t>& ref = scratch->ref;
@@ -248,7 +242,7 @@ void dp_reference_set(const std::vector<MotionLevel>& levels, const DynamicProba
   ref.reserve(n);
   for (std::size_t i = 0; i < n; ++i)
     if (scratch->has_flow[i] && is_reference(levels[i])) ref.push_back(i);
-  if (ref.size() < o.min_reference_features) {
+  if (ref.size() < DynamicProbabilityOptions<T>::kMinReferenceFeatures) {
     r->used_fallback = true;
     ref.clear();
     for (std::size_t i = 0; i < n; ++i)
@@ -282,14 +276,14 @@ void dp_reference_flow(DynamicProbabilityScratch<T>* scratch, DynamicProbability
     if (scratch->has_flow[i]) res[i] = (flow[i] - ref_flow).norm();
 }
 
-/// t of eq. 5, adaptive: median + mad_scale x 1.4826 MAD of the reference features' own residuals, at
-/// least min_motion_threshold_px; the fixed fallback threshold without a reference of its own.
+/// t of eq. 5, adaptive: median + kMadScale x 1.4826 MAD of the reference features' own residuals, at
+/// least kMinMotionThresholdPx; the fixed fallback threshold without a reference of its own.
 template <class T>
-void dp_motion_threshold(const DynamicProbabilityOptions<T>& o, DynamicProbabilityScratch<T>* scratch,
-                         DynamicProbabilityResult<T>* r) {
+void dp_motion_threshold(DynamicProbabilityScratch<T>* scratch, DynamicProbabilityResult<T>* r) {
+  using Options = DynamicProbabilityOptions<T>;
   const std::vector<std::size_t>& ref = scratch->ref;
   if (r->used_fallback || ref.empty()) {
-    r->motion_threshold_px = o.fallback_motion_threshold_px;
+    r->motion_threshold_px = T(Options::kFallbackMotionThresholdPx);
   } else {
     std::vector<T>& res = scratch->res;
     res.clear();
@@ -298,14 +292,15 @@ void dp_motion_threshold(const DynamicProbabilityOptions<T>& o, DynamicProbabili
     const T med = median_in_place(res);
     for (T& x : res) x = std::abs(x - med);
     const T mad = median_in_place(res);
-    const T t = med + o.mad_scale * T(1.4826) * mad;
-    r->motion_threshold_px = std::isfinite(t) ? std::max(o.min_motion_threshold_px, t) : o.min_motion_threshold_px;
+    const T floor_px = T(Options::kMinMotionThresholdPx);
+    const T t = med + T(Options::kMadScale) * T(1.4826) * mad;
+    r->motion_threshold_px = std::isfinite(t) ? std::max(floor_px, t) : floor_px;
   }
   if (r->used_fallback) {
     r->reason.assign("only ");  // built in place: a reused result keeps the string's capacity
     r->reason += std::to_string(r->num_reference);
     r->reason += " features with flow as reference (fewer than ";
-    r->reason += std::to_string(o.min_reference_features);
+    r->reason += std::to_string(Options::kMinReferenceFeatures);
     r->reason += " outside masks): fallback threshold used";
   }
 }
@@ -374,9 +369,9 @@ void dynamic_probability(const Prev& prev_points, const Curr& curr_points, const
                 "dynamic_probability: points must be containers of points");
   if (!detail::dp_start(curr_points.size(), prev_points.size(), levels.size(), track_ids, o, ego, out)) return;
   detail::dp_flow(prev_points, curr_points, ego, scratch, out);           // flow, F / H residuals
-  detail::dp_reference_set(levels, o, scratch, out);                      // eq. 4's static reference
+  detail::dp_reference_set(levels, scratch, out);                         // eq. 4's static reference
   if (ego.model == FlowModel::MeanFlow) detail::dp_reference_flow(scratch, out);  // eq. 4
-  detail::dp_motion_threshold(o, scratch, out);                           // t of eq. 5
+  detail::dp_motion_threshold(scratch, out);                              // t of eq. 5
   detail::dp_combine(levels, o, store, track_ids, scratch->has_flow, out);  // eq. 3 and 5
 }
 

@@ -48,18 +48,15 @@ struct KeyframeMatchOptions {
   /// Nearest / second-nearest ratio: a keyframe point is matched only when best <= ratio * second among
   /// its candidates (ORB-SLAM's 0.9 for guided search, 0.8 in Lowe 2004). 1 disables the test. In (0, 1].
   double ratio = 0.9;
-  /// Keep a pair only when the current keypoint's nearest keyframe point (over all keyframe points that
-  /// searched it) is the same keyframe point. Without it, a current keypoint chosen by several keyframe
-  /// points takes the one at the smallest distance (lowest index on a tie).
-  bool mutual_check = true;
   /// Side (px) of the grid cells the current keypoints are bucketed in; a radius of about a cell visits
-  /// 3 x 3 cells. The grid has at most 256 cells per side: a larger keypoint spread widens the cells. In [1, 4096].
-  double grid_cell_px = 16.0;
+  /// 3 x 3 cells. The grid has at most 256 cells per side: a larger keypoint spread widens the cells.
+  static constexpr double kGridCellPx = 16.0;
   /// Most current keypoints one keyframe point's search examines: when the grid cells its disc overlaps
   /// hold more, an even subsample of them (every k-th in cell order) is examined instead, and the search
   /// is counted in KeyframeMatchResult::searches_capped. Bounds the work by n_kf * max_candidates when
   /// keypoints cluster (thousands in a few pixels); cv::ORB's 1000 features of a 640 x 480 frame put at
-  /// most 512 in the cells of one 40 px search. In [1, 2^20].
+  /// most 512 in the cells of one 40 px search. Why you would change it: a tighter time budget per frame
+  /// with many more keypoints. In [1, 2^20].
   std::size_t max_candidates = 1024;
 
   static constexpr std::size_t kMaxCandidatesLimit = std::size_t(1) << 20;
@@ -75,7 +72,6 @@ struct KeyframeMatchOptions {
       return bad("radius_unpredicted_px", "must be in (0, 4096]");
     if (max_hamming < 0 || max_hamming > 2048) return bad("max_hamming", "must be in [0, 2048]");
     if (!(ratio > 0.0 && ratio <= 1.0)) return bad("ratio", "must be in (0, 1]");
-    if (!(grid_cell_px >= 1.0 && grid_cell_px <= 4096.0)) return bad("grid_cell_px", "must be in [1, 4096]");
     if (max_candidates < 1 || max_candidates > kMaxCandidatesLimit)
       return bad("max_candidates", "must be in [1, 2^20]");
     if (reason) reason->clear();
@@ -396,8 +392,8 @@ bool kfm_inputs_ok(std::size_t n_kf, std::size_t n_kf_points, DescriptorRows kf_
 /// per grid row. The grid spans the keypoints' own extent, not the camera's image size (which may be
 /// bogus): keypoints off the image are still found.
 template <class T, class CurKeypoints>
-void kfm_sort_current(const CurKeypoints& cur_keypoints, DescriptorRows cur_desc, const KeyframeMatchOptions& options,
-                      KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* r) {
+void kfm_sort_current(const CurKeypoints& cur_keypoints, DescriptorRows cur_desc, KeyframeMatchWorkspace<T>& ws,
+                      KeyframeMatchResult<T>* r) {
   const std::size_t n = cur_keypoints.size();
   ws.cur_x.resize(n);
   ws.cur_y.resize(n);
@@ -409,7 +405,7 @@ void kfm_sort_current(const CurKeypoints& cur_keypoints, DescriptorRows cur_desc
     r->current_nonfinite += finite ? 0 : 1;
   }
   constexpr int kMaxCellsPerSide = 256;
-  size_point_grid(ws.cur_x.data(), ws.cur_y.data(), n, options.grid_cell_px, kMaxCellsPerSide, &ws.grid);
+  size_point_grid(ws.cur_x.data(), ws.cur_y.data(), n, KeyframeMatchOptions::kGridCellPx, kMaxCellsPerSide, &ws.grid);
   const std::size_t n_sorted = n - r->current_nonfinite;
   const std::size_t row_bytes = cur_desc.row_bytes;
   ws.sorted_x.resize(n_sorted);
@@ -516,8 +512,8 @@ void kfm_search(DescriptorRows kf_desc, std::size_t row_bytes, const KeyframeMat
 }
 
 /// Accepts a keyframe point's nearest keypoint on distance and ratio (Lowe's test against its second
-/// nearest) and, with mutual_check, only when the keypoint's nearest is that point; a keypoint claimed by
-/// several keyframe points keeps the closest (the earliest on a tie).
+/// nearest) and only when the keypoint's nearest over all keyframe points that searched it is that point
+/// (mutual); a keypoint claimed by several keyframe points keeps the closest (the earliest on a tie).
 template <class T, class KfKeypoints>
 void kfm_accept(const KfKeypoints& kf_keypoints, const KeyframeMatchOptions& options,
                 const KeyframeMatchWorkspace<T>& ws, KeyframeMatchResult<T>* out) {
@@ -528,7 +524,7 @@ void kfm_accept(const KfKeypoints& kf_keypoints, const KeyframeMatchOptions& opt
     const int d = ws.kf_best_dist[k], second = ws.kf_second_dist[k];
     if (d > options.max_hamming) continue;
     if (second != std::numeric_limits<int>::max() && !(double(d) <= options.ratio * double(second))) continue;
-    if (options.mutual_check && ws.cur_best_kf[static_cast<std::size_t>(c)] != static_cast<int>(k)) continue;
+    if (ws.cur_best_kf[static_cast<std::size_t>(c)] != static_cast<int>(k)) continue;
     const std::size_t ci = ws.sorted_index[static_cast<std::size_t>(c)];
     if (r.keyframe_index[ci] >= 0 && r.distance[ci] <= d) continue;
     if (r.keyframe_index[ci] < 0) ++r.matched;
@@ -571,7 +567,7 @@ void match_to_keyframe(const KfKeypoints& kf_keypoints, const KfPoints& kf_point
   if (!detail::kfm_inputs_ok(kf_keypoints.size(), kf_points.size(), kf_desc, cur_keypoints.size(), cur_desc, camera,
                              cam_from_keyframe, options, &r))
     return;
-  detail::kfm_sort_current(cur_keypoints, cur_desc, options, ws, &r);
+  detail::kfm_sort_current(cur_keypoints, cur_desc, ws, &r);
   detail::kfm_predict(kf_keypoints, kf_points, camera, cam_from_keyframe, ws, &r);
   detail::kfm_search(kf_desc, cur_desc.row_bytes, options, ws, &r);
   detail::kfm_accept(kf_keypoints, options, ws, &r);

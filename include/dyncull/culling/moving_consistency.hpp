@@ -26,8 +26,11 @@ namespace dyncull {
 /// SG-SLAM variants (fit outside boxes, tighter threshold inside boxes) act only when box flags are given.
 template <class T>
 struct MovingConsistencyOptions {
-  /// F-RANSAC; fundamental.ransac.max_residual is a Sampson distance in px (about eq. 3 / sqrt(2)).
-  FundamentalOptions<T> fundamental{};
+  /// F-RANSAC's inlier threshold, a Sampson distance in px (about eq. 3 / sqrt(2)): SG-SLAM's 1 px.
+  static constexpr double kRansacSampsonPx = 1.0;
+  /// F-RANSAC's confidence of having drawn one all-inlier sample (SG-SLAM's 0.99).
+  static constexpr double kRansacConfidence = 0.99;
+
   T max_epipolar_distance_px = T(1);  ///< eq. 3 distance above this: dynamic (DS-SLAM limit_dis_epi)
   /// Threshold for tracks flagged as inside a dynamic-class box (SG-SLAM uses 0.2 px inside person boxes).
   /// Default 0.5 px: about 1.5 sigma of LK noise, so a still person is not flagged wholesale.
@@ -43,17 +46,24 @@ struct MovingConsistencyOptions {
   /// on its own inliers (docs/algorithms.md).
   int refit_iterations = 2;
   static constexpr int kMaxRefitIterations = 100;  ///< upper bound of refit_iterations (each is one 8-point fit)
+  /// F-RANSAC's sample cap. Why you would change it: to bound the worst frame's time on a slow CPU (a
+  /// frame with few static tracks, or random ones, runs to the cap; a usual frame stops far earlier).
+  std::size_t max_ransac_iterations = 10000;
 
-  MovingConsistencyOptions() {
-    // The homography test of fundamental.hpp fires at small baselines, where F on the static tracks is
-    // still well determined; and under pure rotation any F = [e]x H keeps static tracks at distance 0,
-    // so the labels stay meaningful. Off by default here.
-    fundamental.check_homography_degeneracy = false;
+  /// The F fit's solver settings: the constants above, and no homography test: it fires at small
+  /// baselines, where F on the static tracks is still well determined; and under pure rotation any
+  /// F = [e]x H keeps static tracks at distance 0, so the labels stay meaningful.
+  FundamentalOptions<T> fundamental_fit() const {
+    FundamentalOptions<T> f;
+    f.ransac.max_residual = kRansacSampsonPx;
+    f.ransac.confidence = kRansacConfidence;
+    f.ransac.max_iterations = max_ransac_iterations;
+    f.check_homography_degeneracy = false;
+    return f;
   }
 
   /// InvalidInput naming the first field out of its range: both epipolar thresholds positive and finite,
-  /// refit_iterations in [0, kMaxRefitIterations], fundamental (and fundamental.ransac) passing their own
-  /// validate().
+  /// refit_iterations in [0, kMaxRefitIterations], max_ransac_iterations in [1, RansacOptions::kMaxIterations].
   Status validate(std::string* reason = nullptr) const {
     using detail::invalid_option;
     if (!(max_epipolar_distance_px > T(0)) || !std::isfinite(max_epipolar_distance_px))
@@ -62,9 +72,8 @@ struct MovingConsistencyOptions {
       return invalid_option(reason, "max_epipolar_distance_in_boxes_px", "must be positive and finite");
     if (refit_iterations < 0 || refit_iterations > kMaxRefitIterations)
       return invalid_option(reason, "refit_iterations", "must be in [0, 100]");
-    if (detail::validate_nested(fundamental, "fundamental", reason) != Status::Ok) return Status::InvalidInput;
-    if (detail::validate_nested(fundamental.ransac, "fundamental.ransac", reason) != Status::Ok)
-      return Status::InvalidInput;
+    if (max_ransac_iterations < 1 || max_ransac_iterations > RansacOptions::kMaxIterations)
+      return invalid_option(reason, "max_ransac_iterations", "must be in [1, 1e7]");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -158,7 +167,7 @@ struct EpipolarEstimator {
   /// tracks (static camera, pure rotation, planar scene), so F's epipolar lines carry no evidence of motion.
   bool fit() {
     FundamentalResult<T>& fr = r->scratch_ransac_fit;
-    estimate_fundamental_ransac(fit_prev(), fit_cur(), options.fundamental, &r->scratch_fundamental, &fr);
+    estimate_fundamental_ransac(fit_prev(), fit_cur(), options.fundamental_fit(), &r->scratch_fundamental, &fr);
     const std::vector<std::uint32_t>& fit_index = subset ? r->scratch_fit_index : r->scratch_index;
     for (std::size_t k = 0; k < fr.inlier_mask.size(); ++k) r->inlier_mask[fit_index[k]] = fr.inlier_mask[k];
     r->num_inliers = fr.num_inliers;

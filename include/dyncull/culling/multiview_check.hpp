@@ -35,13 +35,14 @@ struct MultiViewOptions {
   T depth_threshold_m = T(0.4);      ///< tau_d of RTD-SLAM (DynaSLAM's code uses 0.6)
   int search_radius_px = 2;          ///< d' is the valid depth closest to d_proj in a (2r+1)^2 window (DynaSLAM: 20)
   T max_reference_depth_m = T(6);    ///< keyframe keypoints deeper than this are not used (DynaSLAM)
-  T max_projected_depth_m = T(7);    ///< projections deeper than this are not used (DynaSLAM)
+  static constexpr double kMaxProjectedDepthM = 7;  ///< projections deeper than this are not used (DynaSLAM)
   T border_px = T(0);                ///< projections closer than this to the image edge are not used
-  T region_depth_tolerance_m = T(0.2);  ///< region growing: |d - d_seed| below this joins the region
+  /// Region growing: |d - d_seed| below this joins the region (DynaSLAM's code).
+  static constexpr double kRegionDepthToleranceM = 0.2;
 
   /// InvalidInput naming the first field out of its range: max_parallax_deg in (0, 180];
-  /// depth_threshold_m > 0; search_radius_px in [0, 256]; the depth gates > 0 (not NaN; +Inf = no gate);
-  /// border_px and region_depth_tolerance_m finite and >= 0.
+  /// depth_threshold_m > 0; search_radius_px in [0, 256]; max_reference_depth_m > 0 (not NaN; +Inf = no
+  /// gate); border_px finite and >= 0.
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -52,10 +53,7 @@ struct MultiViewOptions {
     if (search_radius_px < 0 || search_radius_px > 256)
       return invalid_option(reason, "search_radius_px", "must be in [0, 256]");
     if (!(max_reference_depth_m > T(0))) return invalid_option(reason, "max_reference_depth_m", "must be positive");
-    if (!(max_projected_depth_m > T(0))) return invalid_option(reason, "max_projected_depth_m", "must be positive");
     if (!finite_in(border_px, 0, 1e9)) return invalid_option(reason, "border_px", "must be finite and >= 0");
-    if (!finite_in(region_depth_tolerance_m, 0, 1e9))
-      return invalid_option(reason, "region_depth_tolerance_m", "must be finite and >= 0");
     if (reason) reason->clear();
     return Status::Ok;
   }
@@ -65,7 +63,7 @@ struct MultiViewOptions {
 enum class MultiViewOutcome : std::uint8_t {
   Checked = 0,         ///< compared; label is Static or Dynamic
   NoReferenceDepth,    ///< keyframe depth missing, non-positive or above max_reference_depth_m
-  BehindCamera,        ///< projects behind the current camera or beyond max_projected_depth_m
+  BehindCamera,        ///< projects behind the current camera or beyond kMaxProjectedDepthM
   OutsideImage,        ///< projects outside the current image (or inside the border)
   LargeParallax,       ///< viewing rays differ by more than max_parallax_deg: skipped
   NoMeasuredDepth,     ///< no valid current depth around x'
@@ -194,7 +192,7 @@ MultiViewOutcome multiview_observe(T u, T v, T d, const Rigid3<T>& cur_from_ref,
   if (!(d > T(0)) || d > options.max_reference_depth_m) return MultiViewOutcome::NoReferenceDepth;
   const Vec3<T> X_ref = camera.backproject(Vec2<T>(u, v), d);
   const Vec3<T> X_cur = cur_from_ref.apply(X_ref);
-  if (!(X_cur.z() > T(0)) || X_cur.z() > options.max_projected_depth_m) return MultiViewOutcome::BehindCamera;
+  if (!(X_cur.z() > T(0)) || X_cur.z() > T(MultiViewOptions<T>::kMaxProjectedDepthM)) return MultiViewOutcome::BehindCamera;
   *x = camera.project(X_cur);
   *z = X_cur.z();
   if (!camera.in_image(x->x(), x->y(), options.border_px)) return MultiViewOutcome::OutsideImage;
@@ -265,15 +263,14 @@ MultiViewResult<T> check_multiview(const C& ref_points, const D& ref_depths_m, c
 }
 
 /// Grows the dynamic seeds x' of `result` over the current depth image (4-neighbour flood fill, pixels
-/// within region_depth_tolerance_m of the seed's measured depth d'), OR-ing into `mask` (same size as the
+/// within kRegionDepthToleranceM of the seed's measured depth d'), OR-ing into `mask` (same size as the
 /// depth image; resized and cleared when its size differs). DynaSLAM does the same before dilating.
 /// `stack` is caller-owned scratch, reused across frames. `roi` (optional) limits seeds and growth to
 /// a pixel rectangle (the pipeline passes the region of the features it still has to decide).
 /// Returns the number of pixels set.
 template <class Raw, class T>
-std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const DepthView<Raw>& depth,
-                                   const MultiViewOptions<T>& options, Mask* mask, std::vector<std::uint32_t>* stack,
-                                   const PixelRect* roi = nullptr) {
+std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const DepthView<Raw>& depth, Mask* mask,
+                                   std::vector<std::uint32_t>* stack, const PixelRect* roi = nullptr) {
   const std::size_t nr = result.labels.size();
   if (depth.empty() || depth.validate() != Status::Ok || result.projected.size() != nr ||
       result.measured_depth_m.size() != nr)
@@ -284,7 +281,7 @@ std::size_t grow_multiview_regions(const MultiViewResult<T>& result, const Depth
   if (mask->width != w || mask->height != h) mask->reset(w, h, 0);
   std::uint8_t* m = mask->pixels.data();
   std::size_t set = 0;
-  const T tol = options.region_depth_tolerance_m;
+  const T tol = T(MultiViewOptions<T>::kRegionDepthToleranceM);
   const double units = static_cast<double>(depth.units_per_metre);
   for (std::size_t i = 0; i < result.labels.size(); ++i) {
     if (result.labels[i] != FeatureLabel::Dynamic) continue;

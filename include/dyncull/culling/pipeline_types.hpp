@@ -148,21 +148,21 @@ struct ReprojectionStageOptions : ReprojectionCheckOptions<T> {
 
 /// Geometric flags on occlusion edges discounted (needs the depth image): an LK window straddling an
 /// occlusion edge follows the contour, not a 3-D point, and is flagged although its surface is static.
-/// A flag with a depth step above depth_step_ratio within radius_px (sampled every 2 px) becomes Candidate.
+/// A flag with a depth step above kDepthStepRatio within radius_px (sampled every 2 px) becomes Candidate.
 struct EdgeEvidenceOptions {
   bool enabled = false;
+  /// How far from an occlusion edge a flag is discounted. Why you would change it: the LK window of your
+  /// front end (the demo's is 21 x 21 px, so a flag 8 px from an edge may straddle it).
   int radius_px = 8;
-  double depth_step_ratio = 0.05;
+  /// A depth step: neighbouring depths differing by more than this share (5 %, several Kinect sigmas).
+  static constexpr double kDepthStepRatio = 0.05;
 
   static constexpr int kMaxRadiusPx = 64;
 
-  /// InvalidInput naming the first field out of its range: radius_px in [1, 64], depth_step_ratio finite
-  /// and >= 0.
+  /// InvalidInput naming the first field out of its range: radius_px in [1, 64].
   Status validate(std::string* reason = nullptr) const {
     if (radius_px < 1 || radius_px > kMaxRadiusPx)
       return detail::invalid_option(reason, "radius_px", "must be in [1, 64]");
-    if (!detail::finite_in(depth_step_ratio, 0, 1e30))
-      return detail::invalid_option(reason, "depth_step_ratio", "must be finite and >= 0");
     if (reason) reason->clear();
     return Status::Ok;
   }

@@ -29,9 +29,13 @@ namespace dyncull {
 /// Options. The thresholds are pixel reprojection errors at the fitted pose.
 template <class T>
 struct ReprojectionCheckOptions {
-  /// PnP-RANSAC on the fit subset (P3P + MSAC + LM, geometry/pnp.hpp). Inlier threshold 2 px as the
-  /// demo front end; 300 samples reach 0.999 confidence down to about 20 % outliers (outside boxes).
-  PnpOptions<T> pnp = default_pnp();
+  /// PnP-RANSAC's inlier threshold in px on the fit subset (P3P + MSAC + LM, geometry/pnp.hpp), as the
+  /// demo front end; its confidence of having drawn one all-inlier sample.
+  static constexpr double kRansacThresholdPx = 2.0;
+  static constexpr double kRansacConfidence = 0.999;
+  /// PnP-RANSAC's sample cap: 300 samples reach 0.999 confidence down to about 20 % outliers (outside
+  /// boxes). Why you would change it: more outliers among the fit tracks, or a tighter time budget.
+  std::size_t max_ransac_iterations = 300;
   T max_residual_px = T(3);           ///< residual above this: dynamic (tracks outside dynamic boxes)
   /// Threshold inside dynamic-class boxes. Measured on the dynamic_vo sim at the front end's own pose: 2 px
   /// is exceeded by 4-7 % of the tracks on still chairs and a seated person's legs, against 77 % of the
@@ -47,14 +51,14 @@ struct ReprojectionCheckOptions {
   /// at 3 m). The pixel residual is blind to motion along the viewing ray: a walker heading for the camera
   /// at 0.4 m/s moves 1.3 cm a frame in depth and a fraction of a pixel in the image. 0 = off.
   T max_depth_residual_sigmas = T(0);
-  T depth_sigma_base_m = T(0.0012);
-  T depth_sigma_quadratic = T(0.0019);
-  T depth_sigma_reference_m = T(0.4);
+  /// The Kinect axial noise model's base, quadratic term and reference depth (Nguyen et al. 2012).
+  static constexpr double kDepthSigmaBaseM = 0.0012;
+  static constexpr double kDepthSigmaQuadratic = 0.0019;
+  static constexpr double kDepthSigmaReferenceM = 0.4;
   std::size_t min_tracks = 15;  ///< fewer usable tracks: Skipped
 
   /// InvalidInput naming the first field out of its range: the pixel thresholds positive and finite;
-  /// max_depth_residual_sigmas and the depth noise model finite and >= 0; pnp (and pnp.ransac) passing
-  /// their own validate().
+  /// max_depth_residual_sigmas finite and >= 0; max_ransac_iterations in [1, RansacOptions::kMaxIterations].
   Status validate(std::string* reason = nullptr) const {
     using detail::finite_in;
     using detail::invalid_option;
@@ -65,23 +69,19 @@ struct ReprojectionCheckOptions {
       return invalid_option(reason, "max_residual_in_boxes_px", "must be positive and finite");
     if (!finite_in(max_depth_residual_sigmas, 0, kBig))
       return invalid_option(reason, "max_depth_residual_sigmas", "must be finite and >= 0");
-    if (!finite_in(depth_sigma_base_m, 0, kBig))
-      return invalid_option(reason, "depth_sigma_base_m", "must be finite and >= 0");
-    if (!finite_in(depth_sigma_quadratic, 0, kBig))
-      return invalid_option(reason, "depth_sigma_quadratic", "must be finite and >= 0");
-    if (!finite_in(depth_sigma_reference_m, 0, kBig))
-      return invalid_option(reason, "depth_sigma_reference_m", "must be finite and >= 0");
-    if (detail::validate_nested(pnp, "pnp", reason) != Status::Ok) return Status::InvalidInput;
-    if (detail::validate_nested(pnp.ransac, "pnp.ransac", reason) != Status::Ok) return Status::InvalidInput;
+    if (max_ransac_iterations < 1 || max_ransac_iterations > RansacOptions::kMaxIterations)
+      return invalid_option(reason, "max_ransac_iterations", "must be in [1, 1e7]");
     if (reason) reason->clear();
     return Status::Ok;
   }
 
-  static PnpOptions<T> default_pnp() {
+  /// The pose fit's solver settings: the constants above, then Levenberg-Marquardt with a Huber loss
+  /// (geometry/pnp.hpp's defaults otherwise) on the inliers.
+  PnpOptions<T> pose_fit() const {
     PnpOptions<T> o;
-    o.ransac.max_residual = 2.0;
-    o.ransac.max_iterations = 300;
-    o.ransac.confidence = 0.999;
+    o.ransac.max_residual = kRansacThresholdPx;
+    o.ransac.max_iterations = max_ransac_iterations;
+    o.ransac.confidence = kRansacConfidence;
     o.refinement.huber = true;
     return o;
   }
@@ -146,8 +146,9 @@ bool reprojection_label(std::size_t i, const Vec3<T>& X, T u, T v, T limit, cons
     if (measured > 0.f) {
       const T dz = static_cast<T>(measured) - pc.z();
       r->depth_residual_m[i] = dz;
-      const T sigma = axial_depth_sigma_m(pc.z(), options.depth_sigma_base_m, options.depth_sigma_quadratic,
-                                          options.depth_sigma_reference_m);
+      using Options = ReprojectionCheckOptions<T>;
+      const T sigma = axial_depth_sigma_m(pc.z(), T(Options::kDepthSigmaBaseM), T(Options::kDepthSigmaQuadratic),
+                                          T(Options::kDepthSigmaReferenceM));
       const bool depth_dyn = std::abs(dz) > options.max_depth_residual_sigmas * T(1.4142135623730951) * sigma;
       r->num_depth_dynamic += depth_dyn && !dyn;
       dyn = dyn || depth_dyn;
@@ -232,7 +233,7 @@ struct ReprojectionEstimator {
 
   bool fit() {
     PnpResult<T>& pr = r->scratch_pose_fit;
-    solve_pnp_ransac(r->scratch_points, r->scratch_pixels, camera, options.pnp, &r->scratch_pnp, &pr);
+    solve_pnp_ransac(r->scratch_points, r->scratch_pixels, camera, options.pose_fit(), &r->scratch_pnp, &pr);
     if (!pr.ok() || !pr.cam_from_world.all_finite()) {
       r->status = pr.ok() ? Status::NonFinite : pr.status;
       r->reason.assign("pose not found: ").append(pr.ok() ? "non-finite pose" : pr.reason);  // into the kept buffer

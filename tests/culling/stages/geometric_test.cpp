@@ -124,7 +124,7 @@ TYPED_TEST(GeometricStageTest, FlagOnADepthEdgeIsNotEvidence) {
   f.paint_depth(u3 + 2, v3 - 3, u3 + 10, v3 + 4, 1.f);
   PipelineOptions<T> o;
   o.edge_evidence.enabled = true;
-  o.edge_evidence.radius_px = 4;  // depth_step_ratio 0.05
+  o.edge_evidence.radius_px = 4;  // kDepthStepRatio 0.05
   detail::PipelineWork<T> w;
   PipelineResult<T> r = test::fresh_result(o, f.size());
   detail::gather_geometric_evidence(f.frame(), o, w.regions, w.semantic, &w.geometric, &r);

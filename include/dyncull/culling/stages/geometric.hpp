@@ -106,7 +106,7 @@ void gather_geometric_evidence(const Frame& frame, const NonDeduced<GeometricSli
       if (g.labels[i] != FeatureLabel::Dynamic ||
           !keypoint_in_image<T>(kp, i, frame.depth.width, frame.depth.height, &u, &v))
         continue;
-      if (depth_step_near(frame.depth, u, v, options.edge_evidence.radius_px, options.edge_evidence.depth_step_ratio)) {
+      if (depth_step_near(frame.depth, u, v, options.edge_evidence.radius_px, EdgeEvidenceOptions::kDepthStepRatio)) {
         g.labels[i] = FeatureLabel::Candidate;
         ++discounted;
       }

@@ -105,7 +105,7 @@ struct MultiViewStage {
                       options, &m.check);
       if (m.check.num_checked == 0) continue;
       ++checked;
-      grow_multiview_regions(m.check, frame.depth, options, &m.mask, &m.flood_stack, &roi);
+      grow_multiview_regions(m.check, frame.depth, &m.mask, &m.flood_stack, &roi);
     }
     return checked;
   }
