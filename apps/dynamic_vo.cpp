@@ -151,99 +151,47 @@ bool parse_int(const std::string& option, const std::string& v, long lo, long hi
   return true;
 }
 
-bool parse_args(int argc, char** argv, Args* a) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](std::string* out) {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "dynamic_vo: %s needs a value\n", arg.c_str());
-        return false;
-      }
-      *out = argv[++i];
-      return true;
-    };
-    std::string v;
-    if (arg == "--help" || arg == "-h") {
-      usage(argv[0]);
-      std::exit(0);
-    } else if (arg == "--frames") {
-      if (!value(&v) || !parse_int(arg, v, 2, 100000, &a->frames)) return false;
-      a->frames_set = true;
-    } else if (arg == "--sequences") {
-      if (!value(&v)) return false;
-      a->sequences = split(v);
-      a->sequences_set = true;
-    } else if (arg == "--seeds") {
-      if (!value(&v)) return false;
-      a->seeds_set = true;
-      a->seeds.clear();
-      for (const std::string& item : split(v)) {
-        // Exact: from_chars refuses what does not fit (strtoull would saturate 2^64 to 2^64 - 1).
-        std::uint64_t seed = 0;
-        const std::from_chars_result r = std::from_chars(item.data(), item.data() + item.size(), seed);
-        if (r.ec != std::errc() || r.ptr != item.data() + item.size()) {
-          std::fprintf(stderr, "dynamic_vo: --seeds needs integers in [0, 18446744073709551615] (64-bit seeds), got %s\n",
-                       text::quote_token(item).c_str());
-          return false;
-        }
-        a->seeds.push_back(seed);
-      }
-      if (a->seeds.empty()) {
-        std::fprintf(stderr, "dynamic_vo: --seeds needs at least one seed\n");
-        return false;
-      }
-    } else if (arg == "--depth-edge-radius") {
-      if (!value(&v) || !parse_int(arg, v, 1, 32, &a->depth_edge_radius_px)) return false;
-    } else if (arg == "--strategies") {
-      if (!value(&v)) return false;
-      a->strategies = split(v);
-    } else if (arg == "--out") {
-      if (!value(&a->out)) return false;
-    } else if (arg == "--tum" || arg == "--dataset") {
-      if (!value(&a->tum)) return false;
-    } else if (arg == "--camera") {
-      if (!value(&a->camera)) return false;
-    } else if (arg == "--detections") {
-      if (!value(&a->detections)) return false;
-    } else if (arg == "--detector") {
-      if (!value(&a->detector)) return false;
-    } else if (arg == "--truth") {
-      if (!value(&a->truth)) return false;
-    } else if (arg == "--family") {
-      if (!value(&v)) return false;
-      a->families = split(v);
-      a->families_set = true;
-      for (const std::string& name : a->families) {
-        std::string reason;
-        if (!sim::find_scene_family(name, nullptr, &reason)) {
-          std::fprintf(stderr, "dynamic_vo: --family: %s\n", reason.c_str());
-          return false;
-        }
-      }
-      if (a->families.empty()) {
-        std::fprintf(stderr, "dynamic_vo: --family needs at least one family\n");
-        return false;
-      }
-    } else if (arg == "--scene") {
-      if (!value(&v)) return false;
-      a->scene += (a->scene.empty() ? "" : ",") + v;
-    } else if (arg == "--jobs") {
-      if (!value(&v) || !parse_int(arg, v, 1, 64, &a->jobs)) return false;
-    } else if (arg == "--tum-trajectories") {
-      if (!value(&a->tum_trajectories)) return false;
-    } else if (arg == "--suite") {
-      a->suite = true;
-    } else if (arg == "--quick") {
-      a->quick = true;
-    } else if (arg == "--diagnose") {
-      a->diagnose = true;
-    } else if (arg == "--list") {
-      a->list = true;
-    } else {
-      std::fprintf(stderr, "dynamic_vo: unknown option %s (try --help)\n", text::quote_token(arg).c_str());
+/// The --seeds list: 64-bit integers, at least one. False, after printing why.
+bool parse_seeds(const std::string& v, std::vector<std::uint64_t>* seeds) {
+  seeds->clear();
+  for (const std::string& item : split(v)) {
+    // Exact: from_chars refuses what does not fit (strtoull would saturate 2^64 to 2^64 - 1).
+    std::uint64_t seed = 0;
+    const std::from_chars_result r = std::from_chars(item.data(), item.data() + item.size(), seed);
+    if (r.ec != std::errc() || r.ptr != item.data() + item.size()) {
+      std::fprintf(stderr, "dynamic_vo: --seeds needs integers in [0, 18446744073709551615] (64-bit seeds), got %s\n",
+                   text::quote_token(item).c_str());
+      return false;
+    }
+    seeds->push_back(seed);
+  }
+  if (seeds->empty()) {
+    std::fprintf(stderr, "dynamic_vo: --seeds needs at least one seed\n");
+    return false;
+  }
+  return true;
+}
+
+/// The --family list: known family names, at least one. False, after printing why.
+bool check_families(const std::vector<std::string>& families) {
+  for (const std::string& name : families) {
+    std::string reason;
+    if (!sim::find_scene_family(name, nullptr, &reason)) {
+      std::fprintf(stderr, "dynamic_vo: --family: %s\n", reason.c_str());
       return false;
     }
   }
+  if (families.empty()) {
+    std::fprintf(stderr, "dynamic_vo: --family needs at least one family\n");
+    return false;
+  }
+  return true;
+}
+
+/// The options' combined rules and defaults once every option is read: --detector and --truth need
+/// --dataset, the trajectories default to DYNCULL_DATA_DIR/tum, --suite and --quick set families and
+/// frames, and the --scene assignments must apply to every family. False, after printing why.
+bool complete_args(Args* a) {
   if (!a->detector.empty() && (a->tum.empty() || !a->detections.empty())) {
     std::fprintf(stderr, "dynamic_vo: --detector runs on a recorded sequence (--dataset DIR) and replaces --detections\n");
     return false;
@@ -276,6 +224,77 @@ bool parse_args(int argc, char** argv, Args* a) {
     }
   }
   return true;
+}
+
+bool parse_args(int argc, char** argv, Args* a) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](std::string* out) {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "dynamic_vo: %s needs a value\n", arg.c_str());
+        return false;
+      }
+      *out = argv[++i];
+      return true;
+    };
+    std::string v;
+    if (arg == "--help" || arg == "-h") {
+      usage(argv[0]);
+      std::exit(0);
+    } else if (arg == "--frames") {
+      if (!value(&v) || !parse_int(arg, v, 2, 100000, &a->frames)) return false;
+      a->frames_set = true;
+    } else if (arg == "--sequences") {
+      if (!value(&v)) return false;
+      a->sequences = split(v);
+      a->sequences_set = true;
+    } else if (arg == "--seeds") {
+      if (!value(&v)) return false;
+      a->seeds_set = true;
+      if (!parse_seeds(v, &a->seeds)) return false;
+    } else if (arg == "--depth-edge-radius") {
+      if (!value(&v) || !parse_int(arg, v, 1, 32, &a->depth_edge_radius_px)) return false;
+    } else if (arg == "--strategies") {
+      if (!value(&v)) return false;
+      a->strategies = split(v);
+    } else if (arg == "--out") {
+      if (!value(&a->out)) return false;
+    } else if (arg == "--tum" || arg == "--dataset") {
+      if (!value(&a->tum)) return false;
+    } else if (arg == "--camera") {
+      if (!value(&a->camera)) return false;
+    } else if (arg == "--detections") {
+      if (!value(&a->detections)) return false;
+    } else if (arg == "--detector") {
+      if (!value(&a->detector)) return false;
+    } else if (arg == "--truth") {
+      if (!value(&a->truth)) return false;
+    } else if (arg == "--family") {
+      if (!value(&v)) return false;
+      a->families = split(v);
+      a->families_set = true;
+      if (!check_families(a->families)) return false;
+    } else if (arg == "--scene") {
+      if (!value(&v)) return false;
+      a->scene += (a->scene.empty() ? "" : ",") + v;
+    } else if (arg == "--jobs") {
+      if (!value(&v) || !parse_int(arg, v, 1, 64, &a->jobs)) return false;
+    } else if (arg == "--tum-trajectories") {
+      if (!value(&a->tum_trajectories)) return false;
+    } else if (arg == "--suite") {
+      a->suite = true;
+    } else if (arg == "--quick") {
+      a->quick = true;
+    } else if (arg == "--diagnose") {
+      a->diagnose = true;
+    } else if (arg == "--list") {
+      a->list = true;
+    } else {
+      std::fprintf(stderr, "dynamic_vo: unknown option %s (try --help)\n", text::quote_token(arg).c_str());
+      return false;
+    }
+  }
+  return complete_args(a);
 }
 
 bool motion_from_name(const std::string& name, sim::CameraMotion* m) {
@@ -383,6 +402,193 @@ int run_dataset_command(const Args& args, const std::vector<vo::StrategySpec>& c
   return 0;
 }
 
+/// The strategies to run: the default set, or the named ones behind the reference run "none" (the
+/// improvement column needs it). False, after printing why, for an unknown name.
+bool choose_strategies(const std::vector<std::string>& names, const std::vector<vo::StrategySpec>& all,
+                       std::vector<vo::StrategySpec>* chosen) {
+  if (names.empty()) {
+    for (const auto& s : all)
+      if (s.in_default) chosen->push_back(s);
+    return true;
+  }
+  for (const std::string& name : names) {
+    bool found = false;
+    for (const auto& s : all) {
+      if (s.name == name) {
+        chosen->push_back(s);
+        found = true;
+      }
+    }
+    if (!found) {
+      std::fprintf(stderr, "dynamic_vo: unknown strategy %s (try --list)\n", text::quote_token(name).c_str());
+      return false;
+    }
+  }
+  if (chosen->empty() || chosen->front().name != "none") chosen->insert(chosen->begin(), all.front());
+  return true;
+}
+
+/// The recordings the recorded sequences follow, each loaded once. False, after printing why, for a
+/// recording that cannot be read or a sequence name that is neither a motion nor a recording.
+bool load_recordings(const Args& args, std::map<std::string, sim::TrajectoryOptions>* recorded) {
+  for (const std::string& seq : args.sequences) {
+    sim::CameraMotion m{};
+    if (is_recorded(seq)) {
+      std::string error;
+      if (!load_recorded(args.tum_trajectories, seq, &(*recorded)[seq], &error)) {
+        std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
+        return false;
+      }
+    } else if (!motion_from_name(seq, &m)) {
+      std::fprintf(stderr, "dynamic_vo: unknown sequence %s (static, xyz, rpy, halfsphere, fr3_<TUM sequence>)\n",
+                   text::quote_token(seq).c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The job of one family's scene (`options`, the --scene assignments applied) with one sequence and seed.
+SimJob make_sim_job(const Args& args, const std::string& family, const sim::SceneOptions& options,
+                    const std::string& seq, std::uint64_t seed,
+                    const std::map<std::string, sim::TrajectoryOptions>& recorded) {
+  SimJob job;
+  job.family = family;
+  job.sequence = seq;
+  job.seed = seed;
+  job.options = options;
+  job.options.num_frames = args.frames;
+  job.options.seed = seed;
+  if (is_recorded(seq)) {
+    // The recording replaces the synthetic motion; each seed starts it 7 s later (wrapped so the
+    // run fits), so seeds see different parts of the real trajectory.
+    const sim::TrajectoryOptions& rec = recorded.at(seq);
+    job.options.motion = sim::CameraMotion::Recorded;
+    job.options.trajectory.recorded_stamps_s = rec.recorded_stamps_s;
+    job.options.trajectory.recorded_poses = rec.recorded_poses;
+    const double span = rec.recorded_stamps_s.back() - rec.recorded_stamps_s.front() -
+                        args.frames / job.options.fps;
+    job.options.trajectory.recorded_start_s = span > 0 ? std::fmod(7.0 * static_cast<double>(seed - 1), span) : 0.0;
+  } else {
+    motion_from_name(seq, &job.options.motion);
+  }
+  job.name = (args.families_set ? family + "-" : std::string()) + seq +
+             (args.seeds.size() > 1 ? "-s" + std::to_string(seed) : std::string());
+  return job;
+}
+
+/// Every family x sequence x seed of the run, in that order.
+std::vector<SimJob> make_sim_jobs(const Args& args, const std::map<std::string, sim::TrajectoryOptions>& recorded) {
+  std::vector<SimJob> jobs;
+  for (const std::string& family : args.families) {
+    sim::SceneFamily f;
+    sim::find_scene_family(family, &f);
+    sim::apply_scene_assignments(&f.options, args.scene);  // checked in parse_args
+    for (const std::string& seq : args.sequences)
+      for (const std::uint64_t seed : args.seeds)
+        jobs.push_back(make_sim_job(args, family, f.options, seq, seed, recorded));
+  }
+  return jobs;
+}
+
+/// Runs the jobs on `num_threads` threads (each takes the next job not started); the reports in job
+/// order. False, after printing the first job's error in job order, when a job failed.
+bool run_sim_jobs(const std::vector<SimJob>& jobs, const std::vector<vo::StrategySpec>& chosen,
+                  const vo::RunnerOptions& ro, bool quiet, int num_threads, std::vector<vo::SequenceReport>* reports) {
+  std::vector<vo::SequenceReport> done(jobs.size());
+  std::vector<std::string> errors(jobs.size());
+  std::atomic<std::size_t> next{0}, finished{0};
+  auto worker = [&]() {
+    for (std::size_t k = next++; k < jobs.size(); k = next++) {
+      const auto started = std::chrono::steady_clock::now();
+      vo::SimSource source(jobs[k].options);
+      vo::SequenceReport& rep = done[k];
+      rep.family = jobs[k].family;
+      rep.sequence = jobs[k].sequence;
+      rep.seed = jobs[k].seed;
+      try {
+        if (!vo::run_sequence(jobs[k].name, source, chosen, ro, &rep, &errors[k])) continue;
+        vo::evaluate_against_recorded_truth(&rep, ro);
+      } catch (const std::exception& e) {  // a worker thread's exception would abort the process
+        errors[k] = jobs[k].name + ": stopped by an unexpected error: " + e.what();
+        continue;
+      }
+      if (quiet)
+        std::printf("[%zu/%zu] %s: %.0f s\n", ++finished, jobs.size(), jobs[k].name.c_str(),
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+      std::fflush(stdout);
+    }
+  };
+  std::vector<std::thread> threads;
+  const int n_threads = std::min<int>(num_threads, static_cast<int>(jobs.size()));
+  for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& t : threads) t.join();
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    if (!errors[k].empty()) {
+      std::fprintf(stderr, "dynamic_vo: %s\n", errors[k].c_str());
+      return false;
+    }
+    reports->push_back(std::move(done[k]));
+  }
+  return true;
+}
+
+/// The families' summary (Markdown and CSV) and the frame strip, written under args.out; returns the
+/// summary and appends the figures written to `figures`.
+std::string write_family_summary(const Args& args, const std::vector<vo::SequenceReport>& reports,
+                                 const std::string& cmd, double seconds, std::vector<std::string>* figures) {
+  const std::vector<vo::FamilyStrategySummary> rows = vo::summarise_families(reports);
+  std::string summary = vo::format_family_summary(rows);
+  summary += "\nCommand: `" + cmd + "` (" + vo::fmt(seconds, "%.0f") + " s, " + std::to_string(args.frames) +
+             " frames a sequence)\n";
+  std::ofstream(args.out + "/family_summary.md") << summary;
+  std::ofstream(args.out + "/family_summary.csv") << vo::family_summary_csv(rows);
+  if (vo::write_frame_strip(args.out + "/frame_strip.png", family_frames(reports))) figures->push_back("frame_strip.png");
+  return summary;
+}
+
+/// Prints the truth decision reasons (and recall by speed) of every culling run, for --diagnose.
+void print_diagnosis(const std::vector<vo::SequenceReport>& reports) {
+  for (const auto& r : reports)
+    for (const auto& run : r.runs)
+      if (run.spec.culls)
+        std::printf("\n%s / %s: instance truth decision reason count\n%s%s", r.name.c_str(), run.spec.name.c_str(),
+                    run.breakdown.format().c_str(), run.recall_by_speed.format().c_str());
+}
+
+/// Prints and writes the synthetic run's results: the table (results.md), with several families their
+/// summary; lists the files written.
+void report_sim_run(const Args& args, const std::vector<vo::SequenceReport>& reports, const std::string& cmd,
+                    double seconds) {
+  std::string table = vo::format_table(reports, cmd, seconds);
+  const bool several_families = args.tum.empty() && args.families.size() > 1;
+  if (args.tum.empty() && args.seeds.size() > 1 && !several_families) table += "\n" + vo::format_seed_summary(reports);
+  std::string summary;
+  std::vector<std::string> figures;
+  if (args.tum.empty() && args.families_set) {
+    summary = write_family_summary(args, reports, cmd, seconds, &figures);
+    table = summary + "\n" + table;
+  }
+  // Several families: the summary alone on screen (the per-sequence table is in results.md).
+  std::printf("\n%s", several_families ? summary.c_str() : table.c_str());
+  if (args.diagnose) print_diagnosis(reports);
+  const std::string md = args.out + "/results.md";
+  std::ofstream(md) << table;
+  std::printf("\nwrote %s\n", md.c_str());
+  if (!summary.empty())
+    std::printf("wrote %s/family_summary.md\nwrote %s/family_summary.csv\n", args.out.c_str(), args.out.c_str());
+  for (const std::string& f : figures) std::printf("wrote %s/%s\n", args.out.c_str(), f.c_str());
+  std::size_t files = 0;
+  for (const auto& r : reports) {
+    for (const auto& f : r.files) {
+      if (!several_families) std::printf("wrote %s\n", f.c_str());
+      ++files;
+    }
+  }
+  if (several_families) std::printf("wrote %zu trajectory files and images under %s\n", files, args.out.c_str());
+}
+
 }  // namespace
 
 // Every failure has a reason and a status; an exception reaching here (OpenCV refusing an input the
@@ -400,26 +606,7 @@ int main(int argc, char** argv) try {
     return 0;
   }
   std::vector<vo::StrategySpec> chosen;
-  if (args.strategies.empty()) {
-    for (const auto& s : all)
-      if (s.in_default) chosen.push_back(s);
-  } else {
-    for (const std::string& name : args.strategies) {
-      bool found = false;
-      for (const auto& s : all) {
-        if (s.name == name) {
-          chosen.push_back(s);
-          found = true;
-        }
-      }
-      if (!found) {
-        std::fprintf(stderr, "dynamic_vo: unknown strategy %s (try --list)\n", text::quote_token(name).c_str());
-        return 2;
-      }
-    }
-    // The improvement column needs the reference run.
-    if (chosen.empty() || chosen.front().name != "none") chosen.insert(chosen.begin(), all.front());
-  }
+  if (!choose_strategies(args.strategies, all, &chosen)) return 2;
 
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
@@ -440,137 +627,19 @@ int main(int argc, char** argv) try {
     if (args.families_set || !args.scene.empty())
       std::printf("--family / --scene set the synthetic scene: ignored with --dataset.\n");
     return run_dataset_command(args, chosen, ro, argc, argv);
-  } else {
-    std::map<std::string, sim::TrajectoryOptions> recorded;  // the recordings, loaded once
-    for (const std::string& seq : args.sequences) {
-      sim::CameraMotion m{};
-      if (is_recorded(seq)) {
-        std::string error;
-        if (!load_recorded(args.tum_trajectories, seq, &recorded[seq], &error)) {
-          std::fprintf(stderr, "dynamic_vo: %s\n", error.c_str());
-          return 2;
-        }
-      } else if (!motion_from_name(seq, &m)) {
-        std::fprintf(stderr, "dynamic_vo: unknown sequence %s (static, xyz, rpy, halfsphere, fr3_<TUM sequence>)\n",
-                     text::quote_token(seq).c_str());
-        return 2;
-      }
-    }
-    std::vector<SimJob> jobs;
-    for (const std::string& family : args.families) {
-      sim::SceneFamily f;
-      sim::find_scene_family(family, &f);
-      sim::apply_scene_assignments(&f.options, args.scene);  // checked in parse_args
-      for (const std::string& seq : args.sequences) {
-        for (const std::uint64_t seed : args.seeds) {
-          SimJob job;
-          job.family = family;
-          job.sequence = seq;
-          job.seed = seed;
-          job.options = f.options;
-          job.options.num_frames = args.frames;
-          job.options.seed = seed;
-          if (is_recorded(seq)) {
-            // The recording replaces the synthetic motion; each seed starts it 7 s later (wrapped so the
-            // run fits), so seeds see different parts of the real trajectory.
-            const sim::TrajectoryOptions& rec = recorded[seq];
-            job.options.motion = sim::CameraMotion::Recorded;
-            job.options.trajectory.recorded_stamps_s = rec.recorded_stamps_s;
-            job.options.trajectory.recorded_poses = rec.recorded_poses;
-            const double span = rec.recorded_stamps_s.back() - rec.recorded_stamps_s.front() -
-                                args.frames / job.options.fps;
-            job.options.trajectory.recorded_start_s = span > 0 ? std::fmod(7.0 * static_cast<double>(seed - 1), span) : 0.0;
-          } else {
-            motion_from_name(seq, &job.options.motion);
-          }
-          job.name = (args.families_set ? family + "-" : std::string()) + seq +
-                     (args.seeds.size() > 1 ? "-s" + std::to_string(seed) : std::string());
-          jobs.push_back(std::move(job));
-        }
-      }
-    }
-    // Several families: one line per finished sequence instead of the per-frame progress.
-    const bool quiet = args.families.size() > 1;
-    if (quiet) ro.print_progress = false;
-    std::vector<vo::SequenceReport> done(jobs.size());
-    std::vector<std::string> errors(jobs.size());
-    std::atomic<std::size_t> next{0}, finished{0};
-    auto worker = [&]() {
-      for (std::size_t k = next++; k < jobs.size(); k = next++) {
-        const auto started = std::chrono::steady_clock::now();
-        vo::SimSource source(jobs[k].options);
-        vo::SequenceReport& rep = done[k];
-        rep.family = jobs[k].family;
-        rep.sequence = jobs[k].sequence;
-        rep.seed = jobs[k].seed;
-        try {
-          if (!vo::run_sequence(jobs[k].name, source, chosen, ro, &rep, &errors[k])) continue;
-          vo::evaluate_against_recorded_truth(&rep, ro);
-        } catch (const std::exception& e) {  // a worker thread's exception would abort the process
-          errors[k] = jobs[k].name + ": stopped by an unexpected error: " + e.what();
-          continue;
-        }
-        if (quiet)
-          std::printf("[%zu/%zu] %s: %.0f s\n", ++finished, jobs.size(), jobs[k].name.c_str(),
-                      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
-        std::fflush(stdout);
-      }
-    };
-    std::vector<std::thread> threads;
-    const int n_threads = std::min<int>(args.jobs, static_cast<int>(jobs.size()));
-    for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-    worker();
-    for (std::thread& t : threads) t.join();
-    for (std::size_t k = 0; k < jobs.size(); ++k) {
-      if (!errors[k].empty()) {
-        std::fprintf(stderr, "dynamic_vo: %s\n", errors[k].c_str());
-        return 1;
-      }
-      reports.push_back(std::move(done[k]));
-    }
   }
+  std::map<std::string, sim::TrajectoryOptions> recorded;  // the recordings, loaded once
+  if (!load_recordings(args, &recorded)) return 2;
+  const std::vector<SimJob> jobs = make_sim_jobs(args, recorded);
+  // Several families: one line per finished sequence instead of the per-frame progress.
+  const bool quiet = args.families.size() > 1;
+  if (quiet) ro.print_progress = false;
+  if (!run_sim_jobs(jobs, chosen, ro, quiet, args.jobs, &reports)) return 1;
 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream cmd;
   for (int i = 0; i < argc; ++i) cmd << (i ? " " : "") << argv[i];
-  std::string table = vo::format_table(reports, cmd.str(), seconds);
-  const bool several_families = args.tum.empty() && args.families.size() > 1;
-  if (args.tum.empty() && args.seeds.size() > 1 && !several_families) table += "\n" + vo::format_seed_summary(reports);
-  std::string summary;
-  std::vector<std::string> figures;
-  if (args.tum.empty() && args.families_set) {
-    const std::vector<vo::FamilyStrategySummary> rows = vo::summarise_families(reports);
-    summary = vo::format_family_summary(rows);
-    summary += "\nCommand: `" + cmd.str() + "` (" + vo::fmt(seconds, "%.0f") + " s, " + std::to_string(args.frames) +
-               " frames a sequence)\n";
-    std::ofstream(args.out + "/family_summary.md") << summary;
-    std::ofstream(args.out + "/family_summary.csv") << vo::family_summary_csv(rows);
-    if (vo::write_frame_strip(args.out + "/frame_strip.png", family_frames(reports))) figures.push_back("frame_strip.png");
-    table = summary + "\n" + table;
-  }
-  // Several families: the summary alone on screen (the per-sequence table is in results.md).
-  std::printf("\n%s", several_families ? summary.c_str() : table.c_str());
-  if (args.diagnose) {
-    for (const auto& r : reports)
-      for (const auto& run : r.runs)
-        if (run.spec.culls)
-          std::printf("\n%s / %s: instance truth decision reason count\n%s%s", r.name.c_str(), run.spec.name.c_str(),
-                      run.breakdown.format().c_str(), run.recall_by_speed.format().c_str());
-  }
-  const std::string md = args.out + "/results.md";
-  std::ofstream(md) << table;
-  std::printf("\nwrote %s\n", md.c_str());
-  if (!summary.empty())
-    std::printf("wrote %s/family_summary.md\nwrote %s/family_summary.csv\n", args.out.c_str(), args.out.c_str());
-  for (const std::string& f : figures) std::printf("wrote %s/%s\n", args.out.c_str(), f.c_str());
-  std::size_t files = 0;
-  for (const auto& r : reports) {
-    for (const auto& f : r.files) {
-      if (!several_families) std::printf("wrote %s\n", f.c_str());
-      ++files;
-    }
-  }
-  if (several_families) std::printf("wrote %zu trajectory files and images under %s\n", files, args.out.c_str());
+  report_sim_run(args, reports, cmd.str(), seconds);
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "dynamic_vo: stopped by an unexpected error: %s\n", e.what());

@@ -80,6 +80,89 @@ bool write_json_detections(const std::filesystem::path& path, int index, const s
   return static_cast<bool>(out);
 }
 
+/// The scene of the command line: the family's (default walking), then --motion, --frames, --seed and
+/// --clean-depth in any order on top of it. False, with why, for a bad or unknown argument.
+bool parse_scene_options(int argc, char** argv, dyncull::sim::SceneOptions* options, std::string* family,
+                         std::string* why) {
+  using namespace dyncull::sim;
+  *family = "walking";
+  for (int k = 2; k + 1 < argc; ++k)
+    if (std::string(argv[k]) == "--family") *family = argv[k + 1];
+  SceneFamily chosen;
+  if (!find_scene_family(*family, &chosen, why)) return false;
+  *options = chosen.options;
+  auto bad = [why](std::string reason) {
+    *why = std::move(reason);
+    return false;
+  };
+  for (int k = 2; k < argc; ++k) {
+    const std::string arg = argv[k];
+    const bool has_value = k + 1 < argc;
+    long long value = 0;
+    if (arg == "--family" && has_value) {
+      ++k;  // read above
+    } else if (arg == "--motion" && has_value) {
+      if (!parse_motion(argv[++k], &options->motion)) return bad("unknown motion");
+    } else if (arg == "--frames" && has_value) {
+      if (!parse_int(argv[++k], 1, 1000000, &value)) return bad("--frames needs a positive integer");
+      options->num_frames = static_cast<int>(value);
+    } else if (arg == "--seed" && has_value) {
+      if (!parse_int(argv[++k], 0, 0x7FFFFFFFFFFFFFFFll, &value))
+        return bad("--seed needs a non-negative integer");
+      options->seed = static_cast<std::uint64_t>(value);
+    } else if (arg == "--clean-depth") {
+      options->depth_noise = false;
+    } else {
+      return bad("unknown or incomplete argument " + arg);
+    }
+  }
+  return true;
+}
+
+// The TUM depth image (16-bit, 5000 per metre) and the moving mask (255 = moving) of a frame.
+void depth_and_moving_images(const dyncull::sim::FrameData& f, cv::Mat* depth16, cv::Mat* moving8) {
+  for (int v = 0; v < f.height; ++v) {
+    auto* drow = depth16->ptr<std::uint16_t>(v);
+    auto* mrow = moving8->ptr<std::uint8_t>(v);
+    for (int u = 0; u < f.width; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(f.width) + static_cast<std::size_t>(u);
+      const double units = std::round(static_cast<double>(f.depth_m[i]) * 5000.0);
+      int raw = 0;  // beyond 13.1 m, negative or NaN: no measurement
+      drow[u] = dyncull::checked_int(units, 0, 65535, &raw) ? static_cast<std::uint16_t>(raw) : std::uint16_t(0);
+      mrow[u] = f.moving[i] ? 255 : 0;
+    }
+  }
+}
+
+// One frame's boxes YOLO style: class cx cy w h conf, normalised to the image size.
+void write_yolo_detections(std::ostream& det, const dyncull::sim::FrameData& f) {
+  det << std::setprecision(6);
+  for (const auto& d : f.detections) {
+    const auto c = d.box.centre();
+    det << d.class_id << ' ' << c.x() / f.width << ' ' << c.y() / f.height << ' ' << d.box.width() / f.width << ' '
+        << d.box.height() / f.height << ' ' << d.confidence << '\n';
+  }
+}
+
+// The frame's images (rgb, depth, instance, moving) and detections (YOLO text and JSON) under `out`;
+// false when one cannot be written.
+bool write_frame_files(const std::filesystem::path& out, int index, const std::string& ts,
+                       const dyncull::sim::FrameData& f, const cv::Mat& bgr, const cv::Mat& depth16,
+                       const cv::Mat& instance16, const cv::Mat& moving8) {
+  const std::string rgb_name = "rgb/" + ts + ".png";
+  const bool written = cv::imwrite((out / rgb_name).string(), bgr) &&
+                       cv::imwrite((out / ("depth/" + ts + ".png")).string(), depth16) &&
+                       cv::imwrite((out / "instance" / (ts + ".png")).string(), instance16) &&
+                       cv::imwrite((out / "moving" / (ts + ".png")).string(), moving8);
+  char json_name[32];
+  std::snprintf(json_name, sizeof json_name, "%06d.json", index);
+  const bool json_written = write_json_detections(out / "detections_json" / json_name, index, ts, rgb_name, f);
+  std::ofstream det(out / ("detections/" + ts + ".txt"));
+  if (!written || !json_written || !det) return false;
+  write_yolo_detections(det, f);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,34 +171,8 @@ int main(int argc, char** argv) {
   if (argc < 2) return usage("missing OUTDIR");
   const fs::path out = argv[1];
   SceneOptions options;
-  std::string family = "walking";
-  // The family sets the scene; motion, frames and seed given in any order apply on top of it.
-  for (int k = 2; k + 1 < argc; ++k)
-    if (std::string(argv[k]) == "--family") family = argv[k + 1];
-  SceneFamily chosen;
-  std::string why;
-  if (!find_scene_family(family, &chosen, &why)) return usage(why.c_str());
-  options = chosen.options;
-  for (int k = 2; k < argc; ++k) {
-    const std::string arg = argv[k];
-    const bool has_value = k + 1 < argc;
-    long long value = 0;
-    if (arg == "--family" && has_value) {
-      ++k;  // read above
-    } else if (arg == "--motion" && has_value) {
-      if (!parse_motion(argv[++k], &options.motion)) return usage("unknown motion");
-    } else if (arg == "--frames" && has_value) {
-      if (!parse_int(argv[++k], 1, 1000000, &value)) return usage("--frames needs a positive integer");
-      options.num_frames = static_cast<int>(value);
-    } else if (arg == "--seed" && has_value) {
-      if (!parse_int(argv[++k], 0, 0x7FFFFFFFFFFFFFFFll, &value)) return usage("--seed needs a non-negative integer");
-      options.seed = static_cast<std::uint64_t>(value);
-    } else if (arg == "--clean-depth") {
-      options.depth_noise = false;
-    } else {
-      return usage(("unknown or incomplete argument " + arg).c_str());
-    }
-  }
+  std::string family, why;
+  if (!parse_scene_options(argc, argv, &options, &family, &why)) return usage(why.c_str());
   const Scene scene(options);
   if (!scene.ok()) return usage(scene.reason().c_str());
 
@@ -155,38 +212,14 @@ int main(int argc, char** argv) {
     const std::string ts = stamp(f.timestamp);
     const cv::Mat rgb(f.height, f.width, CV_8UC3, f.rgb.data());
     cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-    for (int v = 0; v < f.height; ++v) {
-      auto* drow = depth16.ptr<std::uint16_t>(v);
-      auto* mrow = moving8.ptr<std::uint8_t>(v);
-      for (int u = 0; u < f.width; ++u) {
-        const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(f.width) + static_cast<std::size_t>(u);
-        const double units = std::round(static_cast<double>(f.depth_m[i]) * 5000.0);
-        int raw = 0;  // beyond 13.1 m, negative or NaN: no measurement
-        drow[u] = dyncull::checked_int(units, 0, 65535, &raw) ? static_cast<std::uint16_t>(raw) : std::uint16_t(0);
-        mrow[u] = f.moving[i] ? 255 : 0;
-      }
-    }
+    depth_and_moving_images(f, &depth16, &moving8);
     const cv::Mat instance16(f.height, f.width, CV_16UC1, f.instance.data());
-    const std::string rgb_name = "rgb/" + ts + ".png", depth_name = "depth/" + ts + ".png",
-                      det_name = "detections/" + ts + ".txt";
-    const bool written = cv::imwrite((out / rgb_name).string(), bgr) &&
-                         cv::imwrite((out / depth_name).string(), depth16) &&
-                         cv::imwrite((out / "instance" / (ts + ".png")).string(), instance16) &&
-                         cv::imwrite((out / "moving" / (ts + ".png")).string(), moving8);
-    char json_name[32];
-    std::snprintf(json_name, sizeof json_name, "%06d.json", index);
-    const bool json_written = write_json_detections(out / "detections_json" / json_name, index, ts, rgb_name, f);
-    std::ofstream det(out / det_name);
-    if (!written || !json_written || !det) {
+    if (!write_frame_files(out, index, ts, f, bgr, depth16, instance16, moving8)) {
       std::cerr << "write_tum_sequence: cannot write frame " << index << " into " << out << "\n";
       return 1;
     }
-    det << std::setprecision(6);
-    for (const auto& d : f.detections) {
-      const auto c = d.box.centre();
-      det << d.class_id << ' ' << c.x() / f.width << ' ' << c.y() / f.height << ' ' << d.box.width() / f.width << ' '
-          << d.box.height() / f.height << ' ' << d.confidence << '\n';
-    }
+    const std::string rgb_name = "rgb/" + ts + ".png", depth_name = "depth/" + ts + ".png",
+                      det_name = "detections/" + ts + ".txt";
     rgb_txt << ts << ' ' << rgb_name << '\n';
     depth_txt << ts << ' ' << depth_name << '\n';
     assoc_txt << ts << ' ' << rgb_name << ' ' << ts << ' ' << depth_name << '\n';

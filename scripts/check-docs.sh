@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Checks that the documentation, code comments and test names describe what dyncull does rather than how
 # it was developed (that belongs in git log), that relative links in README.md and docs/*.md resolve, and
-# (scripts/check-casts.sh) that no float-to-int conversion in include/ and src/ is raw.
+# (scripts/check-casts.sh) that no float-to-int conversion in include/ and src/ is raw, and
+# (scripts/check-function-length.py) that no function there or in apps/ is over 80 lines.
 # Prints file:line: text for every hit and exits 1 if there is any. Usage: scripts/check-docs.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -80,7 +81,13 @@ if ! scripts/check-casts.sh; then
   status=1
 fi
 
+# No function body in include/, src/ and apps/ longer than 80 lines (scripts/check-function-length.py).
+if ! python3 scripts/check-function-length.py; then
+  status=1
+fi
+
 if [[ $status -eq 0 ]]; then
-  echo "check-docs: no development history, all relative links resolve, README snippet current, no raw float-to-int"
+  echo "check-docs: no development history, all relative links resolve, README snippet current, no raw float-to-int,"\
+       "no function over 80 lines"
 fi
 exit $status

@@ -85,6 +85,48 @@ namespace detail {
 inline double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
 }
+
+/// Scores one frame's keep mask on the tracks the culling saw (before PnP drops outliers): labels against
+/// the moving truth when the source has it, box culls, and with options.diagnose the culler's reasons.
+inline void score_culling(const FrontEnd& fe, const Culler& culler, const std::vector<std::uint8_t>& keep,
+                          const SequenceFrame& frame, bool has_label_truth, const RunnerOptions& options,
+                          StrategyRun* run) {
+  if (has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run->labels);
+  run->box_culls.add(fe.tracks().cur_px, keep, frame.detections);
+  if (options.diagnose) {
+    run->breakdown.add(fe.tracks().cur_px, keep, culler.reasons(), culler.kept_why(), frame.moving, frame.instance);
+    run->recall_by_speed.add(fe.tracks().cur_px, keep, frame.moving, frame.motion_m, frame.instance);
+  }
+}
+
+/// Draws frame i's tracks, green kept and red culled, with its caption into <out_dir>/<name>_frameNNNN.png
+/// (loading the colour image first), and lists the file in the report.
+template <class Source>
+void draw_culled_frame(Source& source, SequenceFrame* frame, const std::string& name, int i,
+                       const std::string& strategy, std::size_t kept, const FrontEnd& fe,
+                       const std::vector<std::uint8_t>& keep, const RunnerOptions& options, SequenceReport* report) {
+  source.load_colour(frame);
+  char file[64];
+  std::snprintf(file, sizeof file, "/%s_frame%04d.png", name.c_str(), i);
+  std::ostringstream cap;
+  cap << name << " frame " << i << ", " << strategy << ": " << kept << " kept of " << fe.tracks().size()
+      << (frame->moving.empty() ? " (green kept, red culled)" : " (green kept, red culled, x culled static, ring kept moving)");
+  if (draw_features(options.out_dir + file, frame->bgr, cap.str(), fe.tracks().cur_px, keep, frame->detections,
+                    frame->moving))
+    report->files.push_back(options.out_dir + file);
+}
+
+/// Adds frame i's pose and front-end counts to the run.
+inline void add_frame_stats(const FrameStats& st, int i, double stamp, const Rigid3<double>& world_from_cam,
+                            StrategyRun* run) {
+  run->estimate.push_back(stamp, world_from_cam);
+  ++run->frames;
+  run->fallbacks += (st.fallback && i > 0) ? 1 : 0;
+  run->keyframes += st.keyframe ? 1 : 0;
+  run->tracks += st.tracks;
+  run->kept += st.kept;
+  run->inliers += st.inliers;
+}
 }  // namespace detail
 
 /// Runs every strategy over the first max_frames frames of `source`. Returns false (with `error`)
@@ -149,35 +191,13 @@ bool run_sequence(const std::string& name, Source& source, const std::vector<Str
       run.front_end_ms += cullers[k].descriptor_ms();
       // Labels are counted (and drawn) on the tracks the culling saw, before PnP drops outliers.
       const std::size_t kept = static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
-      if (report->has_label_truth) count_labels(fe.tracks().cur_px, keep, frame.moving, frame.detections, &run.labels);
-      run.box_culls.add(fe.tracks().cur_px, keep, frame.detections);
-      if (options.diagnose) {
-        run.breakdown.add(fe.tracks().cur_px, keep, cullers[k].reasons(), cullers[k].kept_why(), frame.moving,
-                          frame.instance);
-        run.recall_by_speed.add(fe.tracks().cur_px, keep, frame.moving, frame.motion_m, frame.instance);
-      }
-      if (draw && k == draw_strategy && fe.tracks().size() > 0) {
-        source.load_colour(&frame);
-        char file[64];
-        std::snprintf(file, sizeof file, "/%s_frame%04d.png", name.c_str(), i);
-        std::ostringstream cap;
-        cap << name << " frame " << i << ", " << specs[k].name << ": " << kept << " kept of " << fe.tracks().size()
-            << (frame.moving.empty() ? " (green kept, red culled)" : " (green kept, red culled, x culled static, ring kept moving)");
-        if (draw_features(options.out_dir + file, frame.bgr, cap.str(), fe.tracks().cur_px, keep, frame.detections,
-                          frame.moving))
-          report->files.push_back(options.out_dir + file);
-      }
+      detail::score_culling(fe, cullers[k], keep, frame, report->has_label_truth, options, &run);
+      if (draw && k == draw_strategy && fe.tracks().size() > 0)
+        detail::draw_culled_frame(source, &frame, name, i, specs[k].name, kept, fe, keep, options, report);
       const auto t2 = std::chrono::steady_clock::now();
       const FrameStats st = fe.estimate(keep);
       run.front_end_ms += track_ms + detail::ms_since(t2);
-
-      run.estimate.push_back(frame.timestamp, fe.world_from_cam());
-      ++run.frames;
-      run.fallbacks += (st.fallback && i > 0) ? 1 : 0;
-      run.keyframes += st.keyframe ? 1 : 0;
-      run.tracks += st.tracks;
-      run.kept += st.kept;
-      run.inliers += st.inliers;
+      detail::add_frame_stats(st, i, frame.timestamp, fe.world_from_cam(), &run);
       if (options.print_progress && ((i + 1) % options.progress_every == 0 || i + 1 == n)) {
         std::printf("[%s] frame %4d/%d  %-20s tracks %4zu kept %4zu inliers %4zu%s\n", name.c_str(), i + 1, n,
                     specs[k].name.c_str(), st.tracks, st.kept, st.inliers, st.fallback ? "  (constant-velocity fallback)" : "");

@@ -48,6 +48,70 @@ struct ReprojectionResidual {
   }
 };
 
+namespace detail {
+
+/// False, with the status and reason in `res`, for inputs refine_pose_ceres refuses (see its contract).
+template <class T, class Points3, class Points2>
+bool ceres_refinement_inputs_ok(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
+                                const Rigid3<T>& initial_cam_from_world, const PoseRefinementOptions<T>& options,
+                                FlagView mask, PoseRefinementResult<T>* res) {
+  if (!check_pnp_inputs(world, pixels, camera, &res->status, &res->reason)) {
+    res->reason = "refine_pose_ceres: " + res->reason;
+    return false;
+  }
+  std::string why;
+  if (!flags_fit(mask, static_cast<std::size_t>(world.size()), "mask", "correspondences", &why) ||
+      options.validate(&why) != Status::Ok) {
+    res->status = Status::InvalidInput;
+    res->reason = "refine_pose_ceres: " + why;
+    return false;
+  }
+  if (!initial_cam_from_world.all_finite()) {
+    res->status = Status::NonFinite;
+    res->reason = "refine_pose_ceres: initial pose is not finite";
+    return false;
+  }
+  return true;
+}
+
+/// Ceres' solver settings for the options' limits: dense QR on one thread, silent.
+template <class T>
+ceres::Solver::Options ceres_solver_options(const PoseRefinementOptions<T>& options) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = static_cast<double>(options.cost_tolerance);
+  so.parameter_tolerance = static_cast<double>(options.step_tolerance);
+  so.gradient_tolerance = 1e-16;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  return so;
+}
+
+/// RMS of the plain squared reprojection errors at `pose`, over the points the refinement used (masked in,
+/// finite, in front of the initial camera `init`).
+template <class T, class Points3, class Points2>
+double ceres_refinement_rmse(const Points3& world, const Points2& pixels, const PinholeCamera<T>& camera,
+                             FlagView mask, const Rigid3<double>& init, const Rigid3<double>& pose) {
+  const std::size_t n = static_cast<std::size_t>(world.size());
+  double sq = 0;
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (mask.given && !mask[i]) continue;
+    const Vec3<double> X = to_vec3<double>(world[i]);
+    const Vec2<double> x = to_vec2<double>(pixels[i]);
+    if (!X.allFinite() || !x.allFinite() || !((init.R * X + init.t)(2) > 0)) continue;
+    const Vec3<double> p = pose.apply(X);
+    const Vec2<double> e(camera.fx * p(0) / p(2) + camera.cx - x(0), camera.fy * p(1) / p(2) + camera.cy - x(1));
+    sq += e.squaredNorm();
+    ++m;
+  }
+  return m > 0 ? std::sqrt(sq / static_cast<double>(m)) : 0.0;
+}
+
+}  // namespace detail
+
 /// Refines cam_from_world with Ceres' Levenberg-Marquardt on the same cost as refine_pose()
 /// (0.5 sum rho(|r|^2), Huber of options.huber_threshold_px when options.huber) over the finite
 /// correspondences in front of the initial camera (mask: optional, one flag per correspondence,
@@ -65,28 +129,8 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   static_assert(is_point_container_v<Points2>, "refine_pose_ceres: pixels must be a container of 2-D points");
   PoseRefinementResult<T> res;
   res.cam_from_world = initial_cam_from_world;
-  if (!detail::check_pnp_inputs(world, pixels, camera, &res.status, &res.reason)) {
-    res.reason = "refine_pose_ceres: " + res.reason;
+  if (!detail::ceres_refinement_inputs_ok(world, pixels, camera, initial_cam_from_world, options, mask, &res))
     return res;
-  }
-  {
-    std::string why;
-    if (!detail::flags_fit(mask, static_cast<std::size_t>(world.size()), "mask", "correspondences", &why)) {
-      res.status = Status::InvalidInput;
-      res.reason = "refine_pose_ceres: " + why;
-      return res;
-    }
-    if (options.validate(&why) != Status::Ok) {
-      res.status = Status::InvalidInput;
-      res.reason = "refine_pose_ceres: " + why;
-      return res;
-    }
-  }
-  if (!initial_cam_from_world.all_finite()) {
-    res.status = Status::NonFinite;
-    res.reason = "refine_pose_ceres: initial pose is not finite";
-    return res;
-  }
   const Rigid3<double> init = initial_cam_from_world.template cast<double>();
   Eigen::Quaterniond q(init.R);
   q.normalize();
@@ -122,17 +166,8 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   }
   problem.SetManifold(q_xyzw, new ceres::EigenQuaternionManifold);
 
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_iterations;
-  so.function_tolerance = static_cast<double>(options.cost_tolerance);
-  so.parameter_tolerance = static_cast<double>(options.step_tolerance);
-  so.gradient_tolerance = 1e-16;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  ceres::Solve(detail::ceres_solver_options(options), &problem, &summary);
 
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;
@@ -142,20 +177,7 @@ PoseRefinementResult<T> refine_pose_ceres(const Points3& world, const Points2& p
   out.R = qf.normalized().toRotationMatrix();
   out.t = Vec3<double>(t[0], t[1], t[2]);
   res.cam_from_world = out.template cast<T>();
-  // RMS of the plain squared errors at the result, over the points used.
-  double sq = 0;
-  std::size_t m = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (mask.given && !mask[i]) continue;
-    const Vec3<double> X = to_vec3<double>(world[i]);
-    const Vec2<double> x = to_vec2<double>(pixels[i]);
-    if (!X.allFinite() || !x.allFinite() || !((init.R * X + init.t)(2) > 0)) continue;
-    const Vec3<double> p = out.apply(X);
-    const Vec2<double> e(camera.fx * p(0) / p(2) + camera.cx - x(0), camera.fy * p(1) / p(2) + camera.cy - x(1));
-    sq += e.squaredNorm();
-    ++m;
-  }
-  res.rmse_px = m > 0 ? std::sqrt(sq / static_cast<double>(m)) : 0.0;
+  res.rmse_px = detail::ceres_refinement_rmse(world, pixels, camera, mask, init, out);
   if (!summary.IsSolutionUsable() || !res.cam_from_world.all_finite()) {
     res.status = Status::NotConverged;
     res.reason = "refine_pose_ceres: " + summary.message;

@@ -33,6 +33,102 @@ inline bool iequals(std::string_view a, const char* lower) {
   }
   return i == a.size() && lower[i] == '\0';
 }
+
+/// inf / infinity / nan in any case (after the sign) into `out`; false for any other word.
+inline bool parse_float_word(std::string_view body, bool negative, double* out) {
+  if (iequals(body, "inf") || iequals(body, "infinity")) {
+    *out = negative ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+    return true;
+  }
+  if (iequals(body, "nan")) {
+    *out = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  return false;
+}
+
+/// A number token read from position j on, its digits copied without underscores into buf for from_chars
+/// (which never consults the locale), with what telling overflow from underflow needs.
+struct PythonFloatDigits {
+  std::string_view token;
+  std::size_t j;                      // next character of token
+  char buf[kMaxNumberChars + 1];
+  std::size_t n = 0;                  // characters in buf
+  std::size_t num_int = 0;            // integer digits
+  std::ptrdiff_t first_nonzero = -1;  // position of the first non-zero mantissa digit
+  std::size_t num_mantissa = 0;
+  long long exponent = 0;             // saturated: only its sign matters
+
+  PythonFloatDigits(std::string_view t, std::size_t start) : token(t), j(start) {}
+
+  bool at_digit() const { return j < token.size() && is_digit(token[j]); }
+
+  /// digitpart ::= digit (["_"] digit)*; counts the digits as mantissa digits when `mantissa`.
+  bool digitpart(bool mantissa) {
+    const std::size_t size = token.size();
+    if (!at_digit()) return false;
+    while (j < size) {
+      if (is_digit(token[j])) {
+        if (mantissa) {
+          if (first_nonzero < 0 && token[j] != '0') first_nonzero = static_cast<std::ptrdiff_t>(num_mantissa);
+          ++num_mantissa;
+        }
+        buf[n++] = token[j++];
+      } else if (token[j] == '_' && j + 1 < size && is_digit(token[j + 1])) {
+        ++j;
+      } else if (token[j] == '_') {
+        return false;
+      } else {
+        break;
+      }
+    }
+    return true;
+  }
+
+  /// Integer digits, then an optional '.' and fraction digits; at least one digit in all.
+  bool mantissa() {
+    bool has_digits = false;
+    if (at_digit()) {
+      if (!digitpart(true)) return false;
+      num_int = num_mantissa;
+      has_digits = true;
+    }
+    if (j < token.size() && token[j] == '.') {
+      buf[n++] = token[j++];
+      if (at_digit()) {
+        if (!digitpart(true)) return false;
+        has_digits = true;
+      }
+    }
+    return has_digits;
+  }
+
+  /// An optional exponent: e/E, an optional sign, digits.
+  bool exponent_part() {
+    if (!(j < token.size() && (token[j] == 'e' || token[j] == 'E'))) return true;
+    buf[n++] = token[j++];
+    bool exp_negative = false;
+    if (j < token.size() && (token[j] == '+' || token[j] == '-')) {
+      exp_negative = token[j] == '-';
+      buf[n++] = token[j++];
+    }
+    const std::size_t exp_start = n;
+    if (!digitpart(false)) return false;
+    for (std::size_t k = exp_start; k < n; ++k) {
+      if (exponent < 1000000000LL) exponent = exponent * 10 + (buf[k] - '0');  // saturates: only the sign matters
+    }
+    if (exp_negative) exponent = -exponent;
+    return true;
+  }
+
+  /// +-inf or +-0 for a value out of the double range: the decimal magnitude of the leading digit says which.
+  double out_of_range_value(bool negative) const {
+    const long long magnitude =
+        static_cast<long long>(num_int) - 1 - static_cast<long long>(first_nonzero < 0 ? 0 : first_nonzero) + exponent;
+    const double big = magnitude > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+    return negative ? -big : big;
+  }
+};
 }  // namespace detail
 
 /// One number as Python's float() reads it, whatever the C or C++ locale: [sign] then digits with
@@ -43,85 +139,17 @@ inline bool iequals(std::string_view a, const char* lower) {
 inline NumberStatus parse_python_float(std::string_view token, double* out) {
   if (token.empty()) return NumberStatus::Empty;
   if (token.size() > kMaxNumberChars) return NumberStatus::TooLong;
-  std::size_t j = 0;
   const bool negative = token[0] == '-';
-  if (token[0] == '+' || token[0] == '-') ++j;
-  const std::string_view body = token.substr(j);
-  if (detail::iequals(body, "inf") || detail::iequals(body, "infinity")) {
-    *out = negative ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
-    return NumberStatus::Ok;
-  }
-  if (detail::iequals(body, "nan")) {
-    *out = std::numeric_limits<double>::quiet_NaN();
-    return NumberStatus::Ok;
-  }
-  // The digits without underscores, for from_chars (which never consults the locale).
-  char buf[kMaxNumberChars + 1];
-  std::size_t n = 0;
-  if (negative) buf[n++] = '-';
-  const std::size_t size = token.size();
-  std::size_t num_int = 0;          // integer digits
-  std::ptrdiff_t first_nonzero = -1;  // position of the first non-zero mantissa digit
-  std::size_t num_mantissa = 0;
-  // digitpart ::= digit (["_"] digit)*
-  const auto digitpart = [&](bool mantissa) {
-    if (j >= size || !detail::is_digit(token[j])) return false;
-    while (j < size) {
-      if (detail::is_digit(token[j])) {
-        if (mantissa) {
-          if (first_nonzero < 0 && token[j] != '0') first_nonzero = static_cast<std::ptrdiff_t>(num_mantissa);
-          ++num_mantissa;
-        }
-        buf[n++] = token[j++];
-      } else if (token[j] == '_' && j + 1 < size && detail::is_digit(token[j + 1])) {
-        ++j;
-      } else if (token[j] == '_') {
-        return false;
-      } else {
-        break;
-      }
-    }
-    return true;
-  };
-  bool has_digits = false;
-  if (j < size && detail::is_digit(token[j])) {
-    if (!digitpart(true)) return NumberStatus::Invalid;
-    num_int = num_mantissa;
-    has_digits = true;
-  }
-  if (j < size && token[j] == '.') {
-    buf[n++] = token[j++];
-    if (j < size && detail::is_digit(token[j])) {
-      if (!digitpart(true)) return NumberStatus::Invalid;
-      has_digits = true;
-    }
-  }
-  if (!has_digits) return NumberStatus::Invalid;
-  long long exponent = 0;
-  if (j < size && (token[j] == 'e' || token[j] == 'E')) {
-    buf[n++] = token[j++];
-    bool exp_negative = false;
-    if (j < size && (token[j] == '+' || token[j] == '-')) {
-      exp_negative = token[j] == '-';
-      buf[n++] = token[j++];
-    }
-    const std::size_t exp_start = n;
-    if (!digitpart(false)) return NumberStatus::Invalid;
-    for (std::size_t k = exp_start; k < n; ++k) {
-      if (exponent < 1000000000LL) exponent = exponent * 10 + (buf[k] - '0');  // saturates: only the sign matters
-    }
-    if (exp_negative) exponent = -exponent;
-  }
-  if (j != size) return NumberStatus::Invalid;
+  const std::size_t sign_chars = (token[0] == '+' || token[0] == '-') ? 1 : 0;
+  if (detail::parse_float_word(token.substr(sign_chars), negative, out)) return NumberStatus::Ok;
+  detail::PythonFloatDigits d(token, sign_chars);
+  if (negative) d.buf[d.n++] = '-';
+  if (!d.mantissa() || !d.exponent_part() || d.j != token.size()) return NumberStatus::Invalid;
   double value = 0;
-  const std::from_chars_result res = std::from_chars(buf, buf + n, value);
+  const std::from_chars_result res = std::from_chars(d.buf, d.buf + d.n, value);
   if (res.ec == std::errc::result_out_of_range) {
-    // Overflow or underflow: the decimal magnitude of the leading digit says which.
-    const long long magnitude =
-        static_cast<long long>(num_int) - 1 - static_cast<long long>(first_nonzero < 0 ? 0 : first_nonzero) + exponent;
-    const double big = magnitude > 0 ? std::numeric_limits<double>::infinity() : 0.0;
-    value = negative ? -big : big;
-  } else if (res.ec != std::errc() || res.ptr != buf + n) {
+    value = d.out_of_range_value(negative);
+  } else if (res.ec != std::errc() || res.ptr != d.buf + d.n) {
     return NumberStatus::Invalid;
   }
   *out = value;

@@ -141,6 +141,132 @@ double relative_rotation_angle_rad(const Mat3<double>& R) {
   return std::atan2(0.5 * w.norm(), 0.5 * (R.trace() - 1.0));
 }
 
+/// TUM's overlap check: true when at least 2 distinct estimate stamps round-trip est -> closest GT ->
+/// closest est (sorted stamps; offset added to the estimate's).
+inline bool stamps_overlap(const std::vector<double>& stamps_gt, const std::vector<double>& stamps_est,
+                           double offset) {
+  std::vector<std::uint8_t> returned(stamps_est.size(), 0);
+  std::size_t distinct = 0;
+  for (std::size_t k = 0; k < stamps_est.size(); ++k) {
+    const double t_gt = stamps_gt[find_closest_index(stamps_gt, stamps_est[k] + offset)];
+    const std::size_t back = find_closest_index(stamps_est, t_gt - offset);
+    distinct += returned[back] == 0;
+    returned[back] = 1;
+  }
+  return distinct >= 2;
+}
+
+/// The coordinate along which delta is measured (evaluate_rpe.py index_est), per estimate pose P[k].
+inline void delta_index(const RpeOptions& options, const std::vector<double>& stamps_est,
+                        const std::vector<Rigid3<double>>& P, std::vector<double>* index) {
+  const std::size_t n_est = stamps_est.size();
+  switch (options.delta_unit) {
+    case DeltaUnit::Frames:
+      for (std::size_t k = 0; k < n_est; ++k) (*index)[k] = static_cast<double>(k);
+      break;
+    case DeltaUnit::Seconds:
+      *index = stamps_est;
+      break;
+    case DeltaUnit::Metres:
+    case DeltaUnit::Radians:
+    case DeltaUnit::Degrees: {
+      const double unit = options.delta_unit == DeltaUnit::Degrees ? Constants<double>::rad_to_deg() : 1.0;
+      double sum = 0.0;
+      (*index)[0] = 0.0;
+      for (std::size_t k = 0; k + 1 < n_est; ++k) {
+        const Rigid3<double> motion = P[k + 1].inverse() * P[k];
+        sum += options.delta_unit == DeltaUnit::Metres ? motion.t.norm() : rotation_angle(motion.R) * unit;
+        (*index)[k + 1] = sum;
+      }
+      break;
+    }
+  }
+}
+
+/// The gap rule's limit: 2 x the median ground-truth stamp interval (sorted stamps, at least 2).
+inline double max_stamp_gap(const std::vector<double>& stamps_gt) {
+  std::vector<double> gt_intervals(stamps_gt.size() - 1);
+  for (std::size_t k = 0; k + 1 < stamps_gt.size(); ++k) gt_intervals[k] = stamps_gt[k + 1] - stamps_gt[k];
+  const ErrorStatistics<double> interval_stats = compute_statistics(gt_intervals.data(), gt_intervals.size());
+  return 2.0 * interval_stats.median;
+}
+
+/// Translation (m) and rotation (deg) error of the estimate's motion from P_i to P_j (translation scaled)
+/// against the ground truth's from Q_gi to Q_gj: ominus(scale(ominus(P_j, P_i)), ominus(Q_j, Q_i)) with
+/// ominus(a, b) = a^-1 b.
+template <class T>
+void relative_pose_error(const Rigid3<double>& P_i, const Rigid3<double>& P_j, const Rigid3<double>& Q_gi,
+                         const Rigid3<double>& Q_gj, double scale, RpePair<T>* pair) {
+  Rigid3<double> est_motion = P_j.inverse() * P_i;
+  est_motion.t *= scale;
+  const Rigid3<double> gt_motion = Q_gj.inverse() * Q_gi;
+  const Rigid3<double> error = est_motion.inverse() * gt_motion;
+  pair->translation_m = static_cast<T>(error.t.norm());
+  pair->rotation_deg = static_cast<T>(relative_rotation_angle_rad<T>(error.R) * Constants<double>::rad_to_deg());
+}
+
+/// A trajectory in stamp order (distinct finite stamps only): each entry's position in the caller's
+/// trajectory, its stamp, and its pose in double.
+struct SortedTrajectory {
+  std::vector<std::uint32_t> order;
+  std::vector<double> stamps;
+  std::vector<Rigid3<double>> poses;
+  std::size_t size() const { return order.size(); }
+};
+
+/// The stamps of `traj` in `sorted->order`.
+template <class T>
+void sorted_stamps(const Trajectory<T>& traj, SortedTrajectory* sorted) {
+  sorted->stamps.resize(sorted->size());
+  for (std::size_t k = 0; k < sorted->size(); ++k) sorted->stamps[k] = traj.stamps[sorted->order[k]];
+}
+
+/// The poses of `traj` in `sorted->order`, in double; false when one is not finite.
+template <class T>
+bool sorted_finite_poses(const Trajectory<T>& traj, SortedTrajectory* sorted) {
+  sorted->poses.resize(sorted->size());
+  for (std::size_t k = 0; k < sorted->size(); ++k) sorted->poses[k] = traj.poses[sorted->order[k]].template cast<double>();
+  return std::all_of(sorted->poses.begin(), sorted->poses.end(), [](const Rigid3<double>& p) { return p.all_finite(); });
+}
+
+/// Every pair (i, j) of estimate poses delta apart along `index` (j not the last pose) whose two stamps
+/// have a ground-truth stamp within max_gap, with its errors, into result->pairs, trans and rot; pairs
+/// beyond the gap are counted in result->num_dropped_gap. False, with the estimate position i in
+/// *bad_i, when a pair's error leaves the range of T (finite poses whose relative motion overflows).
+template <class T>
+bool collect_rpe_pairs(const RpeOptions& options, const std::vector<double>& index, const SortedTrajectory& gt,
+                       const SortedTrajectory& est, double max_gap, RpeResult<T>* result, std::vector<T>* trans,
+                       std::vector<T>* rot, std::size_t* bad_i) {
+  const std::size_t n_est = est.size();
+  const double offset = options.offset_s;
+  for (std::size_t i = 0; i < n_est; ++i) {
+    const std::size_t j = find_closest_index(index, index[i] + options.delta);
+    if (j == n_est - 1) continue;
+    const double te_i = est.stamps[i] + offset;
+    const double te_j = est.stamps[j] + offset;
+    const std::size_t gi = find_closest_index(gt.stamps, te_i);
+    const std::size_t gj = find_closest_index(gt.stamps, te_j);
+    if (std::abs(gt.stamps[gi] - te_i) > max_gap || std::abs(gt.stamps[gj] - te_j) > max_gap) {
+      ++result->num_dropped_gap;
+      continue;
+    }
+    RpePair<T> pair;
+    pair.estimate_i = est.order[i];
+    pair.estimate_j = est.order[j];
+    pair.groundtruth_i = gt.order[gi];
+    pair.groundtruth_j = gt.order[gj];
+    relative_pose_error(est.poses[i], est.poses[j], gt.poses[gi], gt.poses[gj], options.scale, &pair);
+    if (!std::isfinite(pair.translation_m) || !std::isfinite(pair.rotation_deg)) {
+      *bad_i = i;
+      return false;
+    }
+    trans->push_back(pair.translation_m);
+    rot->push_back(pair.rotation_deg);
+    result->pairs.push_back(pair);
+  }
+  return true;
+}
+
 }  // namespace detail
 
 template <class T>
@@ -158,75 +284,27 @@ RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>&
     std::string why;
     if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, why);
   }
-  std::vector<std::uint32_t> gt_order;
-  std::vector<std::uint32_t> est_order;
-  detail::sorted_unique_stamp_order(groundtruth.stamps.data(), groundtruth.size(), &gt_order);
-  detail::sorted_unique_stamp_order(estimate.stamps.data(), estimate.size(), &est_order);
-  if (gt_order.size() < 2 || est_order.size() < 2) {
+  detail::SortedTrajectory gt, est;
+  detail::sorted_unique_stamp_order(groundtruth.stamps.data(), groundtruth.size(), &gt.order);
+  detail::sorted_unique_stamp_order(estimate.stamps.data(), estimate.size(), &est.order);
+  if (gt.size() < 2 || est.size() < 2) {
     return fail(Status::TooFewPoints, "need at least 2 distinct finite stamps in each trajectory, got " +
-                                          std::to_string(gt_order.size()) + " ground truth and " +
-                                          std::to_string(est_order.size()) + " estimate");
+                                          std::to_string(gt.size()) + " ground truth and " +
+                                          std::to_string(est.size()) + " estimate");
   }
-  const std::size_t n_gt = gt_order.size();
-  const std::size_t n_est = est_order.size();
-  std::vector<double> stamps_gt(n_gt);
-  std::vector<double> stamps_est(n_est);
-  for (std::size_t k = 0; k < n_gt; ++k) stamps_gt[k] = groundtruth.stamps[gt_order[k]];
-  for (std::size_t k = 0; k < n_est; ++k) stamps_est[k] = estimate.stamps[est_order[k]];
-  const double offset = options.offset_s;
-
-  // TUM's overlap check: estimate stamps that round-trip est -> closest GT -> closest est.
-  {
-    std::vector<std::uint8_t> returned(n_est, 0);
-    std::size_t distinct = 0;
-    for (std::size_t k = 0; k < n_est; ++k) {
-      const double t_gt = stamps_gt[detail::find_closest_index(stamps_gt, stamps_est[k] + offset)];
-      const std::size_t back = detail::find_closest_index(stamps_est, t_gt - offset);
-      distinct += returned[back] == 0;
-      returned[back] = 1;
-    }
-    if (distinct < 2) {
-      return fail(Status::TooFewPoints, "the stamps of the two trajectories do not overlap (wrong files?)");
-    }
+  detail::sorted_stamps(groundtruth, &gt);
+  detail::sorted_stamps(estimate, &est);
+  if (!detail::stamps_overlap(gt.stamps, est.stamps, options.offset_s)) {
+    return fail(Status::TooFewPoints, "the stamps of the two trajectories do not overlap (wrong files?)");
   }
-
-  std::vector<Rigid3<double>> P(n_est);
-  std::vector<Rigid3<double>> Q(n_gt);
-  for (std::size_t k = 0; k < n_est; ++k) P[k] = estimate.poses[est_order[k]].template cast<double>();
-  for (std::size_t k = 0; k < n_gt; ++k) Q[k] = groundtruth.poses[gt_order[k]].template cast<double>();
-  if (!std::all_of(P.begin(), P.end(), [](const Rigid3<double>& p) { return p.all_finite(); }) ||
-      !std::all_of(Q.begin(), Q.end(), [](const Rigid3<double>& q) { return q.all_finite(); })) {
+  if (!detail::sorted_finite_poses(estimate, &est) || !detail::sorted_finite_poses(groundtruth, &gt)) {
     return fail(Status::NonFinite, "non-finite pose");
   }
 
-  // The coordinate along which delta is measured (evaluate_rpe.py index_est).
+  const std::size_t n_est = est.size();
   std::vector<double> index(n_est);
-  switch (options.delta_unit) {
-    case DeltaUnit::Frames:
-      for (std::size_t k = 0; k < n_est; ++k) index[k] = static_cast<double>(k);
-      break;
-    case DeltaUnit::Seconds:
-      index = stamps_est;
-      break;
-    case DeltaUnit::Metres:
-    case DeltaUnit::Radians:
-    case DeltaUnit::Degrees: {
-      const double unit = options.delta_unit == DeltaUnit::Degrees ? Constants<double>::rad_to_deg() : 1.0;
-      double sum = 0.0;
-      index[0] = 0.0;
-      for (std::size_t k = 0; k + 1 < n_est; ++k) {
-        const Rigid3<double> motion = P[k + 1].inverse() * P[k];
-        sum += options.delta_unit == DeltaUnit::Metres ? motion.t.norm() : rotation_angle(motion.R) * unit;
-        index[k + 1] = sum;
-      }
-      break;
-    }
-  }
-
-  std::vector<double> gt_intervals(n_gt - 1);
-  for (std::size_t k = 0; k + 1 < n_gt; ++k) gt_intervals[k] = stamps_gt[k + 1] - stamps_gt[k];
-  const ErrorStatistics<double> interval_stats = compute_statistics(gt_intervals.data(), gt_intervals.size());
-  const double max_gap = 2.0 * interval_stats.median;
+  detail::delta_index(options, est.stamps, est.poses, &index);
+  const double max_gap = detail::max_stamp_gap(gt.stamps);
   result.max_gap_s = max_gap;
 
   result.pairs.reserve(n_est);
@@ -234,38 +312,11 @@ RpeResult<T> evaluate_rpe(const Trajectory<T>& groundtruth, const Trajectory<T>&
   std::vector<T> rot;
   trans.reserve(n_est);
   rot.reserve(n_est);
-  for (std::size_t i = 0; i < n_est; ++i) {
-    const std::size_t j = detail::find_closest_index(index, index[i] + options.delta);
-    if (j == n_est - 1) continue;
-    const double te_i = stamps_est[i] + offset;
-    const double te_j = stamps_est[j] + offset;
-    const std::size_t gi = detail::find_closest_index(stamps_gt, te_i);
-    const std::size_t gj = detail::find_closest_index(stamps_gt, te_j);
-    if (std::abs(stamps_gt[gi] - te_i) > max_gap || std::abs(stamps_gt[gj] - te_j) > max_gap) {
-      ++result.num_dropped_gap;
-      continue;
-    }
-    // ominus(scale(ominus(P_j, P_i)), ominus(Q_j, Q_i)) with ominus(a, b) = a^-1 b.
-    Rigid3<double> est_motion = P[j].inverse() * P[i];
-    est_motion.t *= options.scale;
-    const Rigid3<double> gt_motion = Q[gj].inverse() * Q[gi];
-    const Rigid3<double> error = est_motion.inverse() * gt_motion;
-    RpePair<T> pair;
-    pair.estimate_i = est_order[i];
-    pair.estimate_j = est_order[j];
-    pair.groundtruth_i = gt_order[gi];
-    pair.groundtruth_j = gt_order[gj];
-    pair.translation_m = static_cast<T>(error.t.norm());
-    pair.rotation_deg = static_cast<T>(detail::relative_rotation_angle_rad<T>(error.R) * Constants<double>::rad_to_deg());
-    if (!std::isfinite(pair.translation_m) || !std::isfinite(pair.rotation_deg)) {
-      // Finite poses whose relative motion leaves the range of T (or of double): no error to report.
-      return fail(Status::InvalidInput, "the translation error of the pair from estimate pose " +
-                                            std::to_string(est_order[i]) + " is beyond the range of the scalar type "
-                                            "(positions near the floating-point limit)");
-    }
-    trans.push_back(pair.translation_m);
-    rot.push_back(pair.rotation_deg);
-    result.pairs.push_back(pair);
+  std::size_t bad_i = 0;
+  if (!detail::collect_rpe_pairs(options, index, gt, est, max_gap, &result, &trans, &rot, &bad_i)) {
+    return fail(Status::InvalidInput, "the translation error of the pair from estimate pose " +
+                                          std::to_string(est.order[bad_i]) + " is beyond the range of the scalar type "
+                                          "(positions near the floating-point limit)");
   }
   result.num_pairs = result.pairs.size();
   if (result.num_pairs < 2) {

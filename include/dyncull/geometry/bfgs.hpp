@@ -80,61 +80,186 @@ BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x
 // Implementation
 // ------------------------------------------------------------------------------------------------
 
+namespace detail {
+
+/// Whether f is callable as `T f(const Vector& x, Vector* gradient) const`.
+template <class Functor, class T, int N>
+constexpr bool is_bfgs_objective =
+    std::is_convertible<decltype(std::declval<const Functor&>()(std::declval<const Eigen::Matrix<T, N, 1>&>(),
+                                                                std::declval<Eigen::Matrix<T, N, 1>*>())),
+                        T>::value;
+
+/// BfgsOptions in the scalar, with tolerances no tighter than it allows (float would otherwise never
+/// meet 1e-12).
+template <class T>
+struct BfgsConstants {
+  T eps, gtol, ftol, xtol, c1, c2;
+  int max_line_search_steps;
+  explicit BfgsConstants(const BfgsOptions& options)
+      : eps(std::numeric_limits<T>::epsilon()),
+        gtol(static_cast<T>(options.gradient_tolerance)),
+        ftol(std::max(static_cast<T>(options.function_tolerance), T(4) * eps)),
+        xtol(std::max(static_cast<T>(options.parameter_tolerance), T(4) * eps)),
+        c1(static_cast<T>(options.armijo_c1)),
+        c2(static_cast<T>(options.wolfe_c2)),
+        max_line_search_steps(options.max_line_search_steps) {}
+};
+
+/// The line search's accepted point (x_new, g_new, f_new), fixed-size and reused by every iteration.
+template <class T, int N>
+struct BfgsLineSearch {
+  using Vector = Eigen::Matrix<T, N, 1>;
+  Vector x_new, g_new;
+  T f_new = T(0);
+  int steps = 0;  ///< evaluations of this line search
+};
+
+/// The point the line search evaluates f at (x) and its gradient (g).
+template <class T, int N>
+struct BfgsTrial {
+  Eigen::Matrix<T, N, 1> x, g;
+};
+
+/// False, with the status and reason in `result`, when the options are invalid or x0 is not finite.
+template <class T, int N>
+bool bfgs_check_start(const BfgsOptions& options, const Eigen::Matrix<T, N, 1>& x0, BfgsResult<T, N>* result) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
+    result->status = Status::InvalidInput;
+    result->reason = "bfgs: " + why;
+    return false;
+  }
+  if (!x0.allFinite()) {
+    result->status = Status::NonFinite;
+    result->reason = "bfgs: non-finite starting point";
+    return false;
+  }
+  return true;
+}
+
+/// False, with NonFinite, f(x0) and its gradient in `result`, when either is not finite.
+template <class T, int N>
+bool bfgs_start_finite(T fx, const Eigen::Matrix<T, N, 1>& g, BfgsResult<T, N>* result) {
+  if (std::isfinite(fx) && g.allFinite()) return true;
+  result->status = Status::NonFinite;
+  result->reason = "bfgs: objective or gradient not finite at the starting point";
+  result->value = fx;
+  result->gradient = g;
+  return false;
+}
+
+/// When round-off has cost H its positive definiteness (p = -H g is no descent direction): restart from
+/// the identity, p as steepest descent, with its slope dphi0.
+template <class T, int N>
+void restart_as_steepest_descent(const Eigen::Matrix<T, N, 1>& g, Eigen::Matrix<T, N, N>* H, bool* scaled,
+                                 Eigen::Matrix<T, N, 1>* p, T* dphi0) {
+  H->setIdentity();
+  *scaled = false;
+  *p = -g;
+  *dphi0 = -g.squaredNorm();
+}
+
+/// After an Armijo point at step alpha: while the slope is still steep (curvature condition fails),
+/// extrapolate with the secant of phi' (exact for quadratics), keeping the better of the two points.
+template <class T, int N, class Functor>
+void bfgs_extrapolate(const Functor& f, const Eigen::Matrix<T, N, 1>& x, T fx, const Eigen::Matrix<T, N, 1>& p,
+                      T dphi0, T alpha, const BfgsConstants<T>& c, BfgsTrial<T, N>* trial, BfgsLineSearch<T, N>* ls,
+                      int* evaluations) {
+  using std::isfinite;
+  T dphi = ls->g_new.dot(p);
+  while (dphi < c.c2 * dphi0 && ls->steps < c.max_line_search_steps) {
+    const T curvature = dphi - dphi0;
+    const T next = curvature > T(0) ? alpha * dphi0 / (dphi0 - dphi) : T(4) * alpha;
+    const T alpha_ext = std::min(next, T(100) * alpha);
+    if (!(alpha_ext > alpha)) break;
+    trial->x = x + alpha_ext * p;
+    const T f_ext = f(trial->x, &trial->g);
+    ++ls->steps;
+    ++*evaluations;
+    if (!isfinite(f_ext) || !trial->g.allFinite() || f_ext > fx + c.c1 * alpha_ext * dphi0 || f_ext >= ls->f_new)
+      break;
+    alpha = alpha_ext;
+    ls->x_new = trial->x;
+    ls->g_new = trial->g;
+    ls->f_new = f_ext;
+    dphi = ls->g_new.dot(p);
+  }
+}
+
+/// Armijo backtracking along p from step alpha, then extrapolation; true with the accepted point in `ls`,
+/// false when no step within max_line_search_steps decreases f enough.
+template <class T, int N, class Functor>
+bool bfgs_line_search(const Functor& f, const Eigen::Matrix<T, N, 1>& x, T fx, const Eigen::Matrix<T, N, 1>& p,
+                      T dphi0, T alpha, const BfgsConstants<T>& c, BfgsTrial<T, N>* trial, BfgsLineSearch<T, N>* ls,
+                      int* evaluations) {
+  using std::isfinite;
+  ls->f_new = fx;
+  ls->steps = 0;
+  while (ls->steps < c.max_line_search_steps) {
+    trial->x = x + alpha * p;
+    const T f_try = f(trial->x, &trial->g);
+    ++ls->steps;
+    ++*evaluations;
+    if (!isfinite(f_try) || !trial->g.allFinite()) {
+      alpha *= T(0.25);
+      continue;
+    }
+    if (f_try > fx + c.c1 * alpha * dphi0) {
+      // Armijo fails: minimise the quadratic through phi(0), phi'(0), phi(alpha), kept in [0.1, 0.5] alpha.
+      const T denom = T(2) * (f_try - fx - dphi0 * alpha);
+      T next = denom > T(0) ? -dphi0 * alpha * alpha / denom : T(0.5) * alpha;
+      alpha = std::min(std::max(next, T(0.1) * alpha), T(0.5) * alpha);
+      continue;
+    }
+    ls->x_new = trial->x;
+    ls->g_new = trial->g;
+    ls->f_new = f_try;
+    bfgs_extrapolate(f, x, fx, p, dphi0, alpha, c, trial, ls, evaluations);
+    return true;
+  }
+  return false;
+}
+
+/// After a line search found no decrease along a descent direction, f is at its round-off floor: that is
+/// convergence (Ok) only if the gradient is tiny compared with the objective's scale; otherwise
+/// NotConverged, with the reason.
+template <class T, int N>
+Status no_decrease_status(const Eigen::Matrix<T, N, 1>& g, T fx, T eps, std::string* reason) {
+  const T g_inf = g.template lpNorm<Eigen::Infinity>();
+  if (g_inf <= std::sqrt(eps) * std::max(T(1), std::abs(fx))) return Status::Ok;
+  *reason = "bfgs: line search found no decrease (gradient " + std::to_string(g_inf) + ")";
+  return Status::NotConverged;
+}
+
+}  // namespace detail
+
 template <class T, int N, class Functor>
 BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x0, const BfgsOptions& options) {
   static_assert(std::is_floating_point<T>::value, "dyncull::bfgs_minimize: scalar must be float or double");
   static_assert(N > 0, "dyncull::bfgs_minimize: fixed positive dimension required");
-  static_assert(std::is_convertible<decltype(std::declval<const Functor&>()(
-                                        std::declval<const Eigen::Matrix<T, N, 1>&>(),
-                                        std::declval<Eigen::Matrix<T, N, 1>*>())),
-                                    T>::value,
+  static_assert(detail::is_bfgs_objective<Functor, T, N>,
                 "dyncull::bfgs_minimize: functor must be callable as `T f(const Vector& x, Vector* gradient) const`");
   using Vector = Eigen::Matrix<T, N, 1>;
   using Matrix = Eigen::Matrix<T, N, N>;
   using std::abs;
-  using std::isfinite;
   using std::max;
   using std::min;
 
   BfgsResult<T, N> result;
   result.x = x0;
-  {
-    std::string why;
-    if (options.validate(&why) != Status::Ok) {
-      result.status = Status::InvalidInput;
-      result.reason = "bfgs: " + why;
-      return result;
-    }
-  }
-  if (!x0.allFinite()) {
-    result.status = Status::NonFinite;
-    result.reason = "bfgs: non-finite starting point";
-    return result;
-  }
-
-  // Tolerances no tighter than the scalar allows (float would otherwise never meet 1e-12).
-  const T eps = std::numeric_limits<T>::epsilon();
-  const T gtol = static_cast<T>(options.gradient_tolerance);
-  const T ftol = max(static_cast<T>(options.function_tolerance), T(4) * eps);
-  const T xtol = max(static_cast<T>(options.parameter_tolerance), T(4) * eps);
-  const T c1 = static_cast<T>(options.armijo_c1);
-  const T c2 = static_cast<T>(options.wolfe_c2);
+  if (!detail::bfgs_check_start(options, x0, &result)) return result;
+  const detail::BfgsConstants<T> c(options);
 
   Vector x = x0;
   Vector g;
   T fx = f(x, &g);
   result.evaluations = 1;
-  if (!isfinite(fx) || !g.allFinite()) {
-    result.status = Status::NonFinite;
-    result.reason = "bfgs: objective or gradient not finite at the starting point";
-    result.value = fx;
-    result.gradient = g;
-    return result;
-  }
+  if (!detail::bfgs_start_finite(fx, g, &result)) return result;
 
   Matrix H = Matrix::Identity();  // inverse Hessian approximation B_k^-1 (eq. 11)
   bool scaled = false;
-  Vector x_new, g_new, x_try, g_try;
+  detail::BfgsTrial<T, N> trial;
+  detail::BfgsLineSearch<T, N> ls;
 
   auto finish = [&](Status status, std::string reason) {
     result.status = status;
@@ -146,89 +271,35 @@ BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x
   };
 
   for (int k = 0;; ++k) {
-    if (g.template lpNorm<Eigen::Infinity>() <= gtol) return finish(Status::Ok, "");
+    if (g.template lpNorm<Eigen::Infinity>() <= c.gtol) return finish(Status::Ok, "");
     if (k >= options.max_iterations) {
       return finish(Status::NotConverged, "bfgs: stopped at max_iterations = " + std::to_string(options.max_iterations));
     }
 
     Vector p = -(H * g);  // eq. 10
     T dphi0 = g.dot(p);
-    if (!(dphi0 < T(0))) {  // H lost positive definiteness through round-off: restart as steepest descent
-      H.setIdentity();
-      scaled = false;
-      p = -g;
-      dphi0 = -g.squaredNorm();
-    }
+    if (!(dphi0 < T(0))) detail::restart_as_steepest_descent(g, &H, &scaled, &p, &dphi0);
     // Before the first curvature pair the step length is unknown: make the first trial move the point
     // by about one unit of x, then let the line search extrapolate.
-    T alpha = scaled ? T(1) : min(T(1), T(1) / g.template lpNorm<Eigen::Infinity>());
+    const T alpha = scaled ? T(1) : min(T(1), T(1) / g.template lpNorm<Eigen::Infinity>());
 
-    bool accepted = false;
-    T f_new = fx;
-    int steps = 0;
-    while (steps < options.max_line_search_steps) {
-      x_try = x + alpha * p;
-      const T f_try = f(x_try, &g_try);
-      ++steps;
-      ++result.evaluations;
-      if (!isfinite(f_try) || !g_try.allFinite()) {
-        alpha *= T(0.25);
-        continue;
-      }
-      if (f_try > fx + c1 * alpha * dphi0) {
-        // Armijo fails: minimise the quadratic through phi(0), phi'(0), phi(alpha), kept in [0.1, 0.5] alpha.
-        const T denom = T(2) * (f_try - fx - dphi0 * alpha);
-        T next = denom > T(0) ? -dphi0 * alpha * alpha / denom : T(0.5) * alpha;
-        alpha = min(max(next, T(0.1) * alpha), T(0.5) * alpha);
-        continue;
-      }
-      // Armijo holds. While the slope is still steep (curvature condition fails), extrapolate with the
-      // secant of phi' (exact for quadratics); keep the better of the two points.
-      accepted = true;
-      x_new = x_try;
-      g_new = g_try;
-      f_new = f_try;
-      T dphi = g_new.dot(p);
-      while (dphi < c2 * dphi0 && steps < options.max_line_search_steps) {
-        const T curvature = dphi - dphi0;
-        const T next = curvature > T(0) ? alpha * dphi0 / (dphi0 - dphi) : T(4) * alpha;
-        const T alpha_ext = min(next, T(100) * alpha);
-        if (!(alpha_ext > alpha)) break;
-        x_try = x + alpha_ext * p;
-        const T f_ext = f(x_try, &g_try);
-        ++steps;
-        ++result.evaluations;
-        if (!isfinite(f_ext) || !g_try.allFinite() || f_ext > fx + c1 * alpha_ext * dphi0 || f_ext >= f_new) break;
-        alpha = alpha_ext;
-        x_new = x_try;
-        g_new = g_try;
-        f_new = f_ext;
-        dphi = g_new.dot(p);
-      }
-      break;
+    if (!detail::bfgs_line_search(f, x, fx, p, dphi0, alpha, c, &trial, &ls, &result.evaluations)) {
+      std::string why;
+      const Status status = detail::no_decrease_status(g, fx, c.eps, &why);
+      return finish(status, std::move(why));
     }
 
-    if (!accepted) {
-      // No decrease along a descent direction: we are at the round-off floor of f. That is convergence
-      // only if the gradient is tiny compared with the objective's scale; otherwise say so.
-      const T g_inf = g.template lpNorm<Eigen::Infinity>();
-      if (g_inf <= std::sqrt(eps) * max(T(1), abs(fx))) {
-        return finish(Status::Ok, "");
-      }
-      return finish(Status::NotConverged, "bfgs: line search found no decrease (gradient " + std::to_string(g_inf) + ")");
-    }
-
-    const Vector s = x_new - x;  // eq. 12
-    const Vector y = g_new - g;  // eq. 13
+    const Vector s = ls.x_new - x;  // eq. 12
+    const Vector y = ls.g_new - g;  // eq. 13
     const T f_old = fx;
-    x = x_new;
-    g = g_new;
-    fx = f_new;
+    x = ls.x_new;
+    g = ls.g_new;
+    fx = ls.f_new;
     ++result.iterations;
-
     const T sy = s.dot(y);
     // Update only with positive curvature (keeps H positive definite); eq. 11 with rho = 1 / y^T s (eq. 14).
-    if (sy > eps * s.norm() * y.norm()) {
+    // Written inline: as a function g++ keeps it out of line, and a small problem costs 11 % more.
+    if (sy > c.eps * s.norm() * y.norm()) {
       if (!scaled) {
         H = Matrix::Identity() * (sy / y.squaredNorm());  // Nocedal & Wright eq. 6.20
         scaled = true;
@@ -239,8 +310,8 @@ BfgsResult<T, N> bfgs_minimize(const Functor& f, const Eigen::Matrix<T, N, 1>& x
       H += (rho * rho * y.dot(Hy) + rho) * (s * s.transpose()) - rho * (Hy * s.transpose() + s * Hy.transpose());
     }
 
-    if (abs(f_old - fx) <= ftol * max(abs(f_old), std::numeric_limits<T>::min())) return finish(Status::Ok, "");
-    if (s.norm() <= xtol * (x.norm() + xtol)) return finish(Status::Ok, "");
+    if (abs(f_old - fx) <= c.ftol * max(abs(f_old), std::numeric_limits<T>::min())) return finish(Status::Ok, "");
+    if (s.norm() <= c.xtol * (x.norm() + c.xtol)) return finish(Status::Ok, "");
   }
 }
 

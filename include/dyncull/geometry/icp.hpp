@@ -60,6 +60,76 @@ struct IcpResult {
   bool converged = false;                ///< stopped by the tolerances rather than max_iterations
 };
 
+namespace detail {
+
+/// False, with the status and reason in `res`, for invalid options, a non-finite initial transform or an
+/// empty target.
+template <class T>
+bool icp_inputs_ok(const KdTree3<T>& target, const Rigid3<T>& initial, const IcpOptions<T>& options,
+                   IcpResult<T>* res) {
+  std::string why;
+  if (options.validate(&why) != Status::Ok) {
+    res->status = Status::InvalidInput;
+    res->reason = why;
+    return false;
+  }
+  if (!initial.all_finite()) {
+    res->status = Status::NonFinite;
+    res->reason = "icp: initial transform is not finite";
+    return false;
+  }
+  if (target.empty()) {
+    res->status = Status::TooFewPoints;
+    res->reason = "icp: the target cloud is empty";
+    return false;
+  }
+  return true;
+}
+
+/// The finite source points, contiguous.
+template <class T, class SourcePoints>
+std::vector<Vec3<T>> finite_points(const SourcePoints& source) {
+  const std::size_t n_in = static_cast<std::size_t>(source.size());
+  std::vector<Vec3<T>> src;
+  src.reserve(n_in);
+  for (std::size_t i = 0; i < n_in; ++i) {
+    const Vec3<T> p = to_vec3<T>(source[i]);
+    if (p.allFinite()) src.push_back(p);
+  }
+  return src;
+}
+
+/// One correspondence pass at (sR, t): the nearest target point of each source point within the
+/// correspondence distance (squared: max_d2), seeded by its previous match in `hint`; the moments of
+/// (source, matched target) into `acc`, fitness (inv_n = 1 / source points) and rmse. Returns the matches.
+template <class T>
+std::size_t icp_match(const KdTree3<T>& target, const std::vector<Vec3<T>>& src, const Mat3<T>& sR, const Vec3<T>& t,
+                      T max_d2, T inv_n, std::vector<std::uint32_t>* hint, AlignmentAccumulator<T>* acc, T* fitness,
+                      T* rmse) {
+  *acc = AlignmentAccumulator<T>();
+  bool first = true;
+  T sum_d2 = T(0);
+  for (std::size_t i = 0; i < src.size(); ++i) {
+    const Vec3<T> q = sR * src[i] + t;
+    T d2 = T(0);
+    const std::uint32_t slot = target.nearest_slot(q, &d2, max_d2, (*hint)[i]);
+    (*hint)[i] = slot;
+    if (slot == KdTree3<T>::kNone) continue;
+    const Vec3<T> m = target.point_of_slot(slot);
+    if (first) {
+      acc->reset(src[i], m);
+      first = false;
+    }
+    acc->add(src[i], m);
+    sum_d2 += d2;
+  }
+  *fitness = static_cast<T>(acc->used) * inv_n;
+  *rmse = acc->used > 0 ? std::sqrt(sum_d2 / static_cast<T>(acc->used)) : T(0);
+  return acc->used;
+}
+
+}  // namespace detail
+
 /// Aligns `source` to the cloud indexed by `target` starting from `initial` (target_from_source).
 /// Non-finite source points are skipped. TooFewPoints when fewer than 3 correspondences are found;
 /// the result then holds the last good transform.
@@ -70,30 +140,9 @@ IcpResult<T> icp_point_to_point(const KdTree3<T>& target, const SourcePoints& so
                 "icp_point_to_point: source must be a container of 3-D points");
   IcpResult<T> res;
   res.target_from_source = initial;
-  std::string why;
-  if (options.validate(&why) != Status::Ok) {
-    res.status = Status::InvalidInput;
-    res.reason = why;
-    return res;
-  }
-  if (!initial.all_finite()) {
-    res.status = Status::NonFinite;
-    res.reason = "icp: initial transform is not finite";
-    return res;
-  }
-  if (target.empty()) {
-    res.status = Status::TooFewPoints;
-    res.reason = "icp: the target cloud is empty";
-    return res;
-  }
+  if (!detail::icp_inputs_ok(target, initial, options, &res)) return res;
   // Finite source points once, contiguous; the previous match of each one seeds its next query.
-  const std::size_t n_in = static_cast<std::size_t>(source.size());
-  std::vector<Vec3<T>> src;
-  src.reserve(n_in);
-  for (std::size_t i = 0; i < n_in; ++i) {
-    const Vec3<T> p = to_vec3<T>(source[i]);
-    if (p.allFinite()) src.push_back(p);
-  }
+  const std::vector<Vec3<T>> src = detail::finite_points<T>(source);
   if (src.size() < 3) {
     res.status = Status::TooFewPoints;
     res.reason = "icp: " + std::to_string(src.size()) + " finite source points, need 3";
@@ -101,37 +150,13 @@ IcpResult<T> icp_point_to_point(const KdTree3<T>& target, const SourcePoints& so
   }
   std::vector<std::uint32_t> hint(src.size(), KdTree3<T>::kNone);
   const T max_d2 = options.max_correspondence_distance_m * options.max_correspondence_distance_m;
-  const T inv_n = T(1) / static_cast<T>(n_in);
+  const T inv_n = T(1) / static_cast<T>(static_cast<std::size_t>(source.size()));
 
   Mat3<T> sR = initial.R;  // scale * R
   Vec3<T> t = initial.t;
   AlignmentAccumulator<T> acc;
-  // One correspondence pass at (sR, t): moments of (source, matched target), fitness and rmse.
-  auto match = [&](T* fitness, T* rmse) {
-    acc = AlignmentAccumulator<T>();
-    bool first = true;
-    T sum_d2 = T(0);
-    for (std::size_t i = 0; i < src.size(); ++i) {
-      const Vec3<T> q = sR * src[i] + t;
-      T d2 = T(0);
-      const std::uint32_t slot = target.nearest_slot(q, &d2, max_d2, hint[i]);
-      hint[i] = slot;
-      if (slot == KdTree3<T>::kNone) continue;
-      const Vec3<T> m = target.point_of_slot(slot);
-      if (first) {
-        acc.reset(src[i], m);
-        first = false;
-      }
-      acc.add(src[i], m);
-      sum_d2 += d2;
-    }
-    *fitness = static_cast<T>(acc.used) * inv_n;
-    *rmse = acc.used > 0 ? std::sqrt(sum_d2 / static_cast<T>(acc.used)) : T(0);
-    return acc.used;
-  };
-
   T fitness = T(0), rmse = T(0);
-  std::size_t matched = match(&fitness, &rmse);
+  std::size_t matched = detail::icp_match(target, src, sR, t, max_d2, inv_n, &hint, &acc, &fitness, &rmse);
   AlignmentOptions align;
   align.estimate_scale = options.estimate_scale;
   int it = 0;
@@ -149,7 +174,7 @@ IcpResult<T> icp_point_to_point(const KdTree3<T>& target, const SourcePoints& so
     res.target_from_source.R = a.dst_from_src.R;
     res.target_from_source.t = t;
     const T prev_fitness = fitness, prev_rmse = rmse;
-    matched = match(&fitness, &rmse);
+    matched = detail::icp_match(target, src, sR, t, max_d2, inv_n, &hint, &acc, &fitness, &rmse);
     if (std::abs(prev_fitness - fitness) < options.relative_fitness &&
         std::abs(prev_rmse - rmse) < options.relative_rmse) {
       res.converged = true;

@@ -249,6 +249,201 @@ inline double huber_rho(double s, double k, double k2) {
   return 2.0 * k * std::sqrt(s) - k2;
 }
 
+/// The correspondences refine_pose_data iterates over (the indices `idx`, or all when idx == nullptr),
+/// the focal lengths and the Huber threshold k (k2 = k^2 <= 0: no robust kernel), in double.
+template <class T>
+struct PoseLmProblem {
+  const PnpData<T>& d;
+  const std::uint32_t* idx;
+  std::size_t count;
+  double fx, fy, k, k2;
+  std::size_t at(std::size_t j) const { return idx ? idx[j] : j; }
+};
+
+/// The pose refinement's iterate: pose, cost (0.5 sum rho), points in front and their squared-error sum.
+struct PoseLmState {
+  Mat3<double> R;
+  Vec3<double> t;
+  double cost = 0;
+  std::size_t used = 0;
+  double sq = 0;
+};
+
+/// Cost (0.5 sum rho) at (Rc, tc); the number of points in front and their squared errors' sum to
+/// `used` and `sq_sum`.
+template <class T>
+double pose_lm_cost(const PoseLmProblem<T>& pr, const Mat3<double>& Rc, const Vec3<double>& tc, std::size_t* used,
+                    double* sq_sum) {
+  double cost = 0, sq = 0;
+  std::size_t m = 0;
+  for (std::size_t j = 0; j < pr.count; ++j) {
+    const std::size_t i = pr.at(j);
+    const Vec3<double> p = Rc * Vec3<double>(pr.d.X[i], pr.d.Y[i], pr.d.Z[i]) + tc;
+    if (!(p(2) > 0)) continue;
+    const double du = pr.fx * (p(0) / p(2) - static_cast<double>(pr.d.x[i]));
+    const double dv = pr.fy * (p(1) / p(2) - static_cast<double>(pr.d.y[i]));
+    const double s = du * du + dv * dv;
+    if (!std::isfinite(s)) continue;  // an overflowing reprojection is unusable, like a point behind
+    cost += huber_rho(s, pr.k, pr.k2);
+    sq += s;
+    ++m;
+  }
+  *used = m;
+  *sq_sum = sq;
+  return 0.5 * cost;
+}
+
+/// Points in front of the camera at (R, t), counted up to 3 (Gauss-Newton mode's check before its first pass).
+template <class T>
+std::size_t count_in_front_up_to_3(const PoseLmProblem<T>& pr, const Mat3<double>& R, const Vec3<double>& t) {
+  std::size_t used = 0;
+  for (std::size_t j = 0; j < pr.count && used < 3; ++j) {
+    const std::size_t i = pr.at(j);
+    used += (R.row(2).dot(Vec3<double>(pr.d.X[i], pr.d.Y[i], pr.d.Z[i])) + t(2)) > 0;
+  }
+  return used;
+}
+
+/// Gauss-Newton normal equations H = J^T W J (full, symmetric) and g = J^T W r at (R, t), W the Huber IRLS
+/// weights; points at or behind the camera are left out.
+template <class T>
+void pose_normal_equations(const PoseLmProblem<T>& pr, const Mat3<double>& R, const Vec3<double>& t,
+                           Eigen::Matrix<double, 6, 6>* H_out, Eigen::Matrix<double, 6, 1>* g_out) {
+  const double fx = pr.fx, fy = pr.fy, k = pr.k, k2 = pr.k2;
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  for (std::size_t j = 0; j < pr.count; ++j) {
+    const std::size_t i = pr.at(j);
+    const Vec3<double> p = R * Vec3<double>(pr.d.X[i], pr.d.Y[i], pr.d.Z[i]) + t;
+    if (!(p(2) > 0)) continue;
+    const double iz = 1.0 / p(2);
+    const double xn = p(0) * iz, yn = p(1) * iz;
+    const double du = fx * (xn - static_cast<double>(pr.d.x[i]));
+    const double dv = fy * (yn - static_cast<double>(pr.d.y[i]));
+    double w = 1.0;
+    if (k2 > 0) {
+      const double s = du * du + dv * dv;
+      if (s > k2) w = k / std::sqrt(s);  // IRLS weight rho'(s) of Huber
+    }
+    // d(pixel)/d(p_cam), then p_cam' = exp(omega) p_cam + v: d p/d omega = -[p]x, d p/d v = I.
+    const double a = fx * iz, b = fy * iz;
+    const double j05 = -a * xn, j15 = -b * yn;
+    const double j0[6] = {j05 * p(1), a * p(2) - j05 * p(0), -a * p(1), a, 0.0, j05};
+    const double j1[6] = {-b * p(2) + j15 * p(1), -j15 * p(0), b * p(0), 0.0, b, j15};
+    // Upper triangle only (21 entries): the symmetric rank-2 update is the inner loop's cost.
+    for (int r = 0; r < 6; ++r) {
+      const double w0 = w * j0[r], w1 = w * j1[r];
+      for (int c = r; c < 6; ++c) H(r, c) += w0 * j0[c] + w1 * j1[c];
+      g(r) += w0 * du + w1 * dv;
+    }
+  }
+  *H_out = H;
+  *g_out = g;
+}
+
+/// The pose moved by a step (omega, v): R' = exp(omega) R, t' = exp(omega) t + v.
+inline void apply_pose_step(const Eigen::Matrix<double, 6, 1>& delta, const Mat3<double>& R, const Vec3<double>& t,
+                            Mat3<double>* R_new, Vec3<double>* t_new) {
+  const Mat3<double> dR = so3_exp(delta.head<3>());
+  *R_new = dR * R;
+  *t_new = dR * t + delta.tail<3>();
+}
+
+/// One Levenberg-Marquardt iteration: up to 10 dampings until the cost does not rise with 3 points in
+/// front. False when the refinement should stop (no step accepted, or a step below step_tolerance); a
+/// decrease below cost_tolerance sets `it` to max_iterations, ending the loop after this iteration.
+template <class T>
+bool levenberg_marquardt_step(const PoseLmProblem<T>& pr, const Eigen::Matrix<double, 6, 6>& H,
+                              const Eigen::Matrix<double, 6, 1>& g, const PoseRefinementOptions<T>& o, double* lambda,
+                              PoseLmState* st, int* it) {
+  bool accepted = false;
+  Eigen::Matrix<double, 6, 1> delta;
+  for (int tries = 0; tries < 10 && !accepted; ++tries) {
+    Eigen::Matrix<double, 6, 6> A = H;
+    A.diagonal() += *lambda * H.diagonal().cwiseMax(1e-12);
+    delta = -A.ldlt().solve(g);
+    if (!delta.allFinite()) {
+      *lambda *= 10;
+      continue;
+    }
+    Mat3<double> R_new;
+    Vec3<double> t_new;
+    apply_pose_step(delta, st->R, st->t, &R_new, &t_new);
+    std::size_t used_new = 0;
+    double sq_new = 0;
+    const double cost_new = pose_lm_cost(pr, R_new, t_new, &used_new, &sq_new);
+    if (cost_new <= st->cost && used_new >= 3) {
+      const double decrease = st->cost - cost_new;
+      st->R = R_new;
+      st->t = t_new;
+      st->cost = cost_new;
+      st->used = used_new;
+      st->sq = sq_new;
+      *lambda = std::max(*lambda * 0.1, 1e-12);
+      accepted = true;
+      if (decrease <= static_cast<double>(o.cost_tolerance) * (st->cost + 1e-300)) *it = o.max_iterations;
+    } else {
+      *lambda *= 10;
+    }
+  }
+  return accepted && !(delta.norm() < static_cast<double>(o.step_tolerance));
+}
+
+/// Plain Gauss-Newton step (RANSAC's local optimisation scores the result itself); false when the
+/// refinement should stop (a non-finite step, or one below step_tolerance after moving).
+template <class T>
+bool gauss_newton_step(const Eigen::Matrix<double, 6, 6>& H, const Eigen::Matrix<double, 6, 1>& g,
+                       const PoseRefinementOptions<T>& o, PoseLmState* st) {
+  const Eigen::Matrix<double, 6, 1> delta = -H.ldlt().solve(g);
+  if (!delta.allFinite()) return false;
+  apply_pose_step(delta, st->R, st->t, &st->R, &st->t);
+  return !(delta.norm() < static_cast<double>(o.step_tolerance));
+}
+
+/// False, with the status and reason in `res`, when the starting cost overflows or fewer than 3 points
+/// are in front of the camera.
+template <class T>
+bool check_refinement_start(const PoseLmState& st, PoseRefinementResult<T>* res) {
+  res->initial_cost = st.cost;
+  if (!std::isfinite(st.cost)) {
+    res->status = Status::InvalidInput;
+    res->reason = "refine_pose: the reprojection cost overflows (coordinates near the floating-point limit)";
+    res->initial_cost = res->final_cost = 0;
+    return false;
+  }
+  if (st.used < 3) {
+    res->status = Status::TooFewPoints;
+    res->reason = "refine_pose: " + std::to_string(st.used) + " points in front of the camera, need 3";
+    res->final_cost = st.cost;
+    return false;
+  }
+  return true;
+}
+
+/// The refined pose, its statistics and status into `res`. R is re-orthonormalised: exp() products drift
+/// by ~1e-16 per step only, but keep R exactly in SO(3).
+template <class T>
+void finish_refinement(PoseLmState st, int it, const PoseRefinementOptions<T>& o, PoseRefinementResult<T>* res) {
+  Eigen::JacobiSVD<Mat3<double>> svd(st.R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  st.R = svd.matrixU() * svd.matrixV().transpose();
+  res->cam_from_world.R = st.R.cast<T>();
+  res->cam_from_world.t = st.t.cast<T>();
+  res->iterations = std::min(it + 1, o.max_iterations);
+  res->num_points = st.used;
+  res->final_cost = st.cost;
+  res->rmse_px = st.used > 0 ? std::sqrt(st.sq / static_cast<double>(st.used)) : 0.0;
+  if (!res->cam_from_world.all_finite()) {
+    res->status = Status::NonFinite;
+    res->reason = "refine_pose: the refinement diverged to a non-finite pose";
+  } else if (!std::isfinite(res->final_cost) || !std::isfinite(res->rmse_px)) {
+    res->status = Status::InvalidInput;
+    res->reason = "refine_pose: the reprojection cost overflows (coordinates near the floating-point limit)";
+  } else if (st.used < 3) {
+    res->status = Status::TooFewPoints;
+    res->reason = "refine_pose: " + std::to_string(st.used) + " usable points at the final pose, need 3";
+  }
+}
+
 /// LM on the pose over the indices `idx` (or all when idx == nullptr). Accumulates in double.
 template <class T>
 PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_t* idx, std::size_t count,
@@ -260,151 +455,32 @@ PoseRefinementResult<T> refine_pose_data(const PnpData<T>& d, const std::uint32_
     res.reason = "refine_pose: initial pose is not finite";
     return res;
   }
-  const double fx = static_cast<double>(d.fx), fy = static_cast<double>(d.fy);
   const double k = o.huber ? static_cast<double>(o.huber_threshold_px) : 0.0;
-  const double k2 = k * k;
-  Mat3<double> R = initial.R.template cast<double>();
-  Vec3<double> t = initial.t.template cast<double>();
-
-  // Cost (0.5 sum rho) and number of points in front at (R, t).
-  auto cost_at = [&](const Mat3<double>& Rc, const Vec3<double>& tc, std::size_t* used, double* sq_sum) {
-    double cost = 0, sq = 0;
-    std::size_t m = 0;
-    for (std::size_t j = 0; j < count; ++j) {
-      const std::size_t i = idx ? idx[j] : j;
-      const Vec3<double> p = Rc * Vec3<double>(d.X[i], d.Y[i], d.Z[i]) + tc;
-      if (!(p(2) > 0)) continue;
-      const double du = fx * (p(0) / p(2) - static_cast<double>(d.x[i]));
-      const double dv = fy * (p(1) / p(2) - static_cast<double>(d.y[i]));
-      const double s = du * du + dv * dv;
-      if (!std::isfinite(s)) continue;  // an overflowing reprojection is unusable, like a point behind
-      cost += huber_rho(s, k, k2);
-      sq += s;
-      ++m;
-    }
-    if (used) *used = m;
-    if (sq_sum) *sq_sum = sq;
-    return 0.5 * cost;
-  };
-
-  std::size_t used = 0;
-  double sq = 0;
+  const PoseLmProblem<T> pr{d, idx, count, static_cast<double>(d.fx), static_cast<double>(d.fy), k, k * k};
+  PoseLmState st;
+  st.R = initial.R.template cast<double>();
+  st.t = initial.t.template cast<double>();
   // Gauss-Newton mode skips the initial cost pass; the in-front count is checked in the first pass.
-  double cost = o.check_cost ? cost_at(R, t, &used, &sq) : 0.0;
-  if (!o.check_cost) {
-    for (std::size_t j = 0; j < count && used < 3; ++j) {
-      const std::size_t i = idx ? idx[j] : j;
-      used += (R.row(2).dot(Vec3<double>(d.X[i], d.Y[i], d.Z[i])) + t(2)) > 0;
-    }
-  }
-  res.initial_cost = cost;
-  if (!std::isfinite(cost)) {
-    res.status = Status::InvalidInput;
-    res.reason = "refine_pose: the reprojection cost overflows (coordinates near the floating-point limit)";
-    res.initial_cost = res.final_cost = 0;
-    return res;
-  }
-  if (used < 3) {
-    res.status = Status::TooFewPoints;
-    res.reason = "refine_pose: " + std::to_string(used) + " points in front of the camera, need 3";
-    res.final_cost = cost;
-    return res;
-  }
+  if (o.check_cost)
+    st.cost = pose_lm_cost(pr, st.R, st.t, &st.used, &st.sq);
+  else
+    st.used = count_in_front_up_to_3(pr, st.R, st.t);
+  if (!check_refinement_start(st, &res)) return res;
   double lambda = static_cast<double>(o.initial_damping);
   int it = 0;
+  Eigen::Matrix<double, 6, 6> H;
+  Eigen::Matrix<double, 6, 1> g;
   for (; it < o.max_iterations; ++it) {
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    for (std::size_t j = 0; j < count; ++j) {
-      const std::size_t i = idx ? idx[j] : j;
-      const Vec3<double> p = R * Vec3<double>(d.X[i], d.Y[i], d.Z[i]) + t;
-      if (!(p(2) > 0)) continue;
-      const double iz = 1.0 / p(2);
-      const double xn = p(0) * iz, yn = p(1) * iz;
-      const double du = fx * (xn - static_cast<double>(d.x[i]));
-      const double dv = fy * (yn - static_cast<double>(d.y[i]));
-      double w = 1.0;
-      if (k2 > 0) {
-        const double s = du * du + dv * dv;
-        if (s > k2) w = k / std::sqrt(s);  // IRLS weight rho'(s) of Huber
-      }
-      // d(pixel)/d(p_cam), then p_cam' = exp(omega) p_cam + v: d p/d omega = -[p]x, d p/d v = I.
-      const double a = fx * iz, b = fy * iz;
-      const double j05 = -a * xn, j15 = -b * yn;
-      const double j0[6] = {j05 * p(1), a * p(2) - j05 * p(0), -a * p(1), a, 0.0, j05};
-      const double j1[6] = {-b * p(2) + j15 * p(1), -j15 * p(0), b * p(0), 0.0, b, j15};
-      // Upper triangle only (21 entries): the symmetric rank-2 update is the inner loop's cost.
-      for (int r = 0; r < 6; ++r) {
-        const double w0 = w * j0[r], w1 = w * j1[r];
-        for (int c = r; c < 6; ++c) H(r, c) += w0 * j0[c] + w1 * j1[c];
-        g(r) += w0 * du + w1 * dv;
-      }
-    }
+    pose_normal_equations(pr, st.R, st.t, &H, &g);
     // A point whose Jacobian overflows (huge coordinates, z -> 0+) poisons the step: stop at the pose so far.
     if (!H.allFinite() || !g.allFinite()) break;
     H.template triangularView<Eigen::StrictlyLower>() = H.transpose();
-    if (!o.check_cost) {
-      // Plain Gauss-Newton (RANSAC's local optimisation scores the result itself).
-      const Eigen::Matrix<double, 6, 1> delta = -H.ldlt().solve(g);
-      if (!delta.allFinite()) break;
-      const Mat3<double> dR = so3_exp(delta.head<3>());
-      R = dR * R;
-      t = dR * t + delta.tail<3>();
-      if (delta.norm() < static_cast<double>(o.step_tolerance)) break;
-      continue;
-    }
-    bool accepted = false;
-    Eigen::Matrix<double, 6, 1> delta;
-    for (int tries = 0; tries < 10 && !accepted; ++tries) {
-      Eigen::Matrix<double, 6, 6> A = H;
-      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
-      delta = -A.ldlt().solve(g);
-      if (!delta.allFinite()) {
-        lambda *= 10;
-        continue;
-      }
-      const Mat3<double> dR = so3_exp(delta.head<3>());
-      const Mat3<double> R_new = dR * R;
-      const Vec3<double> t_new = dR * t + delta.tail<3>();
-      std::size_t used_new = 0;
-      double sq_new = 0;
-      const double cost_new = cost_at(R_new, t_new, &used_new, &sq_new);
-      if (cost_new <= cost && used_new >= 3) {
-        const double decrease = cost - cost_new;
-        R = R_new;
-        t = t_new;
-        cost = cost_new;
-        used = used_new;
-        sq = sq_new;
-        lambda = std::max(lambda * 0.1, 1e-12);
-        accepted = true;
-        if (decrease <= static_cast<double>(o.cost_tolerance) * (cost + 1e-300)) it = o.max_iterations;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!accepted || delta.norm() < static_cast<double>(o.step_tolerance)) break;
+    const bool go_on = o.check_cost ? levenberg_marquardt_step(pr, H, g, o, &lambda, &st, &it)
+                                    : gauss_newton_step(H, g, o, &st);
+    if (!go_on) break;
   }
-  if (!o.check_cost) cost = cost_at(R, t, &used, &sq);
-  // Re-orthonormalise: exp() products drift by ~1e-16 per step only, but keep R exactly in SO(3).
-  Eigen::JacobiSVD<Mat3<double>> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  R = svd.matrixU() * svd.matrixV().transpose();
-  res.cam_from_world.R = R.cast<T>();
-  res.cam_from_world.t = t.cast<T>();
-  res.iterations = std::min(it + 1, o.max_iterations);
-  res.num_points = used;
-  res.final_cost = cost;
-  res.rmse_px = used > 0 ? std::sqrt(sq / static_cast<double>(used)) : 0.0;
-  if (!res.cam_from_world.all_finite()) {
-    res.status = Status::NonFinite;
-    res.reason = "refine_pose: the refinement diverged to a non-finite pose";
-  } else if (!std::isfinite(res.final_cost) || !std::isfinite(res.rmse_px)) {
-    res.status = Status::InvalidInput;
-    res.reason = "refine_pose: the reprojection cost overflows (coordinates near the floating-point limit)";
-  } else if (used < 3) {
-    res.status = Status::TooFewPoints;
-    res.reason = "refine_pose: " + std::to_string(used) + " usable points at the final pose, need 3";
-  }
+  if (!o.check_cost) st.cost = pose_lm_cost(pr, st.R, st.t, &st.used, &st.sq);
+  finish_refinement(st, it, o, &res);
   return res;
 }
 
@@ -463,6 +539,84 @@ DYNCULL_SOLVER bool eig3x3_known0(const Mat3<double>& M, Mat3<double>* E, double
   return E->allFinite() && std::isfinite(s1) && std::isfinite(s2);
 }
 
+/// Squared world-side lengths a_ij and bearing cosines b_ij of the P3P triangle (the paper's notation).
+struct P3pTriangle {
+  double a12, a13, a23, b12, b13, b23;
+};
+
+/// A real root gamma of det(D1 + gamma D2) = 0 (eq. 9): one root of the monic cubic in closed form (Lambda
+/// Twist needs any real root), then two Newton steps. False for a degenerate cubic or a non-finite root.
+DYNCULL_SOLVER bool p3p_gamma(const Mat3<double>& D1, const Mat3<double>& D2, double* gamma_out) {
+  Mat3<double> A1, A2;  // adjugates (transposed cofactors) by columns
+  A1 << D1.col(1).cross(D1.col(2)), D1.col(2).cross(D1.col(0)), D1.col(0).cross(D1.col(1));
+  A2 << D2.col(1).cross(D2.col(2)), D2.col(2).cross(D2.col(0)), D2.col(0).cross(D2.col(1));
+  const double c3 = D2.col(0).dot(A2.col(0));
+  if (!(std::abs(c3) > 1e-300) || !std::isfinite(c3)) return false;
+  const double c2 = (D1.array() * A2.array()).sum() / c3;
+  const double c1 = (D2.array() * A1.array()).sum() / c3;
+  const double c0 = D1.col(0).dot(A1.col(0)) / c3;
+
+  const double p = c1 - c2 * c2 / 3.0;
+  const double q = (2.0 * c2 * c2 * c2 - 9.0 * c2 * c1) / 27.0 + c0;
+  const double disc = q * q / 4.0 + p * p * p / 27.0;
+  double gamma;
+  if (disc > 0) {
+    const double sd = std::sqrt(disc);
+    gamma = std::cbrt(-q / 2.0 + sd) + std::cbrt(-q / 2.0 - sd) - c2 / 3.0;
+  } else {
+    const double arg = std::max(-1.0, std::min(1.0, 3.0 * q / (2.0 * p) * std::sqrt(-3.0 / p)));
+    gamma = 2.0 * std::sqrt(-p / 3.0) * std::cos(std::acos(arg) / 3.0) - c2 / 3.0;
+  }
+  for (int it = 0; it < 2; ++it) {
+    const double f = ((gamma + c2) * gamma + c1) * gamma + c0;
+    const double df = (3.0 * gamma + 2.0 * c2) * gamma + c1;
+    if (std::abs(df) > 1e-300) gamma -= f / df;
+  }
+  *gamma_out = gamma;
+  return std::isfinite(gamma);
+}
+
+/// The poses whose depths lie on the plane lambda1 = w0 lambda2 + w1 lambda3 (eq. 13): the roots tau =
+/// lambda3 / lambda2 of its quadratic, the depths refined, each pose from the world and camera triangles
+/// (XX_inv: the world triangle's frame inverted); appended to out while *count < 4.
+DYNCULL_SOLVER void p3p_poses_on_plane(const P3pTriangle& tri, double w0, double w1, const Vec3<double> bearings[3],
+                                       const Vec3<double>& world0, const Mat3<double>& XX_inv, Rigid3<double> out[4],
+                                       int* count) {
+  const double a12 = tri.a12, a13 = tri.a13, a23 = tri.a23, b12 = tri.b12, b13 = tri.b13, b23 = tri.b23;
+  const Vec3<double>& x0 = bearings[0];
+  const Vec3<double>& x1 = bearings[1];
+  const Vec3<double>& x2 = bearings[2];
+  const double a = (a13 - a12) * w1 * w1 + 2.0 * a12 * b13 * w1 - a12;
+  const double b = -2.0 * a13 * b12 * w1 + 2.0 * a12 * b13 * w0 - 2.0 * w0 * w1 * (a12 - a13);
+  const double c = (a13 - a12) * w0 * w0 - 2.0 * a13 * b12 * w0 + a13;
+  const double b2m4ac = b * b - 4.0 * a * c;
+  if (!(b2m4ac > 0) || !std::isfinite(b2m4ac)) return;
+  const double sq = std::sqrt(b2m4ac);
+  double taus[2];
+  taus[0] = (b > 0) ? (2.0 * c) / (-b - sq) : (2.0 * c) / (-b + sq);  // stable quadratic roots
+  taus[1] = c / (a * taus[0]);
+  for (double tau : taus) {
+    if (!(tau > 0) || !std::isfinite(tau)) continue;
+    const double den2 = tau * (tau - 2.0 * b23) + 1.0;
+    if (!(den2 > 0)) continue;
+    double l[3];
+    l[1] = std::sqrt(a23 / den2);
+    l[2] = tau * l[1];
+    l[0] = w0 * l[1] + w1 * l[2];
+    if (!(l[0] > 0)) continue;
+    refine_lambdas(l, a12, a13, a23, b12, b13, b23);
+    const Vec3<double> v1 = l[0] * x0 - l[1] * x1;
+    const Vec3<double> v2 = l[0] * x0 - l[2] * x2;
+    Mat3<double> YY;
+    YY << v1, v2, v1.cross(v2);
+    Rigid3<double> pose;
+    pose.R = YY * XX_inv;
+    pose.t = l[0] * x0 - pose.R * world0;
+    if (!pose.all_finite() || *count >= 4) continue;
+    out[(*count)++] = pose;
+  }
+}
+
 #endif  // solver definitions
 
 }  // namespace detail
@@ -482,33 +636,8 @@ DYNCULL_SOLVER int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> 
   Mat3<double> D1, D2;
   D1 << a23, -a23 * b12, 0.0, -a23 * b12, a23 - a12, a12 * b23, 0.0, a12 * b23, -a12;
   D2 << a23, 0.0, -a23 * b13, 0.0, -a13, a13 * b23, -a23 * b13, a13 * b23, a23 - a13;
-  Mat3<double> A1, A2;  // adjugates (transposed cofactors) by columns
-  A1 << D1.col(1).cross(D1.col(2)), D1.col(2).cross(D1.col(0)), D1.col(0).cross(D1.col(1));
-  A2 << D2.col(1).cross(D2.col(2)), D2.col(2).cross(D2.col(0)), D2.col(0).cross(D2.col(1));
-  const double c3 = D2.col(0).dot(A2.col(0));
-  if (!(std::abs(c3) > 1e-300) || !std::isfinite(c3)) return 0;
-  const double c2 = (D1.array() * A2.array()).sum() / c3;
-  const double c1 = (D2.array() * A1.array()).sum() / c3;
-  const double c0 = D1.col(0).dot(A1.col(0)) / c3;
-
-  // One real root of the monic cubic (closed form; Lambda Twist needs any real root), then a Newton step.
-  const double p = c1 - c2 * c2 / 3.0;
-  const double q = (2.0 * c2 * c2 * c2 - 9.0 * c2 * c1) / 27.0 + c0;
-  const double disc = q * q / 4.0 + p * p * p / 27.0;
-  double gamma;
-  if (disc > 0) {
-    const double sd = std::sqrt(disc);
-    gamma = std::cbrt(-q / 2.0 + sd) + std::cbrt(-q / 2.0 - sd) - c2 / 3.0;
-  } else {
-    const double arg = std::max(-1.0, std::min(1.0, 3.0 * q / (2.0 * p) * std::sqrt(-3.0 / p)));
-    gamma = 2.0 * std::sqrt(-p / 3.0) * std::cos(std::acos(arg) / 3.0) - c2 / 3.0;
-  }
-  for (int it = 0; it < 2; ++it) {
-    const double f = ((gamma + c2) * gamma + c1) * gamma + c0;
-    const double df = (3.0 * gamma + 2.0 * c2) * gamma + c1;
-    if (std::abs(df) > 1e-300) gamma -= f / df;
-  }
-  if (!std::isfinite(gamma)) return 0;
+  double gamma = 0;
+  if (!detail::p3p_gamma(D1, D2, &gamma)) return 0;
 
   const Mat3<double> D0 = D1 + gamma * D2;
   Mat3<double> E;
@@ -525,6 +654,7 @@ DYNCULL_SOLVER int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> 
   if (!(std::abs(det_xx) > 1e-12 * std::pow(std::max(a12, a13), 2))) return 0;
   const Mat3<double> XX_inv = XX.inverse();
 
+  const detail::P3pTriangle tri{a12, a13, a23, b12, b13, b23};
   int count = 0;
   for (int sign = -1; sign <= 1; sign += 2) {
     // lambda1 = w0 lambda2 + w1 lambda3 on each of the two planes through the degenerate conic (eq. 13).
@@ -532,35 +662,7 @@ DYNCULL_SOLVER int solve_p3p(const Vec3<double> bearings[3], const Vec3<double> 
     const double den = ss * E(0, 1) - E(0, 0);
     const double w0 = (E(1, 0) - ss * E(1, 1)) / den;
     const double w1 = (E(2, 0) - ss * E(2, 1)) / den;
-    const double a = (a13 - a12) * w1 * w1 + 2.0 * a12 * b13 * w1 - a12;
-    const double b = -2.0 * a13 * b12 * w1 + 2.0 * a12 * b13 * w0 - 2.0 * w0 * w1 * (a12 - a13);
-    const double c = (a13 - a12) * w0 * w0 - 2.0 * a13 * b12 * w0 + a13;
-    const double b2m4ac = b * b - 4.0 * a * c;
-    if (!(b2m4ac > 0) || !std::isfinite(b2m4ac)) continue;
-    const double sq = std::sqrt(b2m4ac);
-    double taus[2];
-    taus[0] = (b > 0) ? (2.0 * c) / (-b - sq) : (2.0 * c) / (-b + sq);  // stable quadratic roots
-    taus[1] = c / (a * taus[0]);
-    for (double tau : taus) {
-      if (!(tau > 0) || !std::isfinite(tau)) continue;
-      const double den2 = tau * (tau - 2.0 * b23) + 1.0;
-      if (!(den2 > 0)) continue;
-      double l[3];
-      l[1] = std::sqrt(a23 / den2);
-      l[2] = tau * l[1];
-      l[0] = w0 * l[1] + w1 * l[2];
-      if (!(l[0] > 0)) continue;
-      detail::refine_lambdas(l, a12, a13, a23, b12, b13, b23);
-      const Vec3<double> v1 = l[0] * x0 - l[1] * x1;
-      const Vec3<double> v2 = l[0] * x0 - l[2] * x2;
-      Mat3<double> YY;
-      YY << v1, v2, v1.cross(v2);
-      Rigid3<double> pose;
-      pose.R = YY * XX_inv;
-      pose.t = l[0] * x0 - pose.R * world[0];
-      if (!pose.all_finite() || count >= 4) continue;
-      out[count++] = pose;
-    }
+    detail::p3p_poses_on_plane(tri, w0, w1, bearings, world[0], XX_inv, out, &count);
   }
   return count;
 }

@@ -85,6 +85,67 @@ struct DepthCloud {
   std::size_t num_missing = 0;             ///< sampled pixels without a depth measurement
 };
 
+namespace detail {
+
+/// False, with the reason, when depth_to_points cannot run on these inputs (see its contract).
+template <class T, class Raw>
+bool depth_to_points_inputs_ok(const DepthView<Raw>& depth, const PinholeCamera<T>& camera, ConstMaskView exclude,
+                               int stride, std::string* why) {
+  auto fail = [&](std::string reason) {
+    *why = std::move(reason);
+    return false;
+  };
+  if (depth.empty()) return fail("empty depth image");
+  if (depth.validate(why) != Status::Ok) return false;
+  if (stride < 1) return fail("stride must be >= 1");
+  if (!camera.valid() || !std::isfinite(camera.fx) || !std::isfinite(camera.fy))
+    return fail("invalid camera intrinsics (fx, fy must be positive and finite, cx, cy finite)");
+  if (camera.width != depth.width || camera.height != depth.height)
+    return fail("camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                " but the depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height));
+  if (!exclude.empty() && (exclude.width != depth.width || exclude.height != depth.height))
+    return fail("exclude mask size differs from the depth image");
+  if (static_cast<std::uint64_t>(depth.width) * static_cast<std::uint64_t>(depth.height) > (std::uint64_t{1} << 32))
+    return fail("the image has more than 2^32 pixels, beyond the 32-bit pixel_index");
+  return true;
+}
+
+/// x / z of every sampled column into x_over_z, and the largest |x / z|, |y / z| over the sampled grid
+/// (at least 1); false, with the reason, when a ray overflows T.
+template <class T>
+bool sampled_rays(const PinholeCamera<T>& camera, int stride, std::size_t rows, std::vector<T>* x_over_z,
+                  T* max_ray_out, std::string* why) {
+  T max_ray = T(0);
+  for (std::size_t c = 0; c < x_over_z->size(); ++c) {
+    (*x_over_z)[c] = (T(c * static_cast<std::size_t>(stride)) - camera.cx) / camera.fx;
+    max_ray = std::max(max_ray, std::abs((*x_over_z)[c]));
+  }
+  // The rows' rays are largest at the first and last sampled row.
+  const T y_first = (T(0) - camera.cy) / camera.fy;
+  const T y_last = (T((rows - 1) * static_cast<std::size_t>(stride)) - camera.cy) / camera.fy;
+  if (!std::isfinite(max_ray)) {
+    *why = "camera fx so small that (u - cx) / fx overflows";
+    return false;
+  }
+  if (!std::isfinite(y_first) || !std::isfinite(y_last)) {
+    *why = "camera fy so small that (v - cy) / fy overflows";
+    return false;
+  }
+  *max_ray_out = std::max({max_ray, std::abs(y_first), std::abs(y_last), T(1)});
+  return true;
+}
+
+/// The largest depth accepted: depth.max_m, capped so that no point's ray * z overflows T (the cap
+/// joins the range test, at no per-pixel cost).
+template <class T, class Raw>
+float capped_max_depth(const DepthView<Raw>& depth, T max_ray) {
+  const double z_cap = static_cast<double>(std::numeric_limits<T>::max()) / static_cast<double>(max_ray);
+  return static_cast<double>(depth.max_m) < z_cap ? depth.max_m : static_cast<float>(std::min(
+      z_cap * (1.0 - 1e-6), static_cast<double>(std::numeric_limits<float>::max())));
+}
+
+}  // namespace detail
+
 /// Depth image -> camera-frame points for every stride-th pixel in u and v that has a measurement
 /// (DepthView::depth_m() > 0) and is not set in `exclude` (dynamic pixels; empty = keep all).
 /// Depths pass through DepthView::to_metres(), which is float: double clouds carry float-precision
@@ -100,28 +161,15 @@ Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& came
   out->num_missing = 0;
   out->status = Status::Ok;
   out->reason.clear();
-  auto fail = [&](std::string why) {
+  auto fail = [&](const std::string& why) {
     out->points.clear();
     out->pixel_index.clear();
     out->status = Status::InvalidInput;
-    out->reason = "depth_to_points: " + std::move(why);
+    out->reason = "depth_to_points: " + why;
     return out->status;
   };
-  if (depth.empty()) return fail("empty depth image");
-  {
-    std::string why;
-    if (depth.validate(&why) != Status::Ok) return fail(why);
-  }
-  if (stride < 1) return fail("stride must be >= 1");
-  if (!camera.valid() || !std::isfinite(camera.fx) || !std::isfinite(camera.fy))
-    return fail("invalid camera intrinsics (fx, fy must be positive and finite, cx, cy finite)");
-  if (camera.width != depth.width || camera.height != depth.height)
-    return fail("camera is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                " but the depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height));
-  if (!exclude.empty() && (exclude.width != depth.width || exclude.height != depth.height))
-    return fail("exclude mask size differs from the depth image");
-  if (static_cast<std::uint64_t>(depth.width) * static_cast<std::uint64_t>(depth.height) > (std::uint64_t{1} << 32))
-    return fail("the image has more than 2^32 pixels, beyond the 32-bit pixel_index");
+  std::string why;
+  if (!detail::depth_to_points_inputs_ok(depth, camera, exclude, stride, &why)) return fail(why);
   const int w = depth.width, h = depth.height;
   const std::size_t cols = static_cast<std::size_t>((w + stride - 1) / stride);
   const std::size_t rows = static_cast<std::size_t>((h + stride - 1) / stride);
@@ -133,24 +181,12 @@ Status depth_to_points(const DepthView<Raw>& depth, const PinholeCamera<T>& came
   std::uint32_t* I = out->pixel_index.data();
   std::vector<T> x_over_z(cols);
   T max_ray = T(0);
-  for (std::size_t c = 0; c < cols; ++c) {
-    x_over_z[c] = (T(c * static_cast<std::size_t>(stride)) - camera.cx) / camera.fx;
-    max_ray = std::max(max_ray, std::abs(x_over_z[c]));
-  }
-  // The rows' rays are largest at the first and last sampled row.
-  const T y_first = (T(0) - camera.cy) / camera.fy;
-  const T y_last = (T((rows - 1) * static_cast<std::size_t>(stride)) - camera.cy) / camera.fy;
-  if (!std::isfinite(max_ray)) return fail("camera fx so small that (u - cx) / fx overflows");
-  if (!std::isfinite(y_first) || !std::isfinite(y_last)) return fail("camera fy so small that (v - cy) / fy overflows");
-  max_ray = std::max({max_ray, std::abs(y_first), std::abs(y_last), T(1)});
+  if (!detail::sampled_rays(camera, stride, rows, &x_over_z, &max_ray, &why)) return fail(why);
   // Multiply by the inverse scale: equal to DepthView::to_metres() up to one ulp. NaN fails every
   // comparison and +inf fails d <= max_m, so the range test also rejects non-finite raw values.
-  // Depths whose point would overflow T (ray * z > max) are capped into the same test: no per-pixel cost.
   const float inv_units = 1.f / depth.units_per_metre;
-  const double z_cap = static_cast<double>(std::numeric_limits<T>::max()) / static_cast<double>(max_ray);
   const float min_m = depth.min_m;
-  const float max_m = static_cast<double>(depth.max_m) < z_cap ? depth.max_m : static_cast<float>(std::min(
-      z_cap * (1.0 - 1e-6), static_cast<double>(std::numeric_limits<float>::max())));
+  const float max_m = detail::capped_max_depth(depth, max_ray);
   const bool use_mask = !exclude.empty();
   std::size_t k = 0, excluded = 0, missing = 0;
   for (int v = 0; v < h; v += stride) {

@@ -196,7 +196,6 @@ class RansacRunner {
     constexpr bool kCanProbe = has_indexed_residuals_sq<Estimator>::value;
     const bool use_probe = kCanProbe && n_ >= 4 * kProbe;
     std::uint32_t probe[kProbe];
-    Scalar probe_res[kProbe];
     std::size_t probe_min = 0;
     if (use_probe)
       for (std::size_t i = 0; i < kProbe; ++i) probe[i] = rng.index(static_cast<std::uint32_t>(n_));
@@ -212,12 +211,7 @@ class RansacRunner {
       }
       for (int k = 0; k < std::min(m, kMaxModels); ++k) {
         if constexpr (kCanProbe) {
-          if (use_probe && have_best) {
-            est_.residuals_sq(models[k], probe, kProbe, probe_res);
-            std::size_t hits = 0;
-            for (std::size_t i = 0; i < kProbe; ++i) hits += probe_res[i] < thr_sq_;
-            if (hits < probe_min) continue;
-          }
+          if (use_probe && have_best && !passes_probe(models[k], probe, probe_min)) continue;
         }
         const double cost = score(models[k], best_cost);
         if (!(cost < best_cost)) continue;
@@ -248,7 +242,23 @@ class RansacRunner {
     // Final LO, unless the kept model is already the fixed point of an LO run.
     if (opt_.local_optimisation && !lo_converged_) local_optimise(&result.model, &best_cost, &best_inliers, false);
 
-    // Final labelling from the kept model (the residual buffer may hold a rejected refit).
+    label_by_model(&result);
+  }
+
+ private:
+  /// The probe pre-test: true when at least probe_min of the probe data are inliers of `model`.
+  bool passes_probe(const Model& model, const std::uint32_t* probe, std::size_t probe_min) const {
+    Scalar probe_res[kProbe];
+    est_.residuals_sq(model, probe, kProbe, probe_res);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < kProbe; ++i) hits += probe_res[i] < thr_sq_;
+    return hits >= probe_min;
+  }
+
+  /// Final labelling from the kept model (the residual buffer may hold a rejected refit): inlier mask,
+  /// count and MSAC score; Degenerate when the model has fewer inliers than a minimal sample.
+  void label_by_model(RansacResult<Model>* out) {
+    RansacResult<Model>& result = *out;
     est_.residuals_sq(result.model, residuals_.data());
     result.inlier_mask.assign(n_, 0);
     std::size_t count = 0;
@@ -268,8 +278,6 @@ class RansacRunner {
                       std::to_string(kSampleSize) + ")";
     }
   }
-
- private:
 
   void draw_sample(Random& rng, std::uint32_t* sample) {
     const auto n = static_cast<std::uint32_t>(n_);

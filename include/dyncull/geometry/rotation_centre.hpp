@@ -424,6 +424,44 @@ CentreSolution<T> solve_centre_bfgs(const BisectorLines<T>& lines, const Vec2<T>
   return out;
 }
 
+namespace detail {
+
+/// Eq. 15 filter and eq. 16 sums: each bisector's vector pair whose ends are equidistant from `centre`
+/// (within thr px) is marked in inlier_mask, its angle about the centre added to sum_signed and its
+/// magnitude to sum_abs; returns their number. The unsigned eq. 16 angle acos(a.b / |a||b|) equals
+/// |atan2(a x b, a.b)|, which is accurate near 0 where acos is not.
+template <class S, class C1, class C2>
+std::size_t sum_rotation_angles(const C1& points1, const C2& points2, const BisectorLines<S>& lines,
+                                const Vec2<S>& centre, S thr, std::vector<std::uint8_t>* inlier_mask, S* sum_abs,
+                                S* sum_signed) {
+  using std::abs;
+  using std::atan2;
+  using std::sqrt;
+  std::size_t inliers = 0;
+  for (std::size_t j = 0; j < lines.size(); ++j) {
+    const std::size_t i = lines.source[j];
+    const S ax = point_x<S>(points1[i]) - centre.x(), ay = point_y<S>(points1[i]) - centre.y();
+    const S bx = point_x<S>(points2[i]) - centre.x(), by = point_y<S>(points2[i]) - centre.y();
+    const S ra = sqrt(ax * ax + ay * ay), rb = sqrt(bx * bx + by * by);
+    if (!(abs(ra - rb) <= thr)) continue;  // eq. 15, with the absolute value the paper leaves out
+    const S angle = atan2(ax * by - ay * bx, ax * bx + ay * by);
+    *sum_signed += angle;
+    *sum_abs += abs(angle);
+    (*inlier_mask)[i] = 1;
+    ++inliers;
+  }
+  return inliers;
+}
+
+/// Inliers a rotation needs among `vectors` usable ones: min_inliers, the min_inlier_fraction, at least 1.
+inline std::size_t required_rotation_inliers(const RotationCentreOptions& options, std::size_t vectors) {
+  const std::size_t by_fraction =
+      static_cast<std::size_t>(std::ceil(options.min_inlier_fraction * static_cast<double>(vectors)));  // checked: fraction in [0, 1] (validate)
+  return std::max<std::size_t>({options.min_inliers, by_fraction, std::size_t{1}});
+}
+
+}  // namespace detail
+
 template <class T, class C1, class C2>
 auto estimate_rotation_centre(
     const C1& points1, const C2& points2,
@@ -434,9 +472,6 @@ auto estimate_rotation_centre(
                 "by dyncull::PointTraits");
   using S = std::conditional_t<std::is_void<T>::value, typename PointTraits<container_point_t<C1>>::Scalar, T>;
   static_assert(std::is_floating_point<S>::value, "dyncull::estimate_rotation_centre: scalar must be float or double");
-  using std::abs;
-  using std::atan2;
-  using std::sqrt;
 
   RotationCentreResult<S> res;
   res.centre = start;
@@ -485,27 +520,13 @@ auto estimate_rotation_centre(
   res.centre = sol.centre;
   res.cost = sol.cost;
 
-  // Lines 4-12: eq. 15 filter and the angles of eq. 16 over the survivors. The unsigned eq. 16 angle
-  // acos(a.b / |a||b|) equals |atan2(a x b, a.b)|, which is accurate near 0 where acos is not.
-  const S thr = static_cast<S>(options.distance_threshold_px);
+  // Lines 4-12: eq. 15 filter and the angles of eq. 16 over the survivors.
   S sum_abs = S(0), sum_signed = S(0);
-  std::size_t inliers = 0;
-  for (std::size_t j = 0; j < lines.size(); ++j) {
-    const std::size_t i = lines.source[j];
-    const S ax = point_x<S>(points1[i]) - res.centre.x(), ay = point_y<S>(points1[i]) - res.centre.y();
-    const S bx = point_x<S>(points2[i]) - res.centre.x(), by = point_y<S>(points2[i]) - res.centre.y();
-    const S ra = sqrt(ax * ax + ay * ay), rb = sqrt(bx * bx + by * by);
-    if (!(abs(ra - rb) <= thr)) continue;  // eq. 15, with the absolute value the paper leaves out
-    const S angle = atan2(ax * by - ay * bx, ax * bx + ay * by);
-    sum_signed += angle;
-    sum_abs += abs(angle);
-    res.inlier_mask[i] = 1;
-    ++inliers;
-  }
+  const std::size_t inliers =
+      detail::sum_rotation_angles(points1, points2, lines, res.centre, static_cast<S>(options.distance_threshold_px),
+                                  &res.inlier_mask, &sum_abs, &sum_signed);
   res.num_inliers = inliers;
-  const std::size_t by_fraction =
-      static_cast<std::size_t>(std::ceil(options.min_inlier_fraction * static_cast<double>(lines.size())));  // checked: fraction in [0, 1] (validate)
-  const std::size_t need_inliers = std::max<std::size_t>({options.min_inliers, by_fraction, std::size_t{1}});
+  const std::size_t need_inliers = detail::required_rotation_inliers(options, lines.size());
   if (inliers < need_inliers) {
     return fail(Status::TooFewPoints, "rotation centre: only " + std::to_string(inliers) + " of " +
                                           std::to_string(lines.size()) + " vectors are equidistant from OP (eq. 15, " +

@@ -377,86 +377,20 @@ class YoloDetector {
     };
     std::string why;
     if (options.validate(&why) != Status::Ok) return fail(Status::InvalidInput, why);
-    if (options.model.empty()) return fail(Status::InvalidInput, "options.model is empty (a Darknet .cfg or an .onnx)");
+    if (!model_kind_fits(options, &why)) return fail(Status::InvalidInput, why);
     const bool darknet = ends_with(options.model, ".cfg");
-    const bool onnx = ends_with(options.model, ".onnx");
-    if (!darknet && !onnx)
-      return fail(Status::InvalidInput, options.model + ": unknown model type (expected a Darknet .cfg or an .onnx)");
-    if (darknet && options.weights.empty())
-      return fail(Status::InvalidInput, text::quote_path(options.model) +
-                                            ": a Darknet cfg needs its .weights file (options.weights is empty)");
-    if (onnx && !options.weights.empty())
-      return fail(Status::InvalidInput, text::quote_path(options.model) +
-                                            ": an ONNX model holds its own weights (options.weights must be empty)");
-    if (darknet && (options.head == YoloHead::YoloV5 || options.head == YoloHead::YoloV8))
-      return fail(Status::InvalidInput, text::quote_path(options.model) + ": a Darknet cfg has Darknet heads, not " +
-                                            to_string(options.head));
-    if (onnx && options.head == YoloHead::Darknet)
-      return fail(Status::InvalidInput, text::quote_path(options.model) +
-                                            ": an ONNX export has a YOLOv5 or YOLOv8 head, not darknet");
-    // The files are read here, under the file-opening rule, and OpenCV parses the bytes: it never opens a
-    // path itself, so a FIFO, a device or a file swapped after the check never reaches it.
-    std::vector<char> model_bytes, weights_bytes;
-    if (!read_model_file(options.model, darknet ? kMaxYoloCfgBytes : kMaxYoloModelBytes, &model_bytes, &why) ||
-        (darknet && !read_model_file(options.weights, kMaxYoloModelBytes, &weights_bytes, &why)))
-      return fail(Status::IoError, why);
     DarknetLayout layout;
-    if (darknet) {
-      const Status st = check_darknet_files(options, model_bytes, weights_bytes, &layout, &why);
-      if (st != Status::Ok) return fail(st, why);
-    }
-    try {
-      net_ = darknet ? cv::dnn::readNetFromDarknet(model_bytes.data(), model_bytes.size(), weights_bytes.data(),
-                                                   weights_bytes.size())
-                     : cv::dnn::readNetFromONNX(model_bytes.data(), model_bytes.size());
-    } catch (const cv::Exception& e) {
-      return fail(Status::ParseError, options.model + ": OpenCV cannot read the model: " + first_line(e.what()));
-    } catch (const std::exception& e) {
-      return fail(Status::ParseError, options.model + ": OpenCV cannot read the model: " + first_line(e.what()));
-    }
-    if (net_.empty()) return fail(Status::ParseError, options.model + ": OpenCV read an empty network");
-    try {
-      net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-      net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-      out_names_ = net_.getUnconnectedOutLayersNames();
-      // Warm-up on a blank input: checks the outputs and allocates the network's buffers.
-      const int shape[4] = {1, 3, options.input_height, options.input_width};
-      blob_.create(4, shape, CV_32F);
-      blob_.setTo(0);
-      net_.setInput(blob_);
-      net_.forward(outputs_, out_names_);
-    } catch (const cv::Exception& e) {
-      return fail(Status::ParseError, options.model + ": the network does not run on a " +
-                                          std::to_string(options.input_width) + " x " +
-                                          std::to_string(options.input_height) + " input: " + first_line(e.what()));
-    }
+    const Status read = read_network(options, darknet, &layout, &why);
+    if (read != Status::Ok) return fail(read, why);
+    if (!warm_up(options, &why)) return fail(Status::ParseError, why);
     if (outputs_.empty()) return fail(Status::InvalidInput, options.model + ": the network has no output");
     if (darknet) {
       head_ = YoloHead::Darknet;
       // A cfg without [yolo] layers is reported below with its outputs' shapes.
       if (!layout.heads.empty() && !detail::outputs_fit_layout(outputs_, layout, &why))
         return fail(Status::InvalidInput, options.model + ": " + why);
-    } else {
-      // Some YOLOv5 exports keep the raw per-scale maps ([1, 3, H, W, 85]) beside the decoded output:
-      // the outputs that are a head are used, the others not computed.
-      head_ = options.head;
-      std::vector<cv::String> heads;
-      for (std::size_t k = 0; k < outputs_.size(); ++k) {
-        const YoloHead h = head_ != YoloHead::Auto ? head_ : detail::onnx_head_of(outputs_[k], options.num_classes);
-        int n = 0;
-        if (h == YoloHead::Auto || !detail::head_fits(outputs_[k], h, options.num_classes, &n)) continue;
-        head_ = h;
-        heads.push_back(out_names_[k]);
-      }
-      if (heads.empty()) heads.push_back(out_names_.front());  // reported below with its shape
-      if (heads.size() != out_names_.size()) {
-        out_names_ = heads;
-        try {
-          net_.forward(outputs_, out_names_);
-        } catch (const cv::Exception& e) {
-          return fail(Status::ParseError, options.model + ": the network does not run: " + first_line(e.what()));
-        }
-      }
+    } else if (!select_onnx_heads(options, &why)) {
+      return fail(Status::ParseError, why);
     }
     int anchors = 0;
     for (std::size_t k = 0; k < outputs_.size(); ++k) {
@@ -527,6 +461,106 @@ class YoloDetector {
   }
 
  private:
+  /// False, with the reason, when the model is neither a Darknet cfg nor an ONNX file, or its weights or
+  /// head option do not go with its kind.
+  static bool model_kind_fits(const YoloDetectorOptions& options, std::string* why) {
+    auto bad = [&](std::string reason) {
+      *why = std::move(reason);
+      return false;
+    };
+    if (options.model.empty()) return bad("options.model is empty (a Darknet .cfg or an .onnx)");
+    const bool darknet = ends_with(options.model, ".cfg");
+    const bool onnx = ends_with(options.model, ".onnx");
+    if (!darknet && !onnx) return bad(options.model + ": unknown model type (expected a Darknet .cfg or an .onnx)");
+    if (darknet && options.weights.empty())
+      return bad(text::quote_path(options.model) + ": a Darknet cfg needs its .weights file (options.weights is empty)");
+    if (onnx && !options.weights.empty())
+      return bad(text::quote_path(options.model) +
+                 ": an ONNX model holds its own weights (options.weights must be empty)");
+    if (darknet && (options.head == YoloHead::YoloV5 || options.head == YoloHead::YoloV8))
+      return bad(text::quote_path(options.model) + ": a Darknet cfg has Darknet heads, not " + to_string(options.head));
+    if (onnx && options.head == YoloHead::Darknet)
+      return bad(text::quote_path(options.model) + ": an ONNX export has a YOLOv5 or YOLOv8 head, not darknet");
+    return true;
+  }
+
+  /// Reads the model files under the file-opening rule and has OpenCV parse the bytes into net_ (it never
+  /// opens a path itself, so a FIFO, a device or a file swapped after the check never reaches it); a
+  /// Darknet cfg's layers into `layout`, checked against the weights' size.
+  Status read_network(const YoloDetectorOptions& options, bool darknet, DarknetLayout* layout, std::string* why) {
+    std::vector<char> model_bytes, weights_bytes;
+    if (!read_model_file(options.model, darknet ? kMaxYoloCfgBytes : kMaxYoloModelBytes, &model_bytes, why) ||
+        (darknet && !read_model_file(options.weights, kMaxYoloModelBytes, &weights_bytes, why)))
+      return Status::IoError;
+    if (darknet) {
+      const Status st = check_darknet_files(options, model_bytes, weights_bytes, layout, why);
+      if (st != Status::Ok) return st;
+    }
+    try {
+      net_ = darknet ? cv::dnn::readNetFromDarknet(model_bytes.data(), model_bytes.size(), weights_bytes.data(),
+                                                   weights_bytes.size())
+                     : cv::dnn::readNetFromONNX(model_bytes.data(), model_bytes.size());
+    } catch (const cv::Exception& e) {
+      *why = options.model + ": OpenCV cannot read the model: " + first_line(e.what());
+      return Status::ParseError;
+    } catch (const std::exception& e) {
+      *why = options.model + ": OpenCV cannot read the model: " + first_line(e.what());
+      return Status::ParseError;
+    }
+    if (net_.empty()) {
+      *why = options.model + ": OpenCV read an empty network";
+      return Status::ParseError;
+    }
+    return Status::Ok;
+  }
+
+  /// Runs the network once on a blank input of the options' size: checks it runs, fills outputs_ for the
+  /// head checks and allocates the network's buffers. False, with the reason, when OpenCV fails.
+  bool warm_up(const YoloDetectorOptions& options, std::string* why) {
+    try {
+      net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+      net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+      out_names_ = net_.getUnconnectedOutLayersNames();
+      const int shape[4] = {1, 3, options.input_height, options.input_width};
+      blob_.create(4, shape, CV_32F);
+      blob_.setTo(0);
+      net_.setInput(blob_);
+      net_.forward(outputs_, out_names_);
+    } catch (const cv::Exception& e) {
+      *why = options.model + ": the network does not run on a " + std::to_string(options.input_width) + " x " +
+             std::to_string(options.input_height) + " input: " + first_line(e.what());
+      return false;
+    }
+    return true;
+  }
+
+  /// The ONNX outputs that are a YOLO head (of options.head, or the first kind recognised when Auto) become
+  /// the outputs computed: some YOLOv5 exports keep the raw per-scale maps ([1, 3, H, W, 85]) beside the
+  /// decoded output. With none, the first output stays, for its shape to be reported. False, with the
+  /// reason, when the network does not run on the narrowed outputs.
+  bool select_onnx_heads(const YoloDetectorOptions& options, std::string* why) {
+    head_ = options.head;
+    std::vector<cv::String> heads;
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      const YoloHead h = head_ != YoloHead::Auto ? head_ : detail::onnx_head_of(outputs_[k], options.num_classes);
+      int n = 0;
+      if (h == YoloHead::Auto || !detail::head_fits(outputs_[k], h, options.num_classes, &n)) continue;
+      head_ = h;
+      heads.push_back(out_names_[k]);
+    }
+    if (heads.empty()) heads.push_back(out_names_.front());  // reported below with its shape
+    if (heads.size() != out_names_.size()) {
+      out_names_ = heads;
+      try {
+        net_.forward(outputs_, out_names_);
+      } catch (const cv::Exception& e) {
+        *why = options.model + ": the network does not run: " + first_line(e.what());
+        return false;
+      }
+    }
+    return true;
+  }
+
   static bool ends_with(const std::string& s, const char* suffix) {
     const std::string x(suffix);
     if (s.size() < x.size()) return false;

@@ -367,6 +367,90 @@ inline void detect_instances(const Scene& scene, int index, FrameData* out) {
   }
 }
 
+/// An invalid frame: every buffer empty, size 0.
+inline void clear_frame(FrameData* out) {
+  out->width = out->height = 0;
+  out->rgb.clear();
+  out->gray.clear();
+  out->depth_m.clear();
+  out->instance.clear();
+  out->moving.clear();
+  out->motion_m.clear();
+  out->primitive.clear();
+}
+
+/// Every per-pixel buffer sized for n pixels (rgb: 3 n).
+inline void resize_frame(FrameData* out, std::size_t n) {
+  out->rgb.resize(3 * n);
+  out->gray.resize(n);
+  out->depth_m.resize(n);
+  out->instance.resize(n);
+  out->moving.resize(n);
+  out->motion_m.resize(n);
+  out->primitive.resize(n);
+}
+
+/// Visibility: z-buffer over each primitive's screen bounds (the room covers every pixel first). zbuf
+/// (initialised to kNoHit) gets the nearest ray parameter of each pixel, prim_id its primitive.
+inline void zbuffer(const std::vector<Primitive>& prims, const std::vector<CameraPrimitive>& cps,
+                    const std::vector<double>& ray_x, const std::vector<double>& ray_y, int w, double near_m,
+                    std::vector<double>* zbuf, std::uint16_t* prim_id) {
+  for (std::size_t k = 0; k < prims.size(); ++k) {
+    const PixelRect& r = cps[k].bounds;
+    const Mat3<double>& R = cps[k].local_from_cam_R;
+    for (int v = r.r0; v < r.r1; ++v) {
+      // Local ray direction is affine in x along a row: row_base + x * R.col(0).
+      const Vec3<double> row_base = R.col(1) * ray_y[static_cast<std::size_t>(v)] + R.col(2);
+      const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
+      for (int u = r.c0; u < r.c1; ++u) {
+        const double lambda =
+            intersect_local(prims[k], cps[k], row_base + ray_x[static_cast<std::size_t>(u)] * R.col(0), near_m);
+        if (lambda < (*zbuf)[row + static_cast<std::size_t>(u)]) {
+          (*zbuf)[row + static_cast<std::size_t>(u)] = lambda;
+          prim_id[row + static_cast<std::size_t>(u)] = static_cast<std::uint16_t>(k);
+        }
+      }
+    }
+  }
+}
+
+/// Pixel i where no surface is seen (only possible with a camera outside the room): black, static.
+inline void clear_pixel(FrameData* out, std::size_t i) {
+  out->rgb[3 * i] = out->rgb[3 * i + 1] = out->rgb[3 * i + 2] = 0;
+  out->gray[i] = 0;
+  out->instance[i] = 0;
+  out->moving[i] = 0;
+  out->motion_m[i] = 0.f;
+}
+
+/// Colour and grey of pixel i seeing primitive p at `local` (its frame): albedo times texture times a
+/// Lambertian shade towards `light`.
+inline void shade_pixel(const Primitive& p, const Vec3<double>& local, const Vec3<double>& light, FrameData* out,
+                        std::size_t i) {
+  int axis = -1;
+  const Vec3<double> n_local = local_normal(p, local, &axis);
+  Vec3<double> tex_point = local;
+  std::uint32_t tex_seed = p.texture_seed;
+  Vec3<double> albedo = p.albedo;
+  if (axis >= 0) {
+    // Box faces: drop the constant coordinate (it sits on a cell boundary) and vary per face.
+    const bool positive = local[axis] >= 0;
+    tex_seed ^= static_cast<std::uint32_t>(2 * axis + (positive ? 1 : 0)) * 0x68E31DA4u;
+    tex_point[axis] = 0;
+    if (p.shape == PrimitiveShape::RoomInterior) albedo = room_face_albedo(albedo, axis, local[axis]);
+  }
+  const double texture = 0.55 + p.texture_contrast * (texture_value(tex_point, p.texture_cell_m, tex_seed) - 0.55);
+  const double shade = 0.45 + 0.55 * std::max(0.0, (p.world_from_local.R * n_local).dot(light));
+  const double g = 255.0 * texture * shade;
+  const double r8 = std::min(255.0, albedo.x() * g), g8 = std::min(255.0, albedo.y() * g),
+               b8 = std::min(255.0, albedo.z() * g);
+  // checked: albedo, texture and shade are non-negative and each channel is capped at 255.
+  out->rgb[3 * i] = static_cast<std::uint8_t>(r8 + 0.5);      // checked: above
+  out->rgb[3 * i + 1] = static_cast<std::uint8_t>(g8 + 0.5);  // checked: above
+  out->rgb[3 * i + 2] = static_cast<std::uint8_t>(b8 + 0.5);  // checked: above
+  out->gray[i] = static_cast<std::uint8_t>(std::min(255.0, 0.299 * r8 + 0.587 * g8 + 0.114 * b8 + 0.5));  // checked: above
+}
+
 }  // namespace detail
 
 inline void Scene::render(int index, FrameData* out) const {
@@ -377,14 +461,7 @@ inline void Scene::render(int index, FrameData* out) const {
     out->status = Status::InvalidInput;
     out->reason = !ok() ? "invalid scene options: " + reason_
                         : "frame index " + std::to_string(index) + " outside [0, " + std::to_string(options_.num_frames) + ")";
-    out->width = out->height = 0;
-    out->rgb.clear();
-    out->gray.clear();
-    out->depth_m.clear();
-    out->instance.clear();
-    out->moving.clear();
-    out->motion_m.clear();
-    out->primitive.clear();
+    detail::clear_frame(out);
     return;
   }
   out->status = Status::Ok;
@@ -395,13 +472,7 @@ inline void Scene::render(int index, FrameData* out) const {
   out->height = h;
   out->timestamp = timestamp(index);
   out->world_from_cam = world_from_cam(index);
-  out->rgb.resize(3 * n);
-  out->gray.resize(n);
-  out->depth_m.resize(n);
-  out->instance.resize(n);
-  out->moving.resize(n);
-  out->motion_m.resize(n);
-  out->primitive.resize(n);
+  detail::resize_frame(out, n);
 
   std::vector<Primitive> prims, prims_other;
   primitives(index, &prims);
@@ -411,29 +482,12 @@ inline void Scene::render(int index, FrameData* out) const {
   std::vector<CameraPrimitive> cps(prims.size());
   for (std::size_t k = 0; k < prims.size(); ++k) cps[k] = prepare(prims[k], cam_from_world, camera_, options_.near_m);
 
-  // Visibility: z-buffer over each primitive's screen bounds (the room covers every pixel first).
   float* depth = out->depth_m.data();
   std::uint16_t* prim_id = out->primitive.data();
   std::fill(depth, depth + n, 0.f);
   std::fill(prim_id, prim_id + n, std::uint16_t(0));
   std::vector<double> zbuf(n, kNoHit);
-  for (std::size_t k = 0; k < prims.size(); ++k) {
-    const PixelRect& r = cps[k].bounds;
-    const Mat3<double>& R = cps[k].local_from_cam_R;
-    for (int v = r.r0; v < r.r1; ++v) {
-      // Local ray direction is affine in x along a row: row_base + x * R.col(0).
-      const Vec3<double> row_base = R.col(1) * ray_y_[static_cast<std::size_t>(v)] + R.col(2);
-      const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
-      for (int u = r.c0; u < r.c1; ++u) {
-        const double lambda = intersect_local(prims[k], cps[k], row_base + ray_x_[static_cast<std::size_t>(u)] * R.col(0),
-                                              options_.near_m);
-        if (lambda < zbuf[row + static_cast<std::size_t>(u)]) {
-          zbuf[row + static_cast<std::size_t>(u)] = lambda;
-          prim_id[row + static_cast<std::size_t>(u)] = static_cast<std::uint16_t>(k);
-        }
-      }
-    }
-  }
+  detail::zbuffer(prims, cps, ray_x_, ray_y_, w, options_.near_m, &zbuf, prim_id);
 
   // Shading, instance and moving truth.
   const Vec3<double> light = detail::light_direction();
@@ -442,40 +496,14 @@ inline void Scene::render(int index, FrameData* out) const {
     for (int u = 0; u < w; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(w) + static_cast<std::size_t>(u);
       const double lambda = zbuf[i];
-      if (!(lambda < kNoHit)) {  // no surface (only possible with a camera outside the room)
-        out->rgb[3 * i] = out->rgb[3 * i + 1] = out->rgb[3 * i + 2] = 0;
-        out->gray[i] = 0;
-        out->instance[i] = 0;
-        out->moving[i] = 0;
-        out->motion_m[i] = 0.f;
+      if (!(lambda < kNoHit)) {
+        detail::clear_pixel(out, i);
         continue;
       }
       const Primitive& p = prims[prim_id[i]];
       const CameraPrimitive& cp = cps[prim_id[i]];
       const Vec3<double> local = cp.origin_local + lambda * (cp.local_from_cam_R * Vec3<double>(ray_x_[static_cast<std::size_t>(u)], y, 1.0));
-      int axis = -1;
-      const Vec3<double> n_local = local_normal(p, local, &axis);
-      Vec3<double> tex_point = local;
-      std::uint32_t tex_seed = p.texture_seed;
-      Vec3<double> albedo = p.albedo;
-      if (axis >= 0) {
-        // Box faces: drop the constant coordinate (it sits on a cell boundary) and vary per face.
-        const bool positive = local[axis] >= 0;
-        tex_seed ^= static_cast<std::uint32_t>(2 * axis + (positive ? 1 : 0)) * 0x68E31DA4u;
-        tex_point[axis] = 0;
-        if (p.shape == PrimitiveShape::RoomInterior) albedo = detail::room_face_albedo(albedo, axis, local[axis]);
-      }
-      const double texture =
-          0.55 + p.texture_contrast * (texture_value(tex_point, p.texture_cell_m, tex_seed) - 0.55);
-      const double shade = 0.45 + 0.55 * std::max(0.0, (p.world_from_local.R * n_local).dot(light));
-      const double g = 255.0 * texture * shade;
-      const double r8 = std::min(255.0, albedo.x() * g), g8 = std::min(255.0, albedo.y() * g),
-                   b8 = std::min(255.0, albedo.z() * g);
-      // checked: albedo, texture and shade are non-negative and each channel is capped at 255.
-      out->rgb[3 * i] = static_cast<std::uint8_t>(r8 + 0.5);      // checked: above
-      out->rgb[3 * i + 1] = static_cast<std::uint8_t>(g8 + 0.5);  // checked: above
-      out->rgb[3 * i + 2] = static_cast<std::uint8_t>(b8 + 0.5);  // checked: above
-      out->gray[i] = static_cast<std::uint8_t>(std::min(255.0, 0.299 * r8 + 0.587 * g8 + 0.114 * b8 + 0.5));  // checked: above
+      detail::shade_pixel(p, local, light, out, i);
       out->instance[i] = p.instance;
       out->moving[i] = p.moving;
       out->motion_m[i] =

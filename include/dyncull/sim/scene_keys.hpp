@@ -270,12 +270,12 @@ SceneKey enum_key(const char* name, FieldRef<E> ref, const std::vector<E>& value
   return k;
 }
 
-inline std::vector<SceneKey> make_scene_keys() {
+/// The top-level keys: image, frames, camera motion, seed, detector rates, clipping.
+inline void add_top_level_keys(std::vector<SceneKey>* keys) {
+  std::vector<SceneKey>& k = *keys;
   using O = SceneOptions;
   constexpr double kMinFps = 1e-3;
   constexpr double kMaxStartTimeS = 4e9;
-  std::vector<SceneKey> k;
-  // Top level.
   k.push_back(int_key("width", [](O& o) -> int& { return o.width; }, 1, 8192, "image width, px"));
   k.push_back(int_key("height", [](O& o) -> int& { return o.height; }, 1, 8192, "image height, px"));
   // Frame i is stamped start_time_s + i / fps: at least 0.001 Hz keeps a million frames' stamps
@@ -304,7 +304,12 @@ inline std::vector<SceneKey> make_scene_keys() {
                          "timestamp of frame 0, s; within 4e9 s the stamps keep microseconds and stay distinct"));
   k.push_back(number_key("near_m", [](O& o) -> double& { return o.near_m; }, 0, 100, true,
                          "surfaces closer than this are clipped, m"));
-  // Depth noise model.
+}
+
+/// The keys of depth_model: noise, quantisation, range and holes.
+inline void add_depth_model_keys(std::vector<SceneKey>* keys) {
+  std::vector<SceneKey>& k = *keys;
+  using O = SceneOptions;
   k.push_back(number_key("depth_model.sigma_base_m", [](O& o) -> double& { return o.depth_model.sigma_base_m; }, 0, 1,
                          false, "depth sigma at the reference distance, m"));
   k.push_back(number_key("depth_model.sigma_quadratic", [](O& o) -> double& { return o.depth_model.sigma_quadratic; },
@@ -323,7 +328,12 @@ inline std::vector<SceneKey> make_scene_keys() {
                          "relative depth step that makes holes"));
   k.push_back(int_key("depth_model.border_px", [](O& o) -> int& { return o.depth_model.border_px; }, 0, 8192,
                       "band along the image edges without depth, px"));
-  // Camera trajectory.
+}
+
+/// The keys of trajectory: each camera motion's rest pose and amplitudes.
+inline void add_trajectory_keys(std::vector<SceneKey>* keys) {
+  std::vector<SceneKey>& k = *keys;
+  using O = SceneOptions;
   k.push_back(vector_key<3>("trajectory.eye_m", [](O& o) -> Vec3<double>& { return o.trajectory.eye_m; }, -100, 100,
                             "rest position of the camera centre (world, z up), m"));
   k.push_back(vector_key<3>("trajectory.target_m", [](O& o) -> Vec3<double>& { return o.trajectory.target_m; }, -100,
@@ -353,7 +363,12 @@ inline std::vector<SceneKey> make_scene_keys() {
                          "halfsphere: elevation swing, deg"));
   k.push_back(number_key("trajectory.recorded_start_s", [](O& o) -> double& { return o.trajectory.recorded_start_s; },
                          0, 1e6, false, "recorded: seconds into the recording where frame 0 starts"));
-  // Actors.
+}
+
+/// The keys of actors: walkers, seated people, the pushed chair, textures.
+inline void add_actor_keys(std::vector<SceneKey>* keys) {
+  std::vector<SceneKey>& k = *keys;
+  using O = SceneOptions;
   k.push_back(int_key("actors.walking_people", [](O& o) -> int& { return o.actors.walking_people; }, 0, 4,
                       "people walking the elliptic loop"));
   k.push_back(bool_key("actors.sitting_person", [](O& o) -> bool& { return o.actors.sitting_person; },
@@ -385,7 +400,12 @@ inline std::vector<SceneKey> make_scene_keys() {
                          false, "scales the desk people's sway, head turns, gestures and swivels"));
   k.push_back(bool_key("actors.desk_clutter", [](O& o) -> bool& { return o.actors.desk_clutter; },
                        "monitors, keyboards, mice, bottle, cup, book and laptop on the desk"));
-  // Detector model.
+}
+
+/// The keys of detector: the noise model and its calibrated parameters.
+inline void add_detector_keys(std::vector<SceneKey>* keys) {
+  std::vector<SceneKey>& k = *keys;
+  using O = SceneOptions;
   k.push_back(enum_key<DetectorModel>("detector.model", [](O& o) -> DetectorModel& { return o.detector.model; },
                                       {DetectorModel::Gaussian, DetectorModel::Calibrated},
                                       "detector noise model (calibrated: as YOLOv8n on TUM fr3)"));
@@ -402,6 +422,15 @@ inline std::vector<SceneKey> make_scene_keys() {
                          "calibrated: confidence lost by a box cut by the image border"));
   k.push_back(number_key("detector.min_confidence", [](O& o) -> double& { return o.detector.min_confidence; }, 0, 1,
                          false, "calibrated: detections below it are dropped"));
+}
+
+inline std::vector<SceneKey> make_scene_keys() {
+  std::vector<SceneKey> k;
+  add_top_level_keys(&k);
+  add_depth_model_keys(&k);
+  add_trajectory_keys(&k);
+  add_actor_keys(&k);
+  add_detector_keys(&k);
   return k;
 }
 
