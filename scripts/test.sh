@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds dyncull with warnings as errors and runs the whole ctest suite.
-#   scripts/test.sh            Release (-O3, g++) build in build/test
+#   scripts/test.sh            Release (-O2, g++) build in build/test
 #   scripts/test.sh --asan     AddressSanitizer + UndefinedBehaviorSanitizer build (clang++) in build/asan
 # DYNCULL_DATA_DIR (default: ../shared/data beside the checkout, when it exists) enables real-data tests.
 set -euo pipefail
@@ -17,8 +17,10 @@ echo "test.sh: DYNCULL_DATA_DIR=${DYNCULL_DATA_DIR:-<unset: real-data tests will
 case "$mode" in
   release|"")
     build="$root/build/test"
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDYNCULL_WERROR=ON \
-      -DDYNCULL_DATA_DIR="${DYNCULL_DATA_DIR:-}" >/dev/null
+    # -O2: the suite compiles about 10 % faster than at CMake's Release -O3 and tests the same code (no
+    # fast-math at either level); the published timings come from scripts/benchmarks.sh's -O3 build.
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" \
+      -DDYNCULL_WERROR=ON -DDYNCULL_DATA_DIR="${DYNCULL_DATA_DIR:-}" >/dev/null
     ;;
   --asan)
     build="$root/build/asan"
