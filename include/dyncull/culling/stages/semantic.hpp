@@ -146,10 +146,13 @@ template <class T, class Keypoints, class Raw>
 std::size_t claim_head_bands(const Keypoints& kp, const DepthView<Raw>& depth, const DepthMaskResult& dm,
                              const std::vector<Detection<T>>& dyn_boxes, const MotionLevelTable& levels,
                              const DepthMaskStageOptions& options, SemanticEvidence<T>* s) {
-  const std::size_t n = s->labels.size();
-  s->head_band_box.assign(n, -1);
+  const std::size_t n = s->labels.size();  // head_band_box: all -1 (classify_by_boxes)
   if (!(options.head_band_fraction > 0)) return 0;
   const std::size_t nb = std::min<std::size_t>({dyn_boxes.size(), dm.boxes.size(), 32});
+  // A box has a head band when it is a person's (high level) with an object depth.
+  bool has_band[32] = {};
+  for (std::size_t k = 0; k < nb; ++k)
+    has_band[k] = levels.level(dyn_boxes[k].class_id) == MotionLevel::High && dm.boxes[k].ok() && dm.boxes[k].d_c_m > 0;
   std::size_t claimed = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (s->in_dyn_box[i] || s->labels[i] != FeatureLabel::Static || s->reasons[i] != CullReason::None) continue;
@@ -161,10 +164,10 @@ std::size_t claim_head_bands(const Keypoints& kp, const DepthView<Raw>& depth, c
     std::int32_t best = -1;
     double best_gap = options.head_band_depth_tolerance_m;
     for (std::size_t k = 0; k < nb; ++k) {
+      if (!has_band[k]) continue;
       const Box<T>& b = dyn_boxes[k].box;
       const double top = static_cast<double>(b.y0), band = options.head_band_fraction * static_cast<double>(b.y1 - b.y0);
       const double dc = dm.boxes[k].d_c_m;
-      if (levels.level(dyn_boxes[k].class_id) != MotionLevel::High || !dm.boxes[k].ok() || !(dc > 0)) continue;
       if (!(y < top && y >= top - band && x >= static_cast<double>(b.x0) && x <= static_cast<double>(b.x1))) continue;
       const double gap = std::abs(d - dc);
       if (gap <= best_gap) {
@@ -183,8 +186,6 @@ std::size_t claim_head_bands(const Keypoints& kp, const DepthView<Raw>& depth, c
   }
   return claimed;
 }
-}  // namespace detail
-namespace detail {
 
 /// What the semantic stages read: the box rule's and the depth masks' options, the class levels, and the
 /// inputs each needs (their declarations).
