@@ -163,7 +163,7 @@ bool cell_moves_coherently(ArrayView<Vec2<T>> residuals, std::uint32_t begin, st
 /// [1, 8]) whose features' residual vectors share a significant median, and turns
 /// their Static labels Dynamic (Candidate labels, features without evidence, stay). residuals[i]: measured
 /// minus predicted pixel of feature i (ReprojectionCheckResult::residual_vec, NaN where none); noise_px:
-/// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: min_noise_px).
+/// per-component sd of a static residual (ReprojectionCheckResult::inlier_noise_px; NaN: kMinNoisePx).
 /// in_object_mask / object_box_bits as in refine_subboxes: a box's cells hold only its object's features.
 /// eligible: optional per feature, 0 = takes no part (neither tested nor flagged). residuals (required)
 /// and a given flag view whose size is not points.size() give InvalidInput naming it and both sizes
