@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Counts the settable leaves of an options struct in include/dyncull: each data member is one leaf,
 except a member or base that is itself an options struct of the library, whose leaves count instead.
-A class with private data (MotionLevelTable) is one leaf. The evidence stages' slots
-(detail::OptionSlots<EvidenceStages<T>>) count as the options of the stages listed in stages/list.hpp.
+A class with private data (MotionLevelTable) is one leaf. The stages' slots
+(detail::OptionSlots<PipelineStages<T>>) count as the options of the stages listed in stages/list.hpp.
 
   scripts/count-option-leaves.py [--max N] [--list] STRUCT...   e.g. PipelineOptions CullerCoreOptions
 Exit status 1 when a struct has more than N leaves (CI keeps the pipeline's settings readable)."""
@@ -83,7 +83,7 @@ def listed_stage_options():
     slots = {}
     for f in os.listdir(stages):
         header = strip_comments(open(os.path.join(stages, f), encoding="utf-8").read())
-        for m in re.finditer(r"struct (\w+)\s*\{.*?using Options = (\w+)<.*?struct OptionsSlot\s*\{\s*Options (\w+)",
+        for m in re.finditer(r"struct (\w+Stage)\s*\{.*?using Options = (\w+)\b.*?struct OptionsSlot\s*\{\s*Options (\w+)",
                              header, re.S):
             slots[m.group(1)] = (m.group(3), m.group(2))
     return [slots[s] for s in listed]

@@ -8,7 +8,7 @@
 #include "dyncull/culling/stages/context.hpp"
 #include "dyncull/culling/stages/geometric.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
-#include "dyncull/culling/stages/evidence.hpp"
+#include "dyncull/culling/stages/listed.hpp"
 #include "dyncull/culling/stages/multiview.hpp"
 #include "dyncull/culling/stages/probability.hpp"
 #include "dyncull/culling/stages/region_votes.hpp"
@@ -66,8 +66,8 @@ struct StageRun {
                              &state.subbox_memory, &w.votes, &r);
         break;
       case Stage::MultiView:
-        detail::run_evidence_stage(frame, o, detail::EvidenceContext<float>{w, state.keyframes},
-                                   &w.flags_of<MultiViewStage<float>>(), &r);
+        detail::run_listed_stage(frame, o, detail::StageContext<float>{w, state.keyframes},
+                                   &w.marks_of<MultiViewStage<float>>(), &r);
         break;
       case Stage::Combine:
         detail::combine_evidence(o, w, &r);

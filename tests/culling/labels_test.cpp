@@ -23,7 +23,7 @@ TEST(Labels, EveryValueHasADistinctName) {
   }
   EXPECT_EQ(names.size(), 3u);
   names.clear();
-  const int last = static_cast<int>(CullReason::EvidenceStage);
+  const int last = static_cast<int>(CullReason::ListedStage);
   for (int r = 0; r <= last; ++r) {
     const char* s = to_string(static_cast<CullReason>(r));
     EXPECT_STRNE(s, "unknown") << r;

@@ -909,12 +909,12 @@ TYPED_TEST(PipelineTest, StateBuffersAreReusedAcrossFrames) {
   const auto first = run(s, dets, presets::recommended<T>(), &state, config).labels;
   const auto* labels_data = state.result.labels.data();
   const auto* moving_data = state.internals().geometric.moving.scratch_prev.data();
-  const auto* mask_data = state.internals().template flags_of<MultiViewStage<T>>().work.mask.pixels.data();
+  const auto* mask_data = state.internals().template marks_of<MultiViewStage<T>>().work.mask.pixels.data();
   const auto second = run(s, dets, presets::recommended<T>(), &state, config).labels;
   EXPECT_EQ(first, second);
   EXPECT_EQ(labels_data, state.result.labels.data());
   EXPECT_EQ(moving_data, state.internals().geometric.moving.scratch_prev.data());
-  EXPECT_EQ(mask_data, state.internals().template flags_of<MultiViewStage<T>>().work.mask.pixels.data());
+  EXPECT_EQ(mask_data, state.internals().template marks_of<MultiViewStage<T>>().work.mask.pixels.data());
 }
 
 // The README example: a front end with cv::KeyPoint-like keypoints, cv::Point2f-like LK positions and a

@@ -34,7 +34,7 @@ TYPED_TEST_SUITE(StageInputsTest, Scalars, );  // trailing comma: clang -Wpedant
 bool defined(FeatureLabel l) {
   return l == FeatureLabel::Static || l == FeatureLabel::Candidate || l == FeatureLabel::Dynamic;
 }
-bool defined(CullReason r) { return static_cast<int>(r) <= static_cast<int>(CullReason::EvidenceStage); }
+bool defined(CullReason r) { return static_cast<int>(r) <= static_cast<int>(CullReason::ListedStage); }
 
 /// A value for property tests: mostly ordinary, sometimes NaN, +-Inf, huge, negative or tiny.
 template <class T>

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
-#include "dyncull/culling/stages/evidence.hpp"
+#include "dyncull/culling/stages/listed.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
 
 #include <gtest/gtest.h>
@@ -30,12 +30,12 @@ namespace test {
 
 /// The multi-view stage's output in a frame's buffers.
 template <class T>
-detail::StageFlags<MultiViewStage<T>>& multiview_flags(detail::PipelineWork<T>* w) {
-  return w->template flags_of<MultiViewStage<T>>();
+detail::StageMarks<MultiViewStage<T>>& multiview_marks(detail::PipelineWork<T>* w) {
+  return w->template marks_of<MultiViewStage<T>>();
 }
 template <class T>
-const detail::StageFlags<MultiViewStage<T>>& multiview_flags(const detail::PipelineWork<T>* w) {
-  return w->template flags_of<MultiViewStage<T>>();
+const detail::StageMarks<MultiViewStage<T>>& multiview_marks(const detail::PipelineWork<T>* w) {
+  return w->template marks_of<MultiViewStage<T>>();
 }
 
 /// One frame drawn by hand: owns every input a CullingFrame points to. Depth in float metres, 0 = none.
@@ -217,9 +217,9 @@ Parts parts_of(const detail::PipelineWork<T>& w) {
                    .add(v.subbox.cells)
                    .add(v.ok)
                    .str();
-  const auto& m = w.template flags_of<MultiViewStage<T>>();
+  const auto& m = w.template marks_of<MultiViewStage<T>>();
   p["multiview"] =
-      Bytes().add(m.work.check.labels).add(m.work.mask).add(m.work.ref_index).add(m.dynamic).add(m.ok).str();
+      Bytes().add(m.work.check.labels).add(m.work.mask).add(m.work.ref_index).add(m.marks).add(m.ok).str();
   p["history"] = Bytes().add(w.still_frames).add(w.history_kept).add(w.keypoint_depth).str();
   return p;
 }

@@ -28,7 +28,7 @@ enum class CullReason : std::uint8_t {
   Reprojection,       ///< RGB-D reprojection residual above threshold (reprojection_check.hpp)
   CoherentMotion,     ///< its cell's residuals moved together (coherent_motion.hpp), culled by the sub-box vote
   InvalidInput,       ///< non-finite coordinates: never trusted as static
-  EvidenceStage,      ///< flagged by an evidence stage without a reason of its own (culling/stages/stage.hpp)
+  ListedStage,        ///< culled by a stage of culling/stages/list.hpp without a reason of its own
 };
 
 DYNCULL_CONSTEXPR14 const char* to_string(FeatureLabel label) noexcept {
@@ -56,7 +56,7 @@ DYNCULL_CONSTEXPR14 const char* to_string(CullReason reason) noexcept {
     case CullReason::Reprojection: return "reprojection";
     case CullReason::CoherentMotion: return "coherent motion";
     case CullReason::InvalidInput: return "invalid input";
-    case CullReason::EvidenceStage: return "evidence stage";
+    case CullReason::ListedStage: return "listed stage";
   }
   return "unknown";
 }

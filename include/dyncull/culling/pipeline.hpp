@@ -8,7 +8,7 @@
 #include "dyncull/culling/stages/boxes.hpp"
 #include "dyncull/culling/stages/combine.hpp"
 #include "dyncull/culling/stages/context.hpp"
-#include "dyncull/culling/stages/evidence.hpp"
+#include "dyncull/culling/stages/listed.hpp"
 #include "dyncull/culling/stages/geometric.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
 #include "dyncull/culling/stages/probability.hpp"
@@ -31,11 +31,12 @@ namespace dyncull {
 /// InvalidInput with the reason and cull nothing (refused, labelled() false): every keypoint is labelled
 /// Static and kept.
 ///
-/// Each stage reads the earlier stages' outputs and writes only its own (stages/context.hpp):
-///   boxes -> semantic evidence (box rule, depth masks) -> geometric evidence (tracks, 3-D points)
-///   -> probability (semantic labels in the masks) -> region votes (coherent cells, sub-boxes)
-///   -> evidence stages (stages/list.hpp: the multi-view check) -> combination -> static history
-///   -> survivor guard -> keyframe store.
+/// Each stage reads the earlier stages' outputs and writes only its own (stages/context.hpp); the stages
+/// are those of stages/list.hpp, in its order:
+///   boxes -> semantic evidence (box rule, depth masks) -> box classification and depth stages
+///   -> geometric evidence (tracks, 3-D points) -> probability (semantic labels in the masks)
+///   -> region votes (coherent cells, sub-boxes) -> evidence stages (the multi-view check)
+///   -> combination -> static history -> survivor guard -> keyframe store.
 template <class T, class Keypoints, class Prev, class Raw, class Points3>
 const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, Points3>& frame,
                                     const PipelineOptions<T>& options, PipelineState<T>* state) {
@@ -50,11 +51,15 @@ const PipelineResult<T>& cull_frame(const CullingFrame<T, Keypoints, Prev, Raw, 
 
   detail::collect_boxes(frame, options, &s.tracker, &w.regions, &r);
   detail::classify_by_boxes(frame, options, w.regions, &w.semantic, &r);
+  detail::run_listed_stages<StageKind::BoxClassification>(frame, options, s.keyframes, &w, &r);
+  detail::add_box_classifications(&w);
+  detail::run_listed_stages<StageKind::Depth>(frame, options, s.keyframes, &w, &r);
+  detail::limit_by_depth_stages(&w);
   detail::gather_geometric_evidence(frame, options, w.regions, w.semantic, &w.geometric, &r);
   detail::score_probability(frame, options, w.regions, w.semantic, w.geometric, &s.track_states, &w.probability, &r);
   detail::vote_regions(frame, options, s.frame_index, w.regions, w.semantic, w.semantic_labels(), w.geometric,
                        &s.subbox_memory, &w.votes, &r);
-  detail::run_evidence_stages(frame, options, s.keyframes, &w, &r);
+  detail::run_listed_stages<StageKind::Evidence>(frame, options, s.keyframes, &w, &r);
   detail::combine_evidence(options, w, &r);
   detail::apply_static_history(frame, options, w.geometric, &s.static_history, &w.still_frames, &w.history_kept, &r);
   detail::guard_survivors(options, &r);

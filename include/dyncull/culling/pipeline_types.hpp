@@ -12,20 +12,10 @@
 #include "dyncull/core/status.hpp"
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
-#include "dyncull/culling/box_rule.hpp"
-#include "dyncull/culling/box_tracker.hpp"
-#include "dyncull/culling/coherent_motion.hpp"
-#include "dyncull/culling/depth_mask.hpp"
 #include "dyncull/culling/detections.hpp"
-#include "dyncull/culling/dynamic_probability.hpp"
 #include "dyncull/culling/labels.hpp"
 #include "dyncull/culling/motion_levels.hpp"
-#include "dyncull/culling/moving_consistency.hpp"
-#include "dyncull/culling/reprojection_check.hpp"
-#include "dyncull/culling/static_history.hpp"
 #include "dyncull/culling/stages/list.hpp"
-#include "dyncull/culling/stages/stage.hpp"
-#include "dyncull/culling/subbox_refine.hpp"
 #include "dyncull/culling/validation.hpp"
 
 #include <algorithm>
@@ -56,96 +46,6 @@ constexpr const char* to_string(GuardAction a) noexcept {
   return "unknown";
 }
 
-/// The detection filter's options (detections.hpp) with its switch.
-template <class T>
-struct DetectionStageOptions : DetectionOptions<T> {
-  bool enabled = true;  ///< padding and class-dependent confidence
-};
-
-/// The box tracker's options (box_tracker.hpp) with its switch: missed dynamic-class boxes carried
-/// forward (Dynamic-VINS).
-template <class T>
-struct TrackerStageOptions : BoxTrackerOptions<T> {
-  bool enabled = false;
-};
-
-/// The box rule's options (Zhu et al. 2024 Table 2 / Zhang et al. 2023 Algorithm 1) with its switch.
-template <class T>
-struct BoxRuleStageOptions : BoxRuleOptions<T> {
-  bool enabled = true;
-};
-
-/// The depth mask (DLD-SLAM eq. 1-2: box culls limited to the object's depth band) with its switch and the
-/// decisions that need the objects' depths.
-struct DepthMaskStageOptions : DepthMaskOptions {
-  bool enabled = false;
-  /// A feature held by the depth masks of several dynamic-class boxes (a chair in front of a walker)
-  /// belongs to the one whose object depth d_c is nearest its own depth, and takes that box's level: a
-  /// static chair's features are then candidates verified on their own evidence instead of inheriting
-  /// the walker's label. false: the box rule's label (highest level of the rectangles holding it) stands.
-  bool assign_overlaps_by_depth = false;
-  /// With assign_overlaps_by_depth: a high-level object (a person) takes the feature unless another
-  /// object's d_c is nearer its depth by more than this (a seated person's torso and its chair lie at
-  /// nearly the same depth). 0 = nearest d_c only.
-  double overlap_high_level_margin_m = 0;
-  /// A low-level box (a TV) shelters a feature that a dynamic-class object's depth mask holds only when
-  /// the feature's depth is at least as near the low-level object's d_c (re-estimated outside a nearer box
-  /// covering its centre: occluded_centre_search) as the object's: a walker passing in front of a TV is
-  /// not on it. Without a depth there the shelter stands.
-  bool low_override_by_depth = false;
-  /// Head band: detectors often cut a walker's head off the top of its box. A feature in the band of this
-  /// fraction of the box's height above a high-level box (its columns) belongs to that person when its
-  /// depth lies within head_band_depth_tolerance_m of the box's object depth d_c (the background above a
-  /// box is usually farther); it then follows the top row of the box's sub-box vote. 0 = no band.
-  double head_band_fraction = 0;
-  double head_band_depth_tolerance_m = 0.3;
-
-  /// DepthMaskOptions::validate, then overlap_high_level_margin_m finite and in [0, 1e4] m, the head band's
-  /// fraction in [0, 1] and its tolerance in [0, 1e4] m.
-  Status validate(std::string* reason = nullptr) const {
-    if (DepthMaskOptions::validate(reason) != Status::Ok) return Status::InvalidInput;
-    if (!detail::finite_in(overlap_high_level_margin_m, 0, 1e4))
-      return detail::invalid_option(reason, "overlap_high_level_margin_m", "must be finite and in [0, 1e4] m");
-    if (!detail::finite_in(head_band_fraction, 0, 1))
-      return detail::invalid_option(reason, "head_band_fraction", "must be finite and in [0, 1]");
-    if (!detail::finite_in(head_band_depth_tolerance_m, 0, 1e4))
-      return detail::invalid_option(reason, "head_band_depth_tolerance_m", "must be finite and in [0, 1e4] m");
-    if (reason) reason->clear();
-    return Status::Ok;
-  }
-};
-
-/// The dynamic probability (DLD-SLAM eq. 3-5, features in object masks; needs tracks) with its switch.
-template <class T>
-struct ProbabilityStageOptions : DynamicProbabilityOptions<T> {
-  bool enabled = false;
-  /// Flow model of the M term: Fundamental reuses the moving-consistency F when it ran (DLD-SLAM: MeanFlow).
-  FlowModel flow_model = FlowModel::Fundamental;
-
-  /// DynamicProbabilityOptions::validate, then flow_model in range.
-  Status validate(std::string* reason = nullptr) const {
-    if (DynamicProbabilityOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
-    if (static_cast<int>(flow_model) > 2)
-      return detail::invalid_option(reason, "flow_model", "must be MeanFlow, Fundamental or Homography");
-    if (reason) reason->clear();
-    return Status::Ok;
-  }
-};
-
-/// The epipolar moving-consistency check (DFD-SLAM eq. 1-3; needs tracks) with its switch.
-template <class T>
-struct MovingConsistencyStageOptions : MovingConsistencyOptions<T> {
-  bool enabled = true;
-};
-
-/// The RGB-D reprojection check (reprojection_check.hpp; needs CullingFrame::points_3d) with its switch.
-/// Where it runs its labels replace the epipolar ones: the residual also sees the motion along the
-/// epipolar line.
-template <class T>
-struct ReprojectionStageOptions : ReprojectionCheckOptions<T> {
-  bool enabled = false;
-};
-
 /// Geometric flags on occlusion edges discounted (needs the depth image): an LK window straddling an
 /// occlusion edge follows the contour, not a 3-D point, and is flagged although its surface is static.
 /// A flag with a depth step above kDepthStepRatio within radius_px (sampled every 2 px) becomes Candidate.
@@ -168,52 +68,6 @@ struct EdgeEvidenceOptions {
   }
 };
 
-/// The sub-box refinement (DFD-SLAM Algorithm 1; needs the geometric labels) with its switch and when its
-/// vote is trusted.
-template <class T>
-struct SubBoxStageOptions : SubBoxOptions<T> {
-  bool enabled = true;
-  /// Vote only when F (or the pose) was fitted on tracks outside the dynamic-class boxes, or no track lay
-  /// inside one: a model fitted through a large mover absorbs its motion, and the vote would clear the box.
-  bool requires_fit_outside_boxes = true;
-  /// Medium-level candidates (a chair) are culled by a dynamic sub-box of their region (true), or only on
-  /// their own evidence (false): a chair under a seated person otherwise inherits the person's vote.
-  bool verifies_candidates = true;
-  /// Shortest baseline, in frames (CullingFrame::evidence_frames), at which "not flagged" may make part of
-  /// a dynamic-class box static: over fewer frames a slow mover has not moved past the thresholds, so the
-  /// vote is skipped and the box rule decides. 0 = no minimum; evidence_frames 0 (unknown) always votes.
-  int min_evidence_frames = 0;
-  /// With min_evidence_frames: on too short a baseline, the cells of a tracked box keep the states of its
-  /// last vote within min_evidence_frames frames (a seated person's still legs stay static); the box rule
-  /// decides elsewhere. Needs the box tracker.
-  bool short_baseline_keeps_last_vote = false;
-
-  /// SubBoxOptions::validate, then min_evidence_frames in [0, 65535].
-  Status validate(std::string* reason = nullptr) const {
-    if (SubBoxOptions<T>::validate(reason) != Status::Ok) return Status::InvalidInput;
-    if (min_evidence_frames < 0 || min_evidence_frames > 0xFFFF)
-      return detail::invalid_option(reason, "min_evidence_frames", "must be in [0, 65535]");
-    if (reason) reason->clear();
-    return Status::Ok;
-  }
-};
-
-/// Cell-level coherent motion before the sub-box vote (coherent_motion.hpp; needs the reprojection
-/// check, runs with the sub-box refinement on its grid) with its switch: in a cell of a high-level object
-/// whose residuals share a significant median every feature counts as flagged (a seated person's sway).
-template <class T>
-struct CoherentMotionStageOptions : CoherentMotionOptions<T> {
-  bool enabled = false;
-};
-
-/// A track's static history (static_history.hpp; needs CullingFrame::track_ids and the reprojection
-/// check) with its switch: a feature culled only for its region stays static when its own check said
-/// still in each of its last min_frames evaluated frames and does not flag it now.
-template <class T>
-struct StaticHistoryStageOptions : StaticHistoryOptions<T> {
-  bool enabled = false;
-};
-
 /// Minimum-survivor guard: if fewer than max(min_fraction * n, min_survivors) features stay static, first
 /// soften (restore the culls of single geometric stages and of candidates), then undo all culling.
 /// ORB-SLAM2 loses tracking below ~30 local-map inliers; SG-SLAM guards at 10 %.
@@ -232,8 +86,8 @@ struct SurvivorGuardOptions {
 };
 
 namespace detail {
-/// PipelineOptions and PipelineResult hold the options and the report of each listed evidence stage as a
-/// member named as the stage, from the stage's slots (stages/stage.hpp).
+/// PipelineOptions and PipelineResult hold the options and the report of each listed stage as a member
+/// named as the stage, from the stage's slots (stages/stage.hpp).
 template <class List>
 struct OptionSlots;
 template <class... Stages>
@@ -250,45 +104,26 @@ bool slots_valid(const Options& options, StageList<Stages...>, std::string* reas
 }
 }  // namespace detail
 
-/// Which stages run and their options, in front-end order; each stage's `enabled` is its one switch.
-/// The evidence stages' options (stages/list.hpp: `multiview`) come from detail::OptionSlots.
-/// presets.hpp builds the papers' configurations.
+/// Which stages run and their options. Each stage of stages/list.hpp has its options as a member named
+/// as the stage (`detections`, `box_rule`, `subbox`, `multiview`, ...; detail::OptionSlots), with
+/// `enabled` as its one switch; the members below are shared by several stages. presets.hpp builds the
+/// papers' configurations.
 template <class T>
-struct PipelineOptions : detail::OptionSlots<EvidenceStages<T>> {
-  DetectionStageOptions<T> detections{};
-  TrackerStageOptions<T> tracker{};
+struct PipelineOptions : detail::OptionSlots<PipelineStages<T>> {
   MotionLevelTable levels = MotionLevelTable::coco80();
-  BoxRuleStageOptions<T> box_rule{};
-  DepthMaskStageOptions depth_mask{};
-  ProbabilityStageOptions<T> probability{};
-  MovingConsistencyStageOptions<T> moving_consistency{};
-  ReprojectionStageOptions<T> reprojection{};
   EdgeEvidenceOptions edge_evidence{};
-  CoherentMotionStageOptions<T> coherent_motion{};
-  SubBoxStageOptions<T> subbox{};
-  StaticHistoryStageOptions<T> static_history{};
   /// What happens to the features still labelled Candidate (medium-level boxes) at the end.
   CandidatePolicy candidates = CandidatePolicy::Verify;
   SurvivorGuardOptions guard{};
 
   /// InvalidInput naming the first field out of its range, nested fields as "subbox.min_evidence_frames":
-  /// every stage's options pass their validate() whether the stage is on or not; candidates in range.
+  /// every stage's options pass their validate() whether the stage is on or not (in list order), then
+  /// the shared members; candidates in range.
   Status validate(std::string* reason = nullptr) const {
     using detail::validate_nested;
-    // Stages in order; the first failure's reason stands.
-    if (validate_nested(detections, "detections", reason) != Status::Ok ||
-        validate_nested(tracker, "tracker", reason) != Status::Ok ||
+    if (!detail::slots_valid(*this, PipelineStages<T>{}, reason) ||
         validate_nested(levels, "levels", reason) != Status::Ok ||
-        validate_nested(box_rule, "box_rule", reason) != Status::Ok ||
-        validate_nested(depth_mask, "depth_mask", reason) != Status::Ok ||
-        validate_nested(probability, "probability", reason) != Status::Ok ||
-        validate_nested(moving_consistency, "moving_consistency", reason) != Status::Ok ||
-        validate_nested(reprojection, "reprojection", reason) != Status::Ok ||
         validate_nested(edge_evidence, "edge_evidence", reason) != Status::Ok ||
-        validate_nested(coherent_motion, "coherent_motion", reason) != Status::Ok ||
-        validate_nested(subbox, "subbox", reason) != Status::Ok ||
-        validate_nested(static_history, "static_history", reason) != Status::Ok ||
-        !detail::slots_valid(*this, EvidenceStages<T>{}, reason) ||
         validate_nested(guard, "guard", reason) != Status::Ok)
       return Status::InvalidInput;
     if (static_cast<int>(candidates) > 2)
@@ -314,10 +149,10 @@ struct FeatureTrace {
 /// input of the frame. The reason then says "stage: why" for each such stage, as the stage's option is
 /// named, joined with "; ", and the labels and keep mask are those of the stages that did their job
 /// (labelled() is true). A frame refused at entry (invalid options, depth view or sizes: refused is true)
-/// is InvalidInput with nothing culled and labelled() false. The evidence stages' reports (`multiview`)
-/// come from detail::ReportSlots.
+/// is InvalidInput with nothing culled and labelled() false. Each stage of stages/list.hpp reports into a
+/// StageReport named as the stage (`detections`, `box_rule`, `multiview`, ...; detail::ReportSlots).
 template <class T>
-struct PipelineResult : detail::ReportSlots<EvidenceStages<T>> {
+struct PipelineResult : detail::ReportSlots<PipelineStages<T>> {
   Status status = Status::Ok;
   std::string reason;
   bool refused = false;  ///< the frame could not be culled at all: every keypoint Static and kept
@@ -328,9 +163,6 @@ struct PipelineResult : detail::ReportSlots<EvidenceStages<T>> {
   std::vector<CullReason> reasons;   ///< deciding strategy (None for untouched statics)
   std::vector<std::uint8_t> keep;    ///< 1 = static: apply to every parallel per-keypoint array
   std::size_t num_features = 0, num_static = 0, num_dynamic = 0;
-  StageReport detections, tracker, box_rule, depth_mask, probability, moving_consistency, reprojection,
-      coherent_motion, subbox;
-  StageReport static_history;       ///< PipelineOptions::static_history
   std::size_t history_kept = 0;     ///< features the static history kept against a region's cull
   std::size_t unsheltered = 0;      ///< features low_override_by_depth took out of a low-level box's shelter
   GuardAction guard = GuardAction::None;
@@ -366,7 +198,7 @@ struct CullingFrame {
 namespace detail {
 inline bool is_soft_cull(CullReason r) {
   return r == CullReason::Epipolar || r == CullReason::Reprojection || r == CullReason::MultiView ||
-         r == CullReason::EvidenceStage ||
+         r == CullReason::ListedStage ||
          r == CullReason::SubBox || r == CullReason::CoherentMotion || r == CullReason::MediumLevelBox ||
          r == CullReason::TrackedBox;
 }

@@ -43,7 +43,7 @@ detail::PipelineWork<T> evidence() {
   w.geometric.labels = {L::Static, L::Static, L::Dynamic, L::Static, L::Dynamic, L::Dynamic, L::Dynamic, L::Candidate};
   w.geometric.source.assign(8, R::Epipolar);
   w.geometric.source[4] = R::Reprojection;
-  test::multiview_flags(&w).dynamic.assign(8, 0);
+  test::multiview_marks(&w).marks.assign(8, 0);
   w.history_kept.assign(8, 0);
   return w;
 }
@@ -102,8 +102,8 @@ TYPED_TEST(CombineStageTest, GeometricFlagsOutsideBoxesAloneCullNothing) {
 TYPED_TEST(CombineStageTest, MultiViewFlagsCullCandidatesAndStatics) {
   using T = TypeParam;
   auto w = evidence<T>();
-  test::multiview_flags(&w).ok = true;
-  test::multiview_flags(&w).dynamic[0] = test::multiview_flags(&w).dynamic[3] = 1;
+  test::multiview_marks(&w).ok = true;
+  test::multiview_marks(&w).marks[0] = test::multiview_marks(&w).marks[3] = 1;
   const PipelineOptions<T> o;
   const auto r = combined(o, w);
   EXPECT_EQ(r.labels[0], L::Dynamic);
@@ -133,7 +133,7 @@ detail::PipelineWork<T> voted() {
   w.votes.evidence = {L::Static, L::Static, L::Static, L::Dynamic, L::Dynamic};
   w.votes.subbox.labels = {L::Dynamic, L::Static, L::Dynamic, L::Dynamic, L::Dynamic};
   w.votes.subbox.reasons = {R::SubBox, R::None, R::SubBox, R::SubBox, R::Epipolar};
-  test::multiview_flags(&w).dynamic.assign(5, 0);
+  test::multiview_marks(&w).marks.assign(5, 0);
   w.history_kept.assign(5, 0);
   return w;
 }

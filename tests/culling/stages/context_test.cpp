@@ -6,7 +6,7 @@
 #include "dyncull/culling/stages/context.hpp"
 #include "dyncull/culling/stages/geometric.hpp"
 #include "dyncull/culling/stages/inputs.hpp"
-#include "dyncull/culling/stages/evidence.hpp"
+#include "dyncull/culling/stages/listed.hpp"
 #include "dyncull/culling/stages/probability.hpp"
 #include "dyncull/culling/stages/region_votes.hpp"
 #include "dyncull/culling/stages/semantic.hpp"
@@ -81,8 +81,8 @@ std::vector<std::pair<std::string, const void*>> storage_of(const detail::Pipeli
           {"votes.evidence", w.votes.evidence.data()},
           {"votes.coherent_eligible", w.votes.coherent_eligible.data()},
           {"votes.subbox.labels", w.votes.subbox.labels.data()},
-          {"multiview.mask", w.template flags_of<MultiViewStage<T>>().work.mask.pixels.data()},
-          {"multiview.dynamic", w.template flags_of<MultiViewStage<T>>().dynamic.data()},
+          {"multiview.mask", w.template marks_of<MultiViewStage<T>>().work.mask.pixels.data()},
+          {"multiview.marks", w.template marks_of<MultiViewStage<T>>().marks.data()},
           {"history_kept", w.history_kept.data()}};
 }
 
@@ -115,7 +115,7 @@ TYPED_TEST(ContextTest, EveryStageReusesItsBuffersOnTheNextFrame) {
     detail::score_probability(frame, o, w.regions, w.semantic, w.geometric, &state.track_states, &w.probability, &r);
     detail::vote_regions(frame, o, 1, w.regions, w.semantic, w.semantic_labels(), w.geometric, &state.subbox_memory,
                          &w.votes, &r);
-    detail::run_evidence_stages(frame, o, state.keyframes, &w, &r);
+    detail::run_listed_stages<StageKind::Evidence>(frame, o, state.keyframes, &w, &r);
     detail::combine_evidence(o, w, &r);
     detail::apply_static_history(frame, o, w.geometric, &state.static_history, &w.still_frames, &w.history_kept, &r);
     detail::guard_survivors(o, &r);

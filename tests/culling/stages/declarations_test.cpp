@@ -1,5 +1,5 @@
-// Tests of culling/stages/declarations.hpp: every stage report of PipelineResult is declared once, in
-// front-end order, with the name its option has; what the presets read of a frame follows from the
+// Tests of culling/stages/declarations.hpp: every stage of stages/list.hpp is declared once, in
+// front-end order, with the name its option and its report have; what the presets read of a frame follows from the
 // declarations; a stage lacking a declared input reports it by name and does not run.
 #include "dyncull/culling/presets.hpp"
 #include "dyncull/culling/stages/declarations.hpp"
@@ -31,6 +31,16 @@ TYPED_TEST(Declarations, EveryStageReportOnceInFrontEndOrder) {
                                              "moving_consistency", "reprojection", "coherent_motion", "subbox",
                                              "multiview", "static_history"}));
   EXPECT_EQ(reports.size(), names.size());
+}
+
+// A stage that runs by its kind is listed where cull_frame runs it (the multi-view check, an evidence stage,
+// after the sub-box vote), so the list's order is the order the stages run in.
+TYPED_TEST(Declarations, StagesOfAKindAreListedWhereTheyRun) {
+  using T = TypeParam;
+  EXPECT_TRUE(detail::listed_where_they_run(PipelineStages<T>{}));
+  EXPECT_TRUE(detail::listed_where_they_run(StageList<SubBoxStage<T>, MultiViewStage<T>, StaticHistoryStage<T>>{}));
+  EXPECT_FALSE(detail::listed_where_they_run(StageList<DepthMaskStage<T>, MultiViewStage<T>, SubBoxStage<T>>{}));
+  EXPECT_FALSE(detail::listed_where_they_run(StageList<MultiViewStage<T>, SubBoxStage<T>>{}));
 }
 
 // Each declaration's switch is the option of its name: turning one stage's option off turns off that
@@ -84,10 +94,9 @@ TYPED_TEST(Declarations, WhatThePresetsReadOfAFrame) {
 }
 
 /// The check a stage makes before it runs: the inputs its declaration needs, against the frame.
-template <class T, class Frame>
-bool has_inputs(const Frame& frame, const PipelineOptions<T>& o, detail::ReportMember<T> report, PipelineResult<T>* r,
-                bool keyframe_stored = true) {
-  return detail::has_needed_inputs(frame, detail::needs_of(o, report), &(r->*report), keyframe_stored);
+template <class Stage, class T, class Frame>
+bool has_inputs(const Frame& frame, const PipelineOptions<T>& o, PipelineResult<T>* r, bool keyframe_stored = true) {
+  return detail::has_needed_inputs(frame, detail::stage_needs<Stage>(o), &(r->*Stage::kReport), keyframe_stored);
 }
 
 // A frame of 3 keypoints with nothing else: each stage names the first input it lacks.
@@ -98,7 +107,7 @@ TYPED_TEST(Declarations, AStageLackingAnInputNamesItAndDoesNotRun) {
   frame.keypoints = &kp;
   const PipelineOptions<T> o = presets::rtd_slam<T>();
   PipelineResult<T> r;
-  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
+  EXPECT_FALSE(has_inputs<MultiViewStage<T>>(frame, o, &r));
   EXPECT_EQ(r.multiview.status, Status::MissingInput);
   EXPECT_EQ(r.multiview.reason, "no cam_from_world given");
   const Rigid3<T> lost = [] {
@@ -107,19 +116,19 @@ TYPED_TEST(Declarations, AStageLackingAnInputNamesItAndDoesNotRun) {
     return p;
   }();
   frame.cam_from_world = &lost;
-  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
+  EXPECT_FALSE(has_inputs<MultiViewStage<T>>(frame, o, &r));
   EXPECT_EQ(r.multiview.reason, "cam_from_world not finite (tracking lost)");
   const Rigid3<T> pose;
   const std::vector<float> depth(4, 1.f);
   frame.cam_from_world = &pose;
   frame.depth = DepthView<float>{depth.data(), 2, 2};
-  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r, /*keyframe_stored=*/false));
+  EXPECT_FALSE(has_inputs<MultiViewStage<T>>(frame, o, &r, /*keyframe_stored=*/false));
   EXPECT_EQ(r.multiview.reason, "no reference keyframe stored yet");
   r.multiview = StageReport{};
-  EXPECT_TRUE(has_inputs(frame, o, &PipelineResult<T>::multiview, &r));
+  EXPECT_TRUE(has_inputs<MultiViewStage<T>>(frame, o, &r));
   EXPECT_EQ(r.multiview.status, Status::Skipped);  // untouched: the stage runs
-  EXPECT_TRUE(has_inputs(frame, o, &PipelineResult<T>::tracker, &r));  // reads nothing
-  EXPECT_FALSE(has_inputs(frame, o, &PipelineResult<T>::static_history, &r));
+  EXPECT_TRUE(has_inputs<BoxTrackerStage<T>>(frame, o, &r));  // reads nothing
+  EXPECT_FALSE(has_inputs<StaticHistoryStage<T>>(frame, o, &r));
   EXPECT_EQ(r.static_history.reason, "no track_ids given");
 }
 

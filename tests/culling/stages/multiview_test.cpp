@@ -1,7 +1,7 @@
 // The multi-view stage (stages/multiview.hpp) on its own: keyframe points compared with the current depth
 // (RTD-SLAM §III.A), the moving region grown over the depth image and read at each feature, the region
 // limited to the candidates when static features are not overridden, and each input it can lack.
-#include "dyncull/culling/stages/evidence.hpp"
+#include "dyncull/culling/stages/listed.hpp"
 
 #include "support/stage_context.hpp"
 
@@ -37,7 +37,7 @@ struct KeyframeScene {
     EXPECT_EQ(keyframes.push(f.cam_from_world, points, depths), Status::Ok);
   }
   void check(const PipelineOptions<T>& o, detail::PipelineWork<T>* w, PipelineResult<T>* r) const {
-    detail::run_evidence_stage(f.frame(), o, detail::EvidenceContext<T>{*w, keyframes}, &test::multiview_flags(w), r);
+    detail::run_listed_stage(f.frame(), o, detail::StageContext<T>{*w, keyframes}, &test::multiview_marks(w), r);
   }
 };
 
@@ -59,13 +59,13 @@ TYPED_TEST(MultiViewStageTest, FeaturesInTheGrownRegionAreFlagged) {
   s.check(o, &w, &r);
 
   ASSERT_TRUE(r.multiview.ran()) << r.multiview.reason;
-  ASSERT_TRUE(test::multiview_flags(&w).ok);
+  ASSERT_TRUE(test::multiview_marks(&w).ok);
   // Keyframe point (30, 20) projects to itself at 2 m; the depth there is now 1 m: 2 - 1 > 0.4, moving.
   // Grown over the 1 m patch (20 x 20 pixels), it holds features 0, 3 and 4.
-  EXPECT_EQ(test::multiview_flags(&w).dynamic, (std::vector<std::uint8_t>{1, 0, 0, 1, 1}));
+  EXPECT_EQ(test::multiview_marks(&w).marks, (std::vector<std::uint8_t>{1, 0, 0, 1, 1}));
   EXPECT_EQ(r.multiview.num_dynamic, 3u);
   std::size_t set = 0;
-  for (std::uint8_t p : test::multiview_flags(&w).work.mask.pixels) set += p != 0;
+  for (std::uint8_t p : test::multiview_marks(&w).work.mask.pixels) set += p != 0;
   EXPECT_EQ(set, 400u);
   test::expect_only_changed(work_before, test::parts_of(w), {"multiview"});
   test::expect_only_changed(result_before, test::parts_of(r), {"multiview"});
@@ -76,11 +76,11 @@ TYPED_TEST(MultiViewStageTest, EachMissingInputIsNamedAndNothingIsFlagged) {
   const auto o = multiview_on<T>();
   // Each reason named by a word of the input it lacked (or of what it found nothing to do with).
   auto expect_skipped = [](const detail::PipelineWork<T>& w, const PipelineResult<T>& r, const char* why) {
-    EXPECT_FALSE(test::multiview_flags(&w).ok);
+    EXPECT_FALSE(test::multiview_marks(&w).ok);
     EXPECT_FALSE(r.multiview.ran());
     EXPECT_TRUE(r.multiview.enabled);
     EXPECT_NE(r.multiview.reason.find(why), std::string::npos) << r.multiview.reason;
-    EXPECT_EQ(test::multiview_flags(&w).dynamic, std::vector<std::uint8_t>(5, 0));
+    EXPECT_EQ(test::multiview_marks(&w).marks, std::vector<std::uint8_t>(5, 0));
   };
   {
     KeyframeScene<T> s;
@@ -122,12 +122,12 @@ TYPED_TEST(MultiViewStageTest, DisabledFlagsNothing) {
   const KeyframeScene<T> s;
   const PipelineOptions<T> o;
   detail::PipelineWork<T> w;
-  test::multiview_flags(&w).ok = true;  // a previous frame's
+  test::multiview_marks(&w).ok = true;  // a previous frame's
   PipelineResult<T> r = test::fresh_result(o, s.f.size());
   s.check(o, &w, &r);
   EXPECT_FALSE(r.multiview.enabled);
-  EXPECT_FALSE(test::multiview_flags(&w).ok);
-  EXPECT_EQ(test::multiview_flags(&w).dynamic, std::vector<std::uint8_t>(5, 0));
+  EXPECT_FALSE(test::multiview_marks(&w).ok);
+  EXPECT_EQ(test::multiview_marks(&w).marks, std::vector<std::uint8_t>(5, 0));
 }
 
 }  // namespace

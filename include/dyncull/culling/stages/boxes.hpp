@@ -9,7 +9,7 @@ namespace dyncull {
 namespace detail {
 
 /// What the box stages read: the detection filter's and the box tracker's options, the class levels, and
-/// the inputs the filter needs (its declaration).
+/// the inputs the filter needs (its declaration in stages/builtin.hpp).
 template <class T>
 struct BoxesSlice {
   const DetectionStageOptions<T>& detections;
@@ -20,7 +20,7 @@ struct BoxesSlice {
       : detections(o.detections),
         tracker(o.tracker),
         levels(o.levels),
-        detections_needs(needs_of(o, &PipelineResult<T>::detections)) {}
+        detections_needs(stage_needs<DetectionFilterStage<T>>(o)) {}
 };
 
 /// Fills `out` with this frame's boxes; reports into r.detections and r.tracker.

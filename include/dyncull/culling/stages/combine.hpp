@@ -5,7 +5,7 @@
 #pragma once
 
 #include "dyncull/culling/stages/context.hpp"
-#include "dyncull/culling/stages/evidence.hpp"
+#include "dyncull/culling/stages/listed.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -88,7 +88,7 @@ void combine_evidence(const CombineSlice& options, const PipelineWork<T>& w, Pip
 }
 
 /// What the static history reads: its options, the shortest baseline that may vote (a slow mover is not
-/// proven still over fewer frames), and the inputs it needs (its declaration).
+/// proven still over fewer frames), and the inputs it needs (its declaration in stages/builtin.hpp).
 template <class T>
 struct StaticHistorySlice {
   const StaticHistoryStageOptions<T>& static_history;
@@ -97,7 +97,7 @@ struct StaticHistorySlice {
   StaticHistorySlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
       : static_history(o.static_history),
         min_evidence_frames(o.subbox.min_evidence_frames),
-        needs(needs_of(o, &PipelineResult<T>::static_history)) {}
+        needs(stage_needs<StaticHistoryStage<T>>(o)) {}
 };
 
 /// A track proven still over its last frames outweighs its region's cull (PipelineOptions::static_history).

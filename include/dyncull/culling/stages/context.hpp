@@ -1,6 +1,6 @@
 /// @file context.hpp
 /// The per-frame data the culling stages exchange (box regions, per-feature semantic and geometric
-/// evidence, region votes, the evidence stages' flags) and the caller-owned PipelineState that keeps them between
+/// evidence, region votes, the listed stages' marks) and the caller-owned PipelineState that keeps them between
 /// frames so no stage allocates after warm-up. Each stage writes only its own part.
 #pragma once
 
@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <tuple>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -84,20 +86,25 @@ struct RegionVotes {
   bool ok = false;
 };
 
-/// An evidence stage's output (stages/stage.hpp): its buffers and one flag per feature, valid when ok.
+/// A listed stage's output (stages/stage.hpp, kinds other than Builtin): its buffers and one mark per
+/// feature (a FeatureLabel for a box classification, else a flag), valid when ok.
 template <class Stage>
-struct StageFlags {
+struct StageMarks {
   using StageType = Stage;
+  using Mark = std::conditional_t<Stage::kKind == StageKind::BoxClassification, FeatureLabel, std::uint8_t>;
   typename Stage::Work work;
-  std::vector<std::uint8_t> dynamic;
+  std::vector<Mark> marks;
   bool ok = false;
 };
 
+/// One StageMarks per listed stage that the pipeline runs by its kind (not the built-in ones).
 template <class List>
-struct StageFlagsOf;
+struct StageMarksOf;
 template <class... Stages>
-struct StageFlagsOf<StageList<Stages...>> {
-  using type = std::tuple<StageFlags<Stages>...>;
+struct StageMarksOf<StageList<Stages...>> {
+  using type = decltype(std::tuple_cat(
+      std::declval<std::conditional_t<Stages::kKind == StageKind::Builtin, std::tuple<>,
+                                      std::tuple<StageMarks<Stages>>>>()...));
 };
 
 /// Everything the stages of one frame write, reused between frames.
@@ -108,7 +115,7 @@ struct PipelineWork {
   ProbabilityEvidence<T> probability;
   GeometricEvidence<T> geometric;
   RegionVotes<T> votes;
-  typename StageFlagsOf<EvidenceStages<T>>::type evidence_flags;  ///< one StageFlags per evidence stage
+  typename StageMarksOf<PipelineStages<T>>::type listed;  ///< one StageMarks per listed stage run by kind
   std::vector<std::uint16_t> still_frames;  ///< static history count per feature this frame
   std::vector<std::uint8_t> history_kept;   ///< 1: kept static by its history this frame
   std::vector<T> keypoint_depth;
@@ -120,14 +127,14 @@ struct PipelineWork {
   const std::vector<CullReason>& semantic_reasons() const {
     return probability.ok ? probability.reasons : semantic.reasons;
   }
-  /// The output of the evidence stage Stage (stages/list.hpp).
+  /// The output of the listed stage Stage (stages/list.hpp).
   template <class Stage>
-  const StageFlags<Stage>& flags_of() const {
-    return std::get<StageFlags<Stage>>(evidence_flags);
+  const StageMarks<Stage>& marks_of() const {
+    return std::get<StageMarks<Stage>>(listed);
   }
   template <class Stage>
-  StageFlags<Stage>& flags_of() {
-    return std::get<StageFlags<Stage>>(evidence_flags);
+  StageMarks<Stage>& marks_of() {
+    return std::get<StageMarks<Stage>>(listed);
   }
   /// The geometric evidence the vote and the combination read (with the coherent cells' flags).
   const FeatureLabel* evidence() const { return votes.coherent_ran ? votes.evidence.data() : geometric.labels.data(); }
@@ -141,10 +148,10 @@ struct PipelineWork {
 template <class T>
 PipelineWork<T>& work_of(PipelineState<T>* state);
 
-/// What an evidence stage reads besides the frame and its options: the earlier stages' outputs and the
+/// What a listed stage reads besides the frame and its options: the earlier stages' outputs and the
 /// stored keyframes.
 template <class T>
-struct EvidenceContext {
+struct StageContext {
   const PipelineWork<T>& earlier;
   const KeyframeRing<T>& keyframes;
 };

@@ -1,8 +1,8 @@
 /// @file declarations.hpp
-/// The stages of the culling pipeline in front-end order, each declared once with its name, its report, its
+/// The table of the culling pipeline's stages, derived from stages/list.hpp: each stage's name, report,
 /// switch and the frame inputs it reads. The frame's reason ("stage: why"), every missing-input reason and
-/// the culler's list of inputs (CullerCore::inputs_of) are derived from this list. Pipeline plumbing, no
-/// paper equation.
+/// the culler's list of inputs (CullerCore::inputs_of) are derived from it. Pipeline plumbing, no paper
+/// equation.
 #pragma once
 
 #include "dyncull/culling/pipeline_types.hpp"
@@ -10,7 +10,7 @@
 
 #include <array>
 #include <cstddef>
-#include <cstdint>
+#include <string>
 
 namespace dyncull {
 
@@ -26,88 +26,67 @@ struct StageDeclaration {
   FrameInputs (*uses)(const PipelineOptions<T>&);
 };
 
-namespace detail {
-template <class T>
-using Opt = const PipelineOptions<T>&;
-/// A report as a member of PipelineResult<T>, T not deduced from it: an evidence stage's report is a
-/// member of its slot and converts.
-template <class T>
-using ReportMember = NonDeduced<StageReport PipelineResult<T>::*>;
-template <class T>
-constexpr FrameInputs reads_nothing(Opt<T>) {
-  return 0;
-}
-}  // namespace detail
-
-/// An evidence stage's declaration, from its struct (stages/stage.hpp).
+/// A listed stage's declaration, from its struct (stages/stage.hpp).
 template <class T, class Stage>
-constexpr StageDeclaration<T> declare_evidence_stage() {
-  return {Stage::kName, Stage::kReport, [](detail::Opt<T> o) { return (o.*Stage::kOptions).enabled; },
-          [](detail::Opt<T> o) { return Stage::needs(o.*Stage::kOptions); },
-          [](detail::Opt<T> o) { return Stage::uses(o.*Stage::kOptions); }};
+constexpr StageDeclaration<T> declare_stage() {
+  return {Stage::kName, Stage::kReport,
+          [](const PipelineOptions<T>& o) { return (o.*Stage::kOptions).enabled; },
+          [](const PipelineOptions<T>& o) { return detail::stage_needs<Stage>(o); },
+          [](const PipelineOptions<T>& o) { return detail::stage_uses<Stage>(o); }};
 }
 
-/// The stages in front-end order (pipeline.hpp runs them so), the evidence stages (stages/list.hpp)
-/// between the region votes and the static history.
-template <class T, class... Evidence>
-constexpr std::array<StageDeclaration<T>, 10 + sizeof...(Evidence)> declare_stages(StageList<Evidence...>) {
-  return {{
-    {"detections", &PipelineResult<T>::detections, [](detail::Opt<T> o) { return o.detections.enabled; },
-     [](detail::Opt<T>) { return FrameInputs(FrameInput::Detections); }, detail::reads_nothing<T>},
-    {"tracker", &PipelineResult<T>::tracker, [](detail::Opt<T> o) { return o.tracker.enabled; },
-     detail::reads_nothing<T>, detail::reads_nothing<T>},
-    // Without the detection filter, the box rule is the stage that reads the detections.
-    {"box_rule", &PipelineResult<T>::box_rule, [](detail::Opt<T> o) { return o.box_rule.enabled; },
-     [](detail::Opt<T> o) { return FrameInputs(o.detections.enabled ? 0 : FrameInputs(FrameInput::Detections)); },
-     detail::reads_nothing<T>},
-    {"depth_mask", &PipelineResult<T>::depth_mask, [](detail::Opt<T> o) { return o.depth_mask.enabled; },
-     [](detail::Opt<T>) { return FrameInputs(FrameInput::Depth); }, detail::reads_nothing<T>},
-    {"probability", &PipelineResult<T>::probability, [](detail::Opt<T> o) { return o.probability.enabled; },
-     [](detail::Opt<T>) { return FrameInputs(FrameInput::PrevKeypoints); }, detail::reads_nothing<T>},
-    // Depth: occlusion edges discount the flags on them (edge_evidence).
-    {"moving_consistency", &PipelineResult<T>::moving_consistency,
-     [](detail::Opt<T> o) { return o.moving_consistency.enabled; },
-     [](detail::Opt<T>) { return FrameInputs(FrameInput::PrevKeypoints); },
-     [](detail::Opt<T> o) { return FrameInputs(o.edge_evidence.enabled ? FrameInputs(FrameInput::Depth) : 0); }},
-    // Depth: the depth residual (max_depth_residual_sigmas) and occlusion edges.
-    {"reprojection", &PipelineResult<T>::reprojection, [](detail::Opt<T> o) { return o.reprojection.enabled; },
-     [](detail::Opt<T>) { return FrameInputs(FrameInput::Points3d); },
-     [](detail::Opt<T> o) {
-       return FrameInputs(o.reprojection.max_depth_residual_sigmas > T(0) || o.edge_evidence.enabled
-                              ? FrameInputs(FrameInput::Depth)
-                              : 0);
-     }},
-    {"coherent_motion", &PipelineResult<T>::coherent_motion, [](detail::Opt<T> o) { return o.coherent_motion.enabled; },
-     detail::reads_nothing<T>, detail::reads_nothing<T>},
-    {"subbox", &PipelineResult<T>::subbox, [](detail::Opt<T> o) { return o.subbox.enabled; }, detail::reads_nothing<T>,
-     detail::reads_nothing<T>},
-    declare_evidence_stage<T, Evidence>()...,
-    {"static_history", &PipelineResult<T>::static_history, [](detail::Opt<T> o) { return o.static_history.enabled; },
-     [](detail::Opt<T>) { return FrameInputs(FrameInput::TrackIds); }, detail::reads_nothing<T>},
-  }};
+/// The stages of stages/list.hpp in its order (front-end order: pipeline.hpp runs them so).
+template <class T, class... Stages>
+constexpr std::array<StageDeclaration<T>, sizeof...(Stages)> declare_stages(StageList<Stages...>) {
+  return {{declare_stage<T, Stages>()...}};
 }
 
 template <class T>
-constexpr auto kStages = declare_stages<T>(EvidenceStages<T>{});
+constexpr auto kStages = declare_stages<T>(PipelineStages<T>{});
 
 namespace detail {
-/// Every entry of kStages filled: declare_stages's count of core stages matches its list (an entry left
-/// out would be value-initialised, with no name and no report).
-template <class T>
-constexpr bool every_stage_declared() {
-  for (const StageDeclaration<T>& s : kStages<T>)
-    if (s.name == nullptr || s.report == nullptr) return false;
+constexpr bool same_name(const char* a, const char* b) {
+  while (*a != '\0' && *a == *b) ++a, ++b;
+  return *a == *b;
+}
+
+/// The built-in stage that stages of `kind` follow in the list: where cull_frame runs them.
+constexpr const char* runs_after(StageKind kind) {
+  return kind == StageKind::Evidence ? "subbox" : kind == StageKind::Builtin ? "" : "depth_mask";
+}
+
+/// Every stage of a kind listed where cull_frame runs it: after the built-in stage its kind follows, with
+/// nothing but stages of its kind or of a kind that runs before it in between (box classification, then
+/// depth). The order of the frame's reason is then the order the stages ran.
+template <class... Stages>
+constexpr bool listed_where_they_run(StageList<Stages...>) {
+  constexpr StageKind kinds[] = {Stages::kKind...};
+  constexpr const char* names[] = {Stages::kName...};
+  const char* last_builtin = "";
+  StageKind last = StageKind::Builtin;
+  for (std::size_t i = 0; i < sizeof...(Stages); ++i) {
+    if (kinds[i] == StageKind::Builtin) {
+      last_builtin = names[i];
+    } else if (!same_name(last_builtin, runs_after(kinds[i])) ||
+               (last != StageKind::Builtin && static_cast<int>(last) > static_cast<int>(kinds[i]))) {
+      return false;
+    }
+    last = kinds[i];
+  }
   return true;
 }
-static_assert(every_stage_declared<double>(), "declare_stages: the count of core stages and the list disagree");
+static_assert(listed_where_they_run(PipelineStages<double>{}),
+              "stages/list.hpp: a box classification or depth stage goes after DepthMaskStage, an evidence "
+              "stage after SubBoxStage (stages/stage.hpp, StageKind)");
 }  // namespace detail
 
-/// The declaration of the stage that reports into `report`.
+/// The place of the stage named `name` in front-end order (its index in kStages); kStages<T>.size() when
+/// no stage has that name.
 template <class T>
-constexpr const StageDeclaration<T>& stage_of(detail::ReportMember<T> report) {
-  for (const StageDeclaration<T>& s : kStages<T>)
-    if (s.report == report) return s;
-  return kStages<T>[0];  // unreachable for the reports of PipelineResult
+std::size_t stage_index(const std::string& name) {
+  std::size_t i = 0;
+  while (i < kStages<T>.size() && name != kStages<T>[i].name) ++i;
+  return i;
 }
 
 /// The frame inputs the enabled stages need (`optional` false) or read when given as well (true).
@@ -121,14 +100,4 @@ FrameInputs inputs_read(const PipelineOptions<T>& options, bool optional = false
   return in;
 }
 
-namespace detail {
-
-/// The frame inputs the stage reporting into `report` needs under `options` (its declaration above): a
-/// stage's options slice carries them to detail::has_needed_inputs (stages/stage.hpp).
-template <class T>
-FrameInputs needs_of(const PipelineOptions<T>& options, ReportMember<T> report) {
-  return stage_of<T>(report).needs(options);
-}
-
-}  // namespace detail
 }  // namespace dyncull

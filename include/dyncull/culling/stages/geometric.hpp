@@ -14,7 +14,7 @@ namespace dyncull {
 namespace detail {
 
 /// What the geometric stages read: the epipolar and reprojection checks' options, the occlusion-edge
-/// discount, and the inputs each check needs (their declarations).
+/// discount, and the inputs each check needs (their declarations in stages/builtin.hpp).
 template <class T>
 struct GeometricSlice {
   const MovingConsistencyStageOptions<T>& moving_consistency;
@@ -25,8 +25,8 @@ struct GeometricSlice {
       : moving_consistency(o.moving_consistency),
         reprojection(o.reprojection),
         edge_evidence(o.edge_evidence),
-        moving_consistency_needs(needs_of(o, &PipelineResult<T>::moving_consistency)),
-        reprojection_needs(needs_of(o, &PipelineResult<T>::reprojection)) {}
+        moving_consistency_needs(stage_needs<MovingConsistencyStage<T>>(o)),
+        reprojection_needs(stage_needs<ReprojectionStage<T>>(o)) {}
 };
 
 /// No Ok without its evidence: when enough tracks are flagged valid but none has a finite 3-D point

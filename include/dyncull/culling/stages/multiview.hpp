@@ -41,6 +41,7 @@ struct MultiViewStageOptions : MultiViewOptions<T> {
 template <class T>
 struct MultiViewStage {
   static constexpr const char* kName = "multiview";
+  static constexpr StageKind kKind = StageKind::Evidence;
   static constexpr CullReason kReason = CullReason::MultiView;
   using Options = MultiViewStageOptions<T>;
   struct OptionsSlot {

@@ -10,14 +10,14 @@
 namespace dyncull {
 namespace detail {
 
-/// What the probability reads: its options, the class levels, and the inputs it needs (its declaration).
+/// What the probability reads: its options, the class levels, and the inputs it needs (its declaration in stages/builtin.hpp).
 template <class T>
 struct ProbabilitySlice {
   const ProbabilityStageOptions<T>& probability;
   const MotionLevelTable& levels;
   FrameInputs needs;
   ProbabilitySlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
-      : probability(o.probability), levels(o.levels), needs(needs_of(o, &PipelineResult<T>::probability)) {}
+      : probability(o.probability), levels(o.levels), needs(stage_needs<ProbabilityStage<T>>(o)) {}
 };
 
 /// out->labels / reasons: the semantic labels with the probability's decisions (valid when out->ok).

@@ -188,7 +188,7 @@ std::size_t claim_head_bands(const Keypoints& kp, const DepthView<Raw>& depth, c
 }
 
 /// What the semantic stages read: the box rule's and the depth masks' options, the class levels, and the
-/// inputs each needs (their declarations).
+/// inputs each needs (their declarations in stages/builtin.hpp).
 template <class T>
 struct SemanticSlice {
   const BoxRuleStageOptions<T>& box_rule;
@@ -199,8 +199,8 @@ struct SemanticSlice {
       : box_rule(o.box_rule),
         depth_mask(o.depth_mask),
         levels(o.levels),
-        box_rule_needs(needs_of(o, &PipelineResult<T>::box_rule)),
-        depth_mask_needs(needs_of(o, &PipelineResult<T>::depth_mask)) {}
+        box_rule_needs(stage_needs<BoxRuleStage<T>>(o)),
+        depth_mask_needs(stage_needs<DepthMaskStage<T>>(o)) {}
 };
 
 /// Semantic evidence of this frame: the box rule's labels, then the depth masks (out->labels etc.).

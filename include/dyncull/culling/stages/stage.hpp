@@ -1,7 +1,7 @@
 /// @file stage.hpp
-/// What a culling stage is: the frame inputs it reads (FrameInput), its report (StageReport), and the form
-/// of an evidence stage, the form a new check takes (one header, one line in stages/list.hpp; see
-/// docs/design.md, "Adding a stage"). Pipeline plumbing, no paper equation.
+/// What a culling stage is: the frame inputs it reads (FrameInput), its report (StageReport), where it
+/// runs (StageKind) and the one form every stage is declared in (one header, one line in
+/// stages/list.hpp; see docs/design.md, "Adding a stage"). Pipeline plumbing, no paper equation.
 #pragma once
 
 #include "dyncull/core/pixel.hpp"
@@ -12,6 +12,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 namespace dyncull {
 
@@ -63,27 +65,68 @@ constexpr const char* missing_reason(FrameInput input, bool pose_given = false) 
   return "an input is missing";
 }
 
-/// The evidence stages the pipeline runs after the region votes, in order (stages/list.hpp). An evidence
-/// stage is a struct template on the scalar T with
+/// Where the pipeline runs a stage of stages/list.hpp, and what it writes.
+///   - Builtin: the stages of the papers (stages/builtin.hpp), run by cull_frame's own steps.
+///   - BoxClassification: after the box rule and the depth masks; it labels features from the boxes
+///     (`marks[i]`: Candidate or Dynamic; Static for no opinion). A label it raises stands, with its
+///     kReason, unless a depth stage clears it; a candidate is verified as the box rule's are.
+///   - Depth: after the box classification; it clears box labels off the object (`marks[i]` = 1: the
+///     feature's depth says it is not on the object its box label gave it, so it becomes static).
+///   - Evidence: after the region votes; it flags moving features (`marks[i]` = 1), which cull wherever
+///     they are, as the multi-view check's do (DynaSLAM); the survivor guard may restore them, as it
+///     restores every single geometric stage's culls.
+enum class StageKind : std::uint8_t { Builtin, BoxClassification, Depth, Evidence };
+
+/// The stages of the pipeline, in front-end order (stages/list.hpp). A stage is a struct template on the
+/// scalar T with
 ///   - `kName`: its option in PipelineOptions, its report in PipelineResult and its name in reasons;
-///   - `kReason`: the CullReason of its culls (CullReason::EvidenceStage unless it has its own);
+///   - `kKind`: where it runs (StageKind);
 ///   - `Options`: its options slice, with `bool enabled` and `Status validate(std::string*) const`;
 ///   - `OptionsSlot` and `ReportSlot`: one member each, named kName, of types Options and StageReport
 ///     (PipelineOptions and PipelineResult derive from the slots of the listed stages), and `kOptions`,
 ///     `kReport`: pointers to those members;
-///   - `Work`: its buffers, kept between frames so it allocates nothing after warm-up;
 ///   - `needs(options)` and `uses(options)`: the FrameInputs it cannot run without and those it reads
-///     when given;
-///   - `run(frame, options, context, work, dynamic, report)`: called when it is enabled and has what it
-///     needs, with `dynamic` one zeroed flag per keypoint; it sets dynamic[i] = 1 for each feature it finds
-///     moving and report->status (Ok, or its failure with report->reason). The context (EvidenceContext,
-///     stages/context.hpp) holds the earlier stages' outputs and the stored keyframes, read-only.
-/// Its flags cull wherever they are, as the multi-view check's do (DynaSLAM); the survivor guard may
-/// restore them, as it restores every single geometric stage's culls.
+///     when given (a built-in stage whose inputs depend on another stage's options takes the
+///     PipelineOptions as a second argument).
+/// A stage of another kind than Builtin also has
+///   - `kReason`: the CullReason of its culls (CullReason::ListedStage unless it has its own);
+///   - `Work`: its buffers, kept between frames so it allocates nothing after warm-up;
+///   - `run(frame, options, context, work, marks, report)`: called when it is enabled and has what it
+///     needs, with `marks` one zeroed entry per keypoint (FeatureLabel for a box classification, else a
+///     flag) that it sets as its kind says, and report->status (Ok, or its failure with report->reason).
+///     The context (StageContext, stages/context.hpp) holds the earlier stages' outputs and the stored
+///     keyframes, read-only.
 template <class... Stages>
 struct StageList {};
 
 namespace detail {
+
+/// True when Stage's needs and uses take the PipelineOptions as well (a built-in stage that reads another
+/// stage's switch).
+template <class Stage, class Pipeline, class = void>
+struct ReadsOtherStages : std::false_type {};
+template <class Stage, class Pipeline>
+struct ReadsOtherStages<Stage, Pipeline,
+                        std::void_t<decltype(Stage::needs(std::declval<const typename Stage::Options&>(),
+                                                          std::declval<const Pipeline&>()))>> : std::true_type {};
+
+/// The frame inputs Stage cannot run without under the pipeline's options.
+template <class Stage, class Pipeline>
+constexpr FrameInputs stage_needs(const Pipeline& pipeline) {
+  if constexpr (ReadsOtherStages<Stage, Pipeline>::value)
+    return Stage::needs(pipeline.*Stage::kOptions, pipeline);
+  else
+    return Stage::needs(pipeline.*Stage::kOptions);
+}
+
+/// The frame inputs Stage reads when given under the pipeline's options.
+template <class Stage, class Pipeline>
+constexpr FrameInputs stage_uses(const Pipeline& pipeline) {
+  if constexpr (ReadsOtherStages<Stage, Pipeline>::value)
+    return Stage::uses(pipeline.*Stage::kOptions, pipeline);
+  else
+    return Stage::uses(pipeline.*Stage::kOptions);
+}
 
 /// The frame inputs this frame lacks.
 template <class Frame>

@@ -20,7 +20,8 @@ namespace dyncull {
 template <class T>
 struct LargeDisplacementStage {
   static constexpr const char* kName = "large_displacement";
-  static constexpr CullReason kReason = CullReason::EvidenceStage;
+  static constexpr StageKind kKind = StageKind::Evidence;
+  static constexpr CullReason kReason = CullReason::ListedStage;
 
   struct Options {
     bool enabled = false;

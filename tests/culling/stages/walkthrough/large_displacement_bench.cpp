@@ -36,12 +36,12 @@ void BM_Stage_LargeDisplacement(benchmark::State& bm) {
   PipelineResult<float>& r = state.result;
   detail::begin_frame(o, &r);
   r.num_features = tracks.keypoints.size();
-  const detail::EvidenceContext<float> context{w, state.keyframes};
-  auto& flags = w.flags_of<LargeDisplacementStage<float>>();
+  const detail::StageContext<float> context{w, state.keyframes};
+  auto& flags = w.marks_of<LargeDisplacementStage<float>>();
   for (auto _ : bm) {
     r.large_displacement.num_dynamic = 0;
-    detail::run_evidence_stage(frame, o, context, &flags, &r);
-    benchmark::DoNotOptimize(flags.dynamic.data());
+    detail::run_listed_stage(frame, o, context, &flags, &r);
+    benchmark::DoNotOptimize(flags.marks.data());
   }
   bm.counters["flagged"] = double(r.large_displacement.num_dynamic);
 }
