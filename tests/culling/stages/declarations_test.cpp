@@ -2,6 +2,7 @@
 // front-end order, with the name its option and its report have; what the presets read of a frame follows from the
 // declarations; a stage lacking a declared input reports it by name and does not run.
 #include "dyncull/culling/presets.hpp"
+#include "dyncull/culling/stages/builtin.hpp"
 #include "dyncull/culling/stages/declarations.hpp"
 
 #include <gtest/gtest.h>
@@ -91,6 +92,26 @@ TYPED_TEST(Declarations, WhatThePresetsReadOfAFrame) {
   epipolar.edge_evidence.enabled = true;
   EXPECT_FALSE(reads(inputs_read(epipolar), I::Depth));
   EXPECT_TRUE(reads(inputs_read(epipolar, /*optional=*/true), I::Depth));
+}
+
+// A built-in stage whose inputs follow another stage's switch reads the PipelineOptions in its declaration
+// (stages/builtin.hpp): the box rule reads the boxes itself without the filter; the reprojection check
+// reads depth for its depth residual or the edge discount.
+TYPED_TEST(Declarations, BuiltinStagesReadOtherStagesSwitches) {
+  using T = TypeParam;
+  using I = FrameInput;
+  PipelineOptions<T> o = presets::recommended<T>();
+  EXPECT_EQ(detail::stage_needs<BoxRuleStage<T>>(o), FrameInputs(0));
+  o.detections.enabled = false;
+  EXPECT_EQ(detail::stage_needs<BoxRuleStage<T>>(o), FrameInputs(I::Detections));
+  EXPECT_EQ(detail::stage_needs<ReprojectionStage<T>>(o), FrameInputs(I::Points3d));
+  EXPECT_EQ(detail::stage_uses<ReprojectionStage<T>>(o), FrameInputs(I::Depth));
+  o.reprojection.max_depth_residual_sigmas = T(0);
+  o.edge_evidence.enabled = false;
+  EXPECT_EQ(detail::stage_uses<ReprojectionStage<T>>(o), FrameInputs(0));
+  EXPECT_EQ(detail::stage_uses<MovingConsistencyStage<T>>(o), FrameInputs(0));
+  o.edge_evidence.enabled = true;
+  EXPECT_EQ(detail::stage_uses<MovingConsistencyStage<T>>(o), FrameInputs(I::Depth));
 }
 
 /// The check a stage makes before it runs: the inputs its declaration needs, against the frame.
