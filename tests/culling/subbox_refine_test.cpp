@@ -192,6 +192,40 @@ TYPED_TEST(SubBoxTest, StaticNeedsEvidenceCullsEmptyAndSplitCells) {
   EXPECT_NE(bad.reason.find("static_max_dynamic_ratio"), std::string::npos) << bad.reason;
 }
 
+// static_needs_evidence_boxes limits the burden of proof to the boxes it flags: the same cells in an
+// unflagged box (a chair's) are dynamic only on their own vote. A view of the wrong size is refused.
+TYPED_TEST(SubBoxTest, StaticNeedsEvidenceAppliesToTheFlaggedBoxesOnly) {
+  using T = TypeParam;
+  std::vector<Vec2<T>> pts;
+  std::vector<FeatureLabel> geo;
+  // The same votes in two boxes: cell 0 unanimous static, cell 6 split (2 of 5 flagged), cell 8 one feature.
+  for (T dx : {T(0), T(200)}) {
+    add_votes(&pts, &geo, dx + T(5), T(5), 5, 0);
+    add_votes(&pts, &geo, dx + T(5), T(65), 3, 2);
+    add_votes(&pts, &geo, dx + T(65), T(65), 1, 0);
+  }
+  const std::vector<Box<T>> boxes{Box<T>{T(0), T(0), T(90), T(90)}, Box<T>{T(200), T(0), T(290), T(90)}};
+  SubBoxOptions<T> o;
+  o.static_needs_evidence = true;
+  const std::vector<std::uint8_t> person_then_chair{1, 0};
+  const auto r = refine_subboxes(pts, geo, boxes, o, nullptr, nullptr, FlagView(person_then_chair));
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const std::size_t per_box = 11;
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(r.labels[i], FeatureLabel::Static) << i;
+  for (std::size_t i = 5; i < per_box; ++i) EXPECT_EQ(r.labels[i], FeatureLabel::Dynamic) << i << ": burden on static";
+  for (std::size_t i = per_box; i < 2 * per_box; ++i)
+    EXPECT_EQ(r.labels[i], FeatureLabel::Static) << i << ": no cell of the second box voted dynamic";
+  EXPECT_EQ(r.votes[1].num_dynamic_cells, 0);
+  // Not given: every box carries the burden, as before.
+  const auto all = refine_subboxes(pts, geo, boxes, o);
+  for (std::size_t i = per_box + 5; i < 2 * per_box; ++i) EXPECT_EQ(all.labels[i], FeatureLabel::Dynamic) << i;
+  const std::vector<std::uint8_t> one_flag{1};
+  const auto bad = refine_subboxes(pts, geo, boxes, o, nullptr, nullptr, FlagView(one_flag));
+  EXPECT_EQ(bad.status, Status::InvalidInput);
+  EXPECT_NE(bad.reason.find("static_needs_evidence_boxes has 1 entries for 2 boxes"), std::string::npos) << bad.reason;
+  for (FeatureLabel l : bad.labels) EXPECT_EQ(l, FeatureLabel::Static);
+}
+
 // A walker's box overlapping a still chair's box: with per-box object bits the walker's dynamic
 // sub-boxes act only on the walker's own features, and only they vote.
 TYPED_TEST(SubBoxTest, OverlappingBoxesActOnTheirOwnObjectsOnly) {

@@ -43,7 +43,8 @@ struct SubBoxOptions {
   /// not voted dynamic is still dynamic unless at least min_points labelled features vote in it and at most
   /// static_max_dynamic_ratio of them are flagged, so an empty or split cell keeps the box rule's
   /// "dynamic" (inside the object mask). Such cells take no part in merging or in the whole-box count.
-  /// 0.3 tolerates the 15-25 % false flags of still parts noted at merge_ratio.
+  /// 0.3 tolerates the 15-25 % false flags of still parts noted at merge_ratio. refine_subboxes can
+  /// limit it to some boxes (the pipeline: those of objects that move by themselves, not a chair).
   bool static_needs_evidence = false;
   T static_max_dynamic_ratio = T(0.3);
   int dilation_radius_px = 15;  ///< square dilation of the raster mask (DynaSLAM / RDS-SLAM use 15 px)
@@ -186,6 +187,20 @@ bool subbox_inputs_fit(std::size_t n, FlagView in_object_mask, BoxBitsView objec
   return false;
 }
 
+/// The per-box flags, when given, hold one entry per box; else InvalidInput into the result started by
+/// subbox_begin, naming them and both sizes (nothing read).
+template <class T>
+bool subbox_box_flags_fit(std::size_t nb, FlagView static_needs_evidence_boxes, SubBoxResult<T>* r) {
+  std::string why;
+  if (flags_fit(static_needs_evidence_boxes, nb, "static_needs_evidence_boxes", "boxes", &why)) return true;
+  r->status = Status::InvalidInput;
+  r->reason = why;
+  r->votes.clear();
+  r->cells.clear();
+  r->grid = 0;
+  return false;
+}
+
 /// The required geometric labels hold n entries; else InvalidInput into the result started by
 /// subbox_begin, naming them and both sizes (nothing read).
 template <class T>
@@ -313,11 +328,12 @@ void subbox_merge(const std::uint8_t* st, const std::uint32_t* dc, const std::ui
     }
 }
 
-/// Box b's cells: voted, merged, the whole box by sigma2, and with static_needs_evidence a static cell
-/// needs its own evidence (an empty cell, or one over static_max_dynamic_ratio dynamic, is dynamic).
+/// Box b's cells: voted, merged, the whole box by sigma2, and where static_needs_evidence applies
+/// (`burden_on_static`) a static cell needs its own evidence (an empty cell, or one over
+/// static_max_dynamic_ratio dynamic, is dynamic).
 template <class T>
 void subbox_decide_cells(std::size_t b, std::size_t cells_per_box, const SubBoxOptions<T>& options,
-                         SubBoxResult<T>* r) {
+                         bool burden_on_static, SubBoxResult<T>* r) {
   std::uint8_t* cells = r->cells.data() + b * cells_per_box;
   const std::uint32_t* dc = r->dyn_count.data() + b * cells_per_box;
   const std::uint32_t* sc = r->static_count.data() + b * cells_per_box;
@@ -332,7 +348,7 @@ void subbox_decide_cells(std::size_t b, std::size_t cells_per_box, const SubBoxO
     vote.num_dynamic_cells = static_cast<int>(cells_per_box);
     ++r->num_whole_boxes;
   }
-  if (options.static_needs_evidence && !vote.whole_box)
+  if (options.static_needs_evidence && burden_on_static && !vote.whole_box)
     for (std::size_t c = 0; c < cells_per_box; ++c) {
       if (cells[c]) continue;
       const std::uint32_t total = dc[c] + sc[c];
@@ -354,12 +370,15 @@ void subbox_decide_cells(std::size_t b, std::size_t cells_per_box, const SubBoxO
 /// object_box_bits: optional per-feature bit set (bit b: in box b's own object mask, as
 /// DepthMaskResult::box_bits): box b then acts only on its own object's features, so a chair that a
 /// walker's box overlaps is not culled by the walker's sub-box (boxes from the 33rd on use in_object_mask).
-/// Options failing SubBoxOptions::validate, or a given view whose size is not points.size(), give
-/// InvalidInput (every feature Static, the view and both sizes named).
+/// static_needs_evidence_boxes: optional per-box flag, the boxes options.static_needs_evidence applies to
+/// (not given: every box); elsewhere a cell is dynamic only on its own vote.
+/// Options failing SubBoxOptions::validate, or a given view whose size is not points.size() (boxes.size()
+/// for the per-box flags), give InvalidInput (every feature Static, the view and both sizes named).
 template <class T, class Points, class Boxes>
 void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                      const SubBoxOptions<T>& options, SubBoxResult<T>* out,
-                     FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr) {
+                     FlagView in_object_mask = nullptr, BoxBitsView object_box_bits = nullptr,
+                     FlagView static_needs_evidence_boxes = nullptr) {
   static_assert(is_point_container_v<Points>, "dyncull::refine_subboxes: points must hold points (see PointTraits)");
   SubBoxResult<T>& r = *out;
   const std::size_t n = static_cast<std::size_t>(points.size());
@@ -367,12 +386,15 @@ void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, co
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
   if (!detail::subbox_geometric_fits(geometric, n, &r) ||
-      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r))
+      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r) ||
+      !detail::subbox_box_flags_fit(nb, static_needs_evidence_boxes, &r))
     return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, options.grid);
   detail::subbox_count_votes(points, geometric, boxes, options, cells_per_box, in_object_mask, object_box_bits, &r);
-  for (std::size_t b = 0; b < nb; ++b)
-    if (detail::subbox_as_box(boxes[b]).valid()) detail::subbox_decide_cells(b, cells_per_box, options, &r);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const bool burden_on_static = !static_needs_evidence_boxes.given || static_needs_evidence_boxes[b] != 0;
+    if (detail::subbox_as_box(boxes[b]).valid()) detail::subbox_decide_cells(b, cells_per_box, options, burden_on_static, &r);
+  }
   detail::subbox_label_features(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
   if (r.num_invalid_boxes > 0) r.reason = std::to_string(r.num_invalid_boxes) + " invalid box(es) ignored";
 }
@@ -381,9 +403,9 @@ void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, co
 template <class T, class Points, class Boxes>
 SubBoxResult<T> refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, const Boxes& boxes,
                                 const SubBoxOptions<T>& options = {}, FlagView in_object_mask = nullptr,
-                                BoxBitsView object_box_bits = nullptr) {
+                                BoxBitsView object_box_bits = nullptr, FlagView static_needs_evidence_boxes = nullptr) {
   SubBoxResult<T> r;
-  refine_subboxes(points, geometric, boxes, options, &r, in_object_mask, object_box_bits);
+  refine_subboxes(points, geometric, boxes, options, &r, in_object_mask, object_box_bits, static_needs_evidence_boxes);
   return r;
 }
 

@@ -82,6 +82,7 @@ struct RegionVotes {
   bool coherent_ran = false;           ///< evidence holds the coherent stage's labels
   std::vector<std::uint8_t> coherent_eligible;
   std::vector<std::uint8_t> remembered_cells;  ///< a tracked box's last vote, on too short a baseline
+  std::vector<std::uint8_t> self_moving_boxes;  ///< per dynamic-class box: high level (flag_self_moving_boxes)
   SubBoxResult<T> subbox;
   bool ok = false;
 };

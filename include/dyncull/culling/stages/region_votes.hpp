@@ -15,16 +15,27 @@
 namespace dyncull {
 namespace detail {
 
-/// What the region votes read: the sub-box refinement's and the coherent cells' options, and whether the
-/// box tracker runs (a tracked box's cells keep its last vote on too short a baseline).
+/// What the region votes read: the sub-box refinement's and the coherent cells' options, whether the
+/// box tracker runs (a tracked box's cells keep its last vote on too short a baseline), and the class levels.
 template <class T>
 struct RegionVotesSlice {
   const SubBoxStageOptions<T>& subbox;
   const CoherentMotionStageOptions<T>& coherent_motion;
   bool boxes_tracked;
+  const MotionLevelTable& levels;
   RegionVotesSlice(const PipelineOptions<T>& o)  // implicit: the pipeline passes its options
-      : subbox(o.subbox), coherent_motion(o.coherent_motion), boxes_tracked(o.tracker.enabled) {}
+      : subbox(o.subbox), coherent_motion(o.coherent_motion), boxes_tracked(o.tracker.enabled), levels(o.levels) {}
 };
+
+/// Per dynamic-class box: 1 for an object that moves by itself (high level), where the sub-box vote puts
+/// the burden of proof on "static"; a chair's cell is dynamic only on its own vote, since on a real camera
+/// the flags on a still chair are noise, not a mover's.
+template <class T>
+void flag_self_moving_boxes(const std::vector<Detection<T>>& boxes, const MotionLevelTable& levels,
+                            std::vector<std::uint8_t>* out) {
+  out->resize(boxes.size());
+  for (std::size_t b = 0; b < boxes.size(); ++b) (*out)[b] = levels.level(boxes[b].class_id) == MotionLevel::High;
+}
 
 /// A feature in a box's head band (SemanticEvidence::head_band_box) follows the cell of the box's top row
 /// in its column: dynamic there, it is culled with the person; a static top row keeps it.
@@ -115,7 +126,9 @@ void vote_regions(const Frame& frame, const NonDeduced<RegionVotesSlice<T>>& opt
         r->coherent_motion.num_dynamic = v.coherent.num_flagged;
       }
     }
-    refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits);
+    flag_self_moving_boxes(regions.dyn_boxes, options.levels, &v.self_moving_boxes);
+    refine_subboxes(kp, evidence, regions.dyn_boxes, options.subbox, &v.subbox, in_object, box_bits,
+                    FlagView(v.self_moving_boxes));
     subbox_follow_head_bands(kp, regions.dyn_boxes, semantic.head_band_box, options.subbox.grid, &v.subbox);
     if (options.subbox.short_baseline_keeps_last_vote && options.subbox.min_evidence_frames > 0 &&
         options.boxes_tracked && r->tracker.ran() && v.subbox.ok())
