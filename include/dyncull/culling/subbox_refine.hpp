@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -158,47 +159,37 @@ void subbox_begin(SubBoxResult<T>* out, std::size_t n, std::size_t nb) {
   r.num_whole_boxes = r.num_invalid_boxes = 0;
 }
 
+/// Refuses the frame into the result started by subbox_begin: InvalidInput with `why`, nothing voted
+/// (every feature stays Static). Returns false, for the checks below.
+template <class T>
+bool subbox_refuse(SubBoxResult<T>* r, std::string why) {
+  r->status = Status::InvalidInput;
+  r->reason = std::move(why);
+  r->votes.clear();
+  r->cells.clear();
+  r->grid = 0;
+  return false;
+}
+
 /// options.validate() into the result started by subbox_begin (InvalidInput, every feature Static).
 template <class T>
 bool subbox_options_valid(const SubBoxOptions<T>& options, SubBoxResult<T>* r) {
   std::string why;
   if (options.validate(&why) == Status::Ok) return true;
-  r->status = Status::InvalidInput;
-  r->reason = "invalid options: " + why;
-  r->votes.clear();
-  r->cells.clear();
-  r->grid = 0;
-  return false;
+  return subbox_refuse(r, "invalid options: " + why);
 }
 
-/// The per-feature views hold n entries (those given); else InvalidInput into the result started by
-/// subbox_begin, naming the view and both sizes (nothing read).
+/// The per-feature views hold n entries and the per-box flags nb (those given); else InvalidInput into
+/// the result started by subbox_begin, naming the view and both sizes (nothing read).
 template <class T>
-bool subbox_inputs_fit(std::size_t n, FlagView in_object_mask, BoxBitsView object_box_bits, SubBoxResult<T>* r) {
+bool subbox_inputs_fit(std::size_t n, FlagView in_object_mask, BoxBitsView object_box_bits, std::size_t nb,
+                       FlagView static_needs_evidence_boxes, SubBoxResult<T>* r) {
   std::string why;
   if (flags_fit(in_object_mask, n, "in_object_mask", "points", &why) &&
-      flags_fit(object_box_bits, n, "object_box_bits", "points", &why))
+      flags_fit(object_box_bits, n, "object_box_bits", "points", &why) &&
+      flags_fit(static_needs_evidence_boxes, nb, "static_needs_evidence_boxes", "boxes", &why))
     return true;
-  r->status = Status::InvalidInput;
-  r->reason = why;
-  r->votes.clear();
-  r->cells.clear();
-  r->grid = 0;
-  return false;
-}
-
-/// The per-box flags, when given, hold one entry per box; else InvalidInput into the result started by
-/// subbox_begin, naming them and both sizes (nothing read).
-template <class T>
-bool subbox_box_flags_fit(std::size_t nb, FlagView static_needs_evidence_boxes, SubBoxResult<T>* r) {
-  std::string why;
-  if (flags_fit(static_needs_evidence_boxes, nb, "static_needs_evidence_boxes", "boxes", &why)) return true;
-  r->status = Status::InvalidInput;
-  r->reason = why;
-  r->votes.clear();
-  r->cells.clear();
-  r->grid = 0;
-  return false;
+  return subbox_refuse(r, why);
 }
 
 /// The required geometric labels hold n entries; else InvalidInput into the result started by
@@ -207,13 +198,8 @@ template <class T>
 bool subbox_geometric_fits(ArrayView<FeatureLabel> geometric, std::size_t n, SubBoxResult<T>* r) {
   std::string why;
   if (geometric.holds(n)) return true;
-  r->status = Status::InvalidInput;
   if (geometric.given) flags_fit(geometric, n, "geometric", "points", &why);
-  r->reason = geometric.given ? why : "geometric is required (" + std::to_string(n) + " points)";
-  r->votes.clear();
-  r->cells.clear();
-  r->grid = 0;
-  return false;
+  return subbox_refuse(r, geometric.given ? why : "geometric is required (" + std::to_string(n) + " points)");
 }
 
 /// Zeroed per-box votes and per-cell buffers for nb boxes of grid*grid cells; returns grid*grid.
@@ -386,8 +372,7 @@ void refine_subboxes(const Points& points, ArrayView<FeatureLabel> geometric, co
   detail::subbox_begin(&r, n, nb);
   if (!detail::subbox_options_valid(options, &r)) return;
   if (!detail::subbox_geometric_fits(geometric, n, &r) ||
-      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r) ||
-      !detail::subbox_box_flags_fit(nb, static_needs_evidence_boxes, &r))
+      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, nb, static_needs_evidence_boxes, &r))
     return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, options.grid);
   detail::subbox_count_votes(points, geometric, boxes, options, cells_per_box, in_object_mask, object_box_bits, &r);
@@ -429,16 +414,12 @@ void apply_subbox_states(const Points& points, ArrayView<FeatureLabel> geometric
   if (!detail::subbox_options_valid(options, &r)) return;
   const std::size_t cells = nb * static_cast<std::size_t>(g) * static_cast<std::size_t>(g);
   if (!states.holds(cells)) {  // required, unlike the other views
-    r.status = Status::InvalidInput;
-    r.reason = "states has " + std::to_string(states.given ? states.size : 0) + " entries for " +
-               std::to_string(cells) + " cells (boxes x grid x grid)";
-    r.votes.clear();
-    r.cells.clear();
-    r.grid = 0;
+    detail::subbox_refuse(&r, "states has " + std::to_string(states.given ? states.size : 0) + " entries for " +
+                                  std::to_string(cells) + " cells (boxes x grid x grid)");
     return;
   }
   if (!detail::subbox_geometric_fits(geometric, n, &r) ||
-      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, &r))
+      !detail::subbox_inputs_fit(n, in_object_mask, object_box_bits, nb, nullptr, &r))
     return;
   const std::size_t cells_per_box = detail::subbox_buffers(&r, nb, g);
   for (std::size_t b = 0; b < nb; ++b) {
