@@ -30,6 +30,7 @@
 #include <limits>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -169,18 +170,26 @@ inline int kfm_cell(T v, T origin, T cell, int count) {
   return clamped_int((v - origin) / cell, 0, count - 1);
 }
 
-/// Hamming distance of two rows; kWords > 0 fixes the length at compile time (ORB: 4 words, no tail).
-template <bool UseBuiltin, int kWords>
+template <bool UseBuiltin>
+inline int kfm_popcount(std::uint64_t x) noexcept {
+  return UseBuiltin ? __builtin_popcountll(x) : kfm_popcount_swar(x);
+}
+
+/// Hamming distance of two rows of any length (whole words, then the tail bytes).
+template <bool UseBuiltin>
 inline int kfm_hamming(const std::uint8_t* a, const std::uint8_t* b, std::size_t row_bytes) {
-  const std::size_t words = kWords > 0 ? std::size_t(kWords) : row_bytes / 8;
+  const std::size_t words = row_bytes / 8;
   int d = 0;
-  for (std::size_t w = 0; w < words; ++w) {
-    const std::uint64_t x = kfm_load_u64(a + 8 * w) ^ kfm_load_u64(b + 8 * w);
-    d += UseBuiltin ? __builtin_popcountll(x) : kfm_popcount_swar(x);
-  }
-  if (kWords == 0)
-    for (std::size_t k = 8 * words; k < row_bytes; ++k) d += kfm_popcount_swar(static_cast<std::uint64_t>(a[k] ^ b[k]));
+  for (std::size_t w = 0; w < words; ++w) d += kfm_popcount<UseBuiltin>(kfm_load_u64(a + 8 * w) ^ kfm_load_u64(b + 8 * w));
+  for (std::size_t k = 8 * words; k < row_bytes; ++k) d += kfm_popcount_swar(static_cast<std::uint64_t>(a[k] ^ b[k]));
   return d;
+}
+
+/// Hamming distance of a row of sizeof...(W) words held in `a` (loaded once per search) to row `b`,
+/// unrolled (g++ -O2 keeps a counted loop of four).
+template <bool UseBuiltin, std::size_t... W>
+inline int kfm_hamming_words(const std::uint64_t* a, const std::uint8_t* b, std::index_sequence<W...>) {
+  return (0 + ... + kfm_popcount<UseBuiltin>(a[W] ^ kfm_load_u64(b + 8 * W)));
 }
 
 /// For every keyframe point: the nearest (ties: lowest current index) and second-nearest current
@@ -201,6 +210,8 @@ inline KfmWork kfm_scan_impl(const KfmScan<T>& s) {
     const int c0 = kfm_cell(px - r, s.grid_x0, s.cell, s.cols), c1 = kfm_cell(px + r, s.grid_x0, s.cell, s.cols);
     const int q0 = kfm_cell(py - r, s.grid_y0, s.cell, s.rows), q1 = kfm_cell(py + r, s.grid_y0, s.cell, s.rows);
     const std::uint8_t* kd = s.kf_desc.row(k);
+    std::uint64_t kw[kWords > 0 ? kWords : 1];
+    for (int w = 0; w < kWords; ++w) kw[w] = kfm_load_u64(kd + 8 * w);
     // Key = distance << 32 | current index: one comparison orders by distance, then index. The updates
     // are selects, not branches: which candidate wins is unpredictable.
     std::uint64_t best = std::numeric_limits<std::uint64_t>::max();
@@ -213,7 +224,11 @@ inline KfmWork kfm_scan_impl(const KfmScan<T>& s) {
     for (int q = q0; q <= q1; ++q) held += run_end(q) - run_begin(q);
     const std::size_t step = held > s.max_candidates ? (held + s.max_candidates - 1) / s.max_candidates : 1;
     auto compare = [&](std::uint32_t i) {
-      const int d = kfm_hamming<UseBuiltin, kWords>(kd, s.cur_desc + std::size_t(i) * s.row_bytes, s.row_bytes);
+      const std::size_t row_bytes = kWords > 0 ? 8 * std::size_t(kWords) : s.row_bytes;
+      const std::uint8_t* row = s.cur_desc + std::size_t(i) * row_bytes;
+      int d;
+      if constexpr (kWords > 0) d = kfm_hamming_words<UseBuiltin>(kw, row, std::make_index_sequence<std::size_t(kWords)>());
+      else d = kfm_hamming<UseBuiltin>(kd, row, s.row_bytes);
       const std::uint64_t key = (static_cast<std::uint64_t>(d) << 32) | s.cur_index[i];
       const bool better = key < best;
       const int loser = better ? best_d : d;  // best_d <= second always
