@@ -2,8 +2,9 @@
 /// Per-pixel motion truth for a real RGB-D sequence with ground-truth camera poses: a pixel is static
 /// when, under the (slightly corrected) relative pose of its neighbours K frames before and after, its
 /// back-projected depth lands where dense optical flow sees it, and moving when it lands far from it
-/// (the static-world test of Palazzolo et al. 2019's residuals, with DIS flow, Kroeger et al. 2016).
-/// No detector boxes are used. The method, its thresholds and their reasons: docs/motion_truth.md.
+/// (the static-world test of Palazzolo et al. 2019's residuals, with DIS flow, Kroeger et al. 2016), or
+/// when the neighbour's depth at its static place is farther than it (no static surface can be seen
+/// through). No detector boxes are used. The method, its thresholds and their reasons: docs/motion_truth.md.
 #pragma once
 
 #include "dyncull/core/camera.hpp"
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -52,6 +54,15 @@ struct MotionTruthOptions {
   /// frame's depth where the static world puts it differs by more than moved_depth_ratio.
   double min_texture = 3e-5;
   double moved_depth_ratio = 0.08;
+  /// A visible static point is where the static world puts it in the neighbour, and a hidden one lies
+  /// behind what the neighbour sees there; so where the neighbour's nearest depth within 2 px of that
+  /// place is farther than the point by more than this, the point has left (a walker's pixel whose
+  /// place now shows the wall). Structured-light depth is about 1.5 % noisy at 4-5 m.
+  double farther_depth_ratio = 0.04;
+  /// An untextured pixel (see min_texture) whose flow lags between the thresholds is static when every
+  /// neighbour sees depth within this ratio at its static place and no consistent flow puts it beyond
+  /// moving_px.
+  double same_depth_ratio = 0.03;
   double min_depth_m = 0.3, max_depth_m = 6.0;
 };
 
@@ -141,14 +152,27 @@ inline cv::Mat textured_pixels(const cv::Mat& gray, const MotionTruthOptions& o)
   return texture >= o.min_texture;
 }
 
+/// The nearest measured depth within `radius` px of each pixel (0 where none is measured).
+inline cv::Mat nearest_depth(const cv::Mat& depth, int radius) {
+  constexpr float kNone = std::numeric_limits<float>::max();
+  cv::Mat nearest = depth.clone();
+  nearest.setTo(kNone, depth <= 0);
+  cv::erode(nearest, nearest, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  nearest.setTo(0, nearest == kNone);
+  return nearest;
+}
+
 /// Per pixel, what the neighbours said so far.
 struct Evidence {
   cv::Mat least, worst;  ///< CV_32F: smallest and largest flow residual (px)
   cv::Mat seen;          ///< CV_8U: neighbours that saw the pixel
   cv::Mat depth_moved;   ///< CV_8U: neighbours whose depth says the surface left its static place
+  cv::Mat farther;       ///< CV_8U: neighbours whose nearest depth at the static place is farther
+  cv::Mat depth_same;    ///< CV_8U: neighbours whose depth at the static place agrees
   explicit Evidence(cv::Size size)
       : least(size, CV_32FC1, cv::Scalar(1e9f)), worst(size, CV_32FC1, cv::Scalar(-1.f)),
-        seen(size, CV_8UC1, cv::Scalar(0)), depth_moved(size, CV_8UC1, cv::Scalar(0)) {}
+        seen(size, CV_8UC1, cv::Scalar(0)), depth_moved(size, CV_8UC1, cv::Scalar(0)),
+        farther(size, CV_8UC1, cv::Scalar(0)), depth_same(size, CV_8UC1, cv::Scalar(0)) {}
 };
 
 /// Flow of both directions between two frames.
@@ -186,6 +210,7 @@ class MotionLabeller {
       return out;
     }
     const cv::Mat usable = detail::usable_pixels(ref.depth_m, options_);
+    const cv::Mat textured = detail::textured_pixels(ref.gray, options_);
     detail::Evidence evidence(ref.gray.size());
     const int k = options_.window_frames;
     for (int s : {t - k, t + k}) {
@@ -197,7 +222,7 @@ class MotionLabeller {
       const detail::FlowPair& f = flows(frames, std::min(t, s), std::max(t, s));
       const cv::Mat& ts = t < s ? f.forward : f.backward;
       const cv::Mat& st = t < s ? f.backward : f.forward;
-      out.corrections.push_back(add_residuals(ref, other, ts, st, usable, camera, &evidence));
+      out.corrections.push_back(add_residuals(ref, other, ts, st, usable, textured, camera, &evidence));
     }
     evict_before(t - k);
     if (out.corrections.empty()) {
@@ -205,8 +230,7 @@ class MotionLabeller {
       out.note = "no neighbour with a pose";
       return out;
     }
-    decide(ref.depth_m, usable, detail::textured_pixels(ref.gray, options_), evidence,
-           static_cast<int>(out.corrections.size()), &out);
+    decide(ref.depth_m, usable, textured, evidence, static_cast<int>(out.corrections.size()), &out);
     return out;
   }
 
@@ -240,21 +264,26 @@ class MotionLabeller {
   /// Refines other_from_ref on a grid of flow matches with a trimmed PnP: the static world is the
   /// majority of the image near the ground-truth pose, so the lower half of the residuals is static.
   PoseCorrection refine(const TruthFrame& ref, const cv::Mat& ts, const cv::Mat& st, const cv::Mat& usable,
-                        const PinholeCamera<double>& camera, Rigid3<double>* other_from_ref) const {
+                        const cv::Mat& textured, const PinholeCamera<double>& camera,
+                        Rigid3<double>* other_from_ref) const {
     PoseCorrection c;
     std::vector<cv::Point3f> X;
     std::vector<cv::Point2f> q;
+    int with_texture = 0;
     for (int v = 4; v < ref.gray.rows; v += 8) {
       for (int u = 4; u < ref.gray.cols; u += 8) {
         cv::Point2f seen;
         if (!usable.at<std::uint8_t>(v, u) || !observed(ts, st, u, v, &seen)) continue;
+        with_texture += textured.at<std::uint8_t>(v, u) != 0;
         const Vec3<double> p = camera.backproject(Vec2<double>(u, v), ref.depth_m.at<float>(v, u));
         X.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
         q.push_back(seen);
       }
     }
     c.matches = static_cast<int>(X.size());
-    if (X.size() < 60) return c;
+    // Flow without texture is what DIS's regulariser spreads (zero on a blank image): too little texture
+    // and the fit would take the camera's motion for noise.
+    if (X.size() < 60 || with_texture < 60) return c;
     const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
     cv::Mat rvec, tvec;
     detail::rigid_to_cv(*other_from_ref, &rvec, &tvec);
@@ -293,14 +322,14 @@ class MotionLabeller {
 
   /// Adds one neighbour's residuals: |flow position - static-world prediction| in pixels.
   PoseCorrection add_residuals(const TruthFrame& ref, const TruthFrame& other, const cv::Mat& ts, const cv::Mat& st,
-                               const cv::Mat& usable, const PinholeCamera<double>& camera,
+                               const cv::Mat& usable, const cv::Mat& textured, const PinholeCamera<double>& camera,
                                detail::Evidence* e) const {
     Rigid3<double> other_from_ref = other.world_from_cam.inverse() * ref.world_from_cam;
-    const PoseCorrection c = refine(ref, ts, st, usable, camera, &other_from_ref);
+    const PoseCorrection c = refine(ref, ts, st, usable, textured, camera, &other_from_ref);
+    const cv::Mat nearest = other.depth_m.empty() ? cv::Mat() : detail::nearest_depth(other.depth_m, 2);
     for (int v = 0; v < ref.gray.rows; ++v) {
       for (int u = 0; u < ref.gray.cols; ++u) {
-        cv::Point2f q;
-        if (!usable.at<std::uint8_t>(v, u) || !observed(ts, st, u, v, &q)) continue;
+        if (!usable.at<std::uint8_t>(v, u)) continue;
         const Vec3<double> p =
             other_from_ref.apply(camera.backproject(Vec2<double>(u, v), ref.depth_m.at<float>(v, u)));
         if (p.z() <= 0) continue;
@@ -308,6 +337,9 @@ class MotionLabeller {
         if (predicted.x() < 0 || predicted.y() < 0 || predicted.x() > camera.width - 1 ||
             predicted.y() > camera.height - 1)
           continue;  // leaves the other view: no evidence either way
+        if (!nearest.empty()) add_depth_evidence(other.depth_m, nearest, predicted, p.z(), u, v, e);
+        cv::Point2f q;
+        if (!observed(ts, st, u, v, &q)) continue;
         const float r = static_cast<float>(std::hypot(predicted.x() - q.x, predicted.y() - q.y));
         float& w = e->worst.at<float>(v, u);
         w = std::max(w, r);
@@ -322,19 +354,35 @@ class MotionLabeller {
     return c;
   }
 
-  /// Moving needs every neighbour: one direction's flow alone is wrong too often (glare, blur).
+  /// What the other frame's depth says at the static place of a point at depth `z` there.
+  void add_depth_evidence(const cv::Mat& depth, const cv::Mat& nearest, const Vec2<double>& place, double z, int u,
+                          int v, detail::Evidence* e) const {
+    const int pu = cvRound(place.x()), pv = cvRound(place.y());
+    const float near = nearest.at<float>(pv, pu), there = depth.at<float>(pv, pu);
+    if (near > 0 && near > (1 + options_.farther_depth_ratio) * z) ++e->farther.at<std::uint8_t>(v, u);
+    if (there > 0 && std::abs(there - z) < options_.same_depth_ratio * z) ++e->depth_same.at<std::uint8_t>(v, u);
+  }
+
+  /// Moving needs every neighbour's flow (one direction's flow alone is wrong too often: glare, blur), or
+  /// one neighbour's depth seen behind the point's static place; static needs every neighbour's flow, or
+  /// every neighbour's depth where flow has no texture to follow, and no depth seen behind.
   void decide(const cv::Mat& depth, const cv::Mat& usable, const cv::Mat& textured, const detail::Evidence& e,
               int neighbours, FrameTruth* out) const {
     for (int v = 0; v < depth.rows; ++v) {
       for (int u = 0; u < depth.cols; ++u) {
         if (depth.at<float>(v, u) > 0) ++out->with_depth;
+        if (!usable.at<std::uint8_t>(v, u)) continue;
         const std::uint8_t seen = e.seen.at<std::uint8_t>(v, u);
-        if (!usable.at<std::uint8_t>(v, u) || seen == 0) continue;
+        const bool has_texture = textured.at<std::uint8_t>(v, u) != 0;
         const bool flow_moved = seen == neighbours && e.least.at<float>(v, u) > options_.moving_px;
-        const bool depth_agrees = textured.at<std::uint8_t>(v, u) || e.depth_moved.at<std::uint8_t>(v, u) == seen;
+        const bool depth_agrees = has_texture || e.depth_moved.at<std::uint8_t>(v, u) == seen;
+        const bool flow_static = seen > 0 && e.worst.at<float>(v, u) < options_.static_px;
+        const bool depth_static = !has_texture && e.depth_same.at<std::uint8_t>(v, u) == neighbours &&
+                                  seen > 0 && e.worst.at<float>(v, u) <= options_.moving_px;
+        const bool seen_behind = e.farther.at<std::uint8_t>(v, u) > 0;
         std::uint8_t& label = out->labels.at<std::uint8_t>(v, u);
-        if (flow_moved && depth_agrees) label = kMoving;
-        else if (e.worst.at<float>(v, u) < options_.static_px) label = kStatic;
+        if ((flow_moved && depth_agrees) || (seen_behind && !flow_static)) label = kMoving;
+        else if ((flow_static || depth_static) && !seen_behind) label = kStatic;
         else continue;
         ++out->known;
         if (label == kMoving) ++out->moving;

@@ -173,6 +173,35 @@ TEST(MotionTruth, UntexturedPixelsNeedDepthToBeMoving) {
   EXPECT_EQ(count(t.labels, s.region[4], 0)[1], 0) << "blank wall labelled moving";
 }
 
+// A static point is seen at its static place in a neighbour, or hidden behind what is seen there; depth
+// farther than the point there means it left. With flow unable to say "moving" (moving_px out of reach),
+// depth alone labels the bands the walker leaves (17 px of its 105 px each way), and never the wall the
+// walker hides in the neighbours.
+TEST(MotionTruth, DepthSeenBehindItsStaticPlaceIsMoving) {
+  RenderedSequence s = render(13);
+  truth::MotionTruthOptions options;
+  options.moving_px = 100;
+  truth::MotionLabeller labeller(options);
+  const truth::FrameTruth t = labeller.label(s.frames, 6, s.camera);
+  const std::array<int, 3> walker = count(t.labels, s.region[6], 1);
+  const std::array<int, 3> wall = count(t.labels, s.region[6], 0);
+  EXPECT_GT(walker[1], (walker[0] + walker[1] + walker[2]) / 10);
+  EXPECT_EQ(walker[0], 0) << "walker labelled static";
+  EXPECT_LT(wall[1], (wall[0] + wall[1]) / 200) << "wall labelled moving";
+}
+
+// On a blank image flow is zero everywhere; a pose refinement fitted on it would take the camera's motion
+// for noise and call the untextured walker static. The refinement needs textured matches, so here it is
+// refused and the walker is never static.
+TEST(MotionTruth, PoseIsNotRefinedOnUntexturedFlow) {
+  RenderedSequence s = render(9);
+  for (truth::TruthFrame& f : s.frames) f.gray.setTo(128);
+  truth::MotionLabeller labeller;
+  const truth::FrameTruth t = labeller.label(s.frames, 4, s.camera);
+  for (const truth::PoseCorrection& c : t.corrections) EXPECT_FALSE(c.fitted);
+  EXPECT_EQ(count(t.labels, s.region[4], 1)[0], 0) << "walker labelled static";
+}
+
 }  // namespace
 
 #else
