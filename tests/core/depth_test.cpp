@@ -135,57 +135,19 @@ TEST(DepthStepNear, HugeRadiusIsClampedToTheImage) {
   EXPECT_LT(seconds, 1.0);
 }
 
-// Reference: the plain loop over every sampled offset (radius small enough not to overflow).
-template <class Raw>
-bool depth_step_reference(const dyncull::DepthView<Raw>& v, int u, int y, int radius, double ratio) {
-  const float z = v.depth_m(u, y);
-  if (!(z > 0.f)) return false;
-  const int step = radius > 2 ? 2 : 1;
-  for (int dy = -radius; dy <= radius; dy += step)
-    for (int dx = -radius; dx <= radius; dx += step) {
-      if (!v.in_bounds(u + dx, y + dy)) continue;
-      const float zz = v.depth_m(u + dx, y + dy);
-      if (!(zz > 0.f) || std::abs(zz - z) > static_cast<float>(ratio) * z) return true;
-    }
-  return false;
-}
-
-// Every path of depth_step_near (raw uint16 against an interval of raw values, metres read directly,
-// other units divided per pixel) against the reference, on random depth near the valid range's ends and
-// the tolerance's edges, with ratios from 0 to beyond 1 and NaN.
-TEST(DepthStepNear, PropertyEveryDepthTypeMatchesTheReference) {
-  dyncull::Random rng(11);
-  for (int trial = 0; trial < 3000; ++trial) {
-    const int w = 1 + static_cast<int>(rng.index(12)), h = 1 + static_cast<int>(rng.index(12));
-    const float units = trial % 3 == 0 ? 5000.f : trial % 3 == 1 ? 1000.f : 1.f;
-    const float min_m = rng.index(2) ? 0.f : 0.4f, max_m = rng.index(2) ? 1e30f : 2.f;
-    std::vector<std::uint16_t> raw(static_cast<std::size_t>(w * h));
-    std::vector<float> metres(raw.size());
-    const double base = rng.uniform(0.3, 2.2);
-    for (std::size_t k = 0; k < raw.size(); ++k) {
-      const double m = rng.index(8) == 0 ? 0.0 : base * (1.0 + rng.uniform(-0.08, 0.08));
-      raw[k] = static_cast<std::uint16_t>(std::min(65535.0, std::round(m * units)));
-      metres[k] = rng.index(20) == 0 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(raw[k]) / units;
-    }
-    dyncull::DepthView<std::uint16_t> rv{raw.data(), w, h, 0, units, min_m, max_m};
-    dyncull::DepthView<float> mv{metres.data(), w, h, 0, trial % 2 ? 1.f : 0.5f, min_m, max_m};
-    const int u = static_cast<int>(rng.index(16)) - 2, y = static_cast<int>(rng.index(16)) - 2;
-    const int radius = static_cast<int>(rng.index(12)) - 1;
-    const int kind = static_cast<int>(rng.index(10));
-    const double ratio = kind == 0 ? std::numeric_limits<double>::quiet_NaN()
-                         : kind == 1 ? rng.uniform(0.5, 3.0)
-                         : kind == 2 ? 0.0
-                                     : rng.uniform(0, 0.1);
-    EXPECT_EQ(dyncull::depth_step_near(rv, u, y, radius, ratio), depth_step_reference(rv, u, y, radius, ratio))
-        << trial << " raw " << u << "," << y << " r=" << radius << " ratio " << ratio;
-    EXPECT_EQ(dyncull::depth_step_near(mv, u, y, radius, ratio), depth_step_reference(mv, u, y, radius, ratio))
-        << trial << " metres " << u << "," << y << " r=" << radius << " ratio " << ratio;
-  }
-}
-
 TEST(DepthStepNear, PropertyMatchesTheUnclampedLoopOnSmallRadii) {
+  // Reference: the plain loop over every sampled offset (radius small enough not to overflow).
   auto reference = [](const dyncull::DepthView<float>& v, int u, int y, int radius, double ratio) {
-    return depth_step_reference(v, u, y, radius, ratio);
+    const float z = v.depth_m(u, y);
+    if (!(z > 0.f)) return false;
+    const int step = radius > 2 ? 2 : 1;
+    for (int dy = -radius; dy <= radius; dy += step)
+      for (int dx = -radius; dx <= radius; dx += step) {
+        if (!v.in_bounds(u + dx, y + dy)) continue;
+        const float zz = v.depth_m(u + dx, y + dy);
+        if (!(zz > 0.f) || std::abs(zz - z) > static_cast<float>(ratio) * z) return true;
+      }
+    return false;
   };
   dyncull::Random rng(5);
   for (int trial = 0; trial < 300; ++trial) {

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -80,82 +79,6 @@ T axial_depth_sigma_m(T z, T base = T(0.0012), T quadratic = T(0.0019), T refere
   return base + quadratic * dz * dz;
 }
 
-namespace detail {
-
-/// The pixels depth_step_near() samples: rows y0..y1 and columns x0..x1, every `step`, all inside the image.
-struct DepthWindow {
-  long long x0, x1, y0, y1, step;
-};
-
-/// Whether every sampled pixel of `w` passes `near(raw)`.
-template <class Raw, class Near>
-bool all_near(const DepthView<Raw>& depth, const DepthWindow& w, Near near) {
-  for (long long y = w.y0; y <= w.y1; y += w.step) {
-    const Raw* row = depth.row(static_cast<int>(y));
-    for (long long x = w.x0; x <= w.x1; x += w.step)
-      if (!near(row[x])) return false;
-  }
-  return true;
-}
-
-/// The raw values of `depth` that to_metres() reads as a depth within `tol` of z (z > 0, tol >= 0): one
-/// interval [*lo, *hi], since to_metres() never decreases with the raw value and the valid range is an
-/// interval. From the estimates (z -/+ tol) * units, nudged until to_metres() agrees at both ends; centre
-/// is a raw value inside the interval.
-template <class Raw>
-void raw_interval_near(const DepthView<Raw>& depth, float z, float tol, Raw centre, Raw* lo, Raw* hi) {
-  auto near = [&](double r) {
-    const float d = depth.to_metres(static_cast<Raw>(r));
-    return d > 0.f && std::abs(d - z) <= tol;
-  };
-  const double top = static_cast<double>(std::numeric_limits<Raw>::max()), c = static_cast<double>(centre);
-  const double units = static_cast<double>(depth.units_per_metre);
-  // The estimates are within a raw unit or two of the ends. checked: every value converted to Raw is in [0, top].
-  double a = std::ceil(std::max(static_cast<double>(z) - tol, static_cast<double>(depth.min_m)) * units);
-  a = std::min(std::max(a, 0.0), c);
-  while (a > 0 && near(a - 1)) a -= 1;
-  while (a < c && !near(a)) a += 1;
-  double b = std::floor(std::min(static_cast<double>(z) + tol, static_cast<double>(depth.max_m)) * units);
-  b = std::max(std::min(b, top), c);
-  while (b < top && near(b + 1)) b += 1;
-  while (b > c && !near(b)) b -= 1;
-  *lo = static_cast<Raw>(a);
-  *hi = static_cast<Raw>(b);
-}
-
-/// Whether every sampled pixel's depth is within tol of z: the test of depth_step_near(), pixel by pixel.
-template <class Raw>
-bool all_near_in_metres(const DepthView<Raw>& depth, const DepthWindow& w, float z, float tol) {
-  return all_near(depth, w, [&](Raw r) {
-    const float d = depth.to_metres(r);
-    return d > 0.f && !(std::abs(d - z) > tol);
-  });
-}
-
-/// The same without a division per pixel: integer raw against the interval of raw values that passes ...
-template <class Raw>
-bool window_near(const DepthView<Raw>& depth, const DepthWindow& w, int u, int v, float z, float tol,
-                 std::true_type /*integral raw*/) {
-  if (!(tol >= 0.f)) return all_near_in_metres(depth, w, z, tol);  // NaN or negative: no interval
-  Raw lo = 0, hi = 0;
-  raw_interval_near(depth, z, tol, depth.raw(u, v), &lo, &hi);
-  return all_near(depth, w, [&](Raw r) { return r >= lo && r <= hi; });
-}
-
-/// ... and metres (units 1) read directly, other float units through to_metres().
-template <class Raw>
-bool window_near(const DepthView<Raw>& depth, const DepthWindow& w, int, int, float z, float tol,
-                 std::false_type /*float raw*/) {
-  if (depth.units_per_metre != 1.f) return all_near_in_metres(depth, w, z, tol);
-  const float min_m = depth.min_m, max_m = depth.max_m;
-  return all_near(depth, w, [&](Raw r) {
-    const float d = static_cast<float>(r);  // to_metres divides by 1: d exactly
-    return std::isfinite(d) && d > 0.f && d >= min_m && d <= max_m && !(std::abs(d - z) > tol);
-  });
-}
-
-}  // namespace detail
-
 /// True when a pixel within `radius` of (u, v) (sampled every 2 px beyond radius 2; pixels outside the
 /// image are not looked at) has no depth or differs from the depth at (u, v) by more than `ratio` of it:
 /// (u, v) lies near an occlusion edge or a hole. A centre without depth is not near an edge (nothing to
@@ -172,10 +95,15 @@ bool depth_step_near(const DepthView<Raw>& depth, int u, int v, int radius, doub
     const long long lo = centre - radius;
     return lo >= 0 ? lo : lo + ((-lo + step - 1) / step) * step;
   };
-  const detail::DepthWindow w{first_inside(u), std::min<long long>(static_cast<long long>(u) + radius, depth.width - 1),
-                              first_inside(v), std::min<long long>(static_cast<long long>(v) + radius, depth.height - 1),
-                              step};
-  return !detail::window_near(depth, w, u, v, z, tol, std::is_integral<Raw>());
+  const long long y_end = std::min<long long>(static_cast<long long>(v) + radius, depth.height - 1);
+  const long long x_end = std::min<long long>(static_cast<long long>(u) + radius, depth.width - 1);
+  for (long long y = first_inside(v); y <= y_end; y += step) {
+    for (long long x = first_inside(u); x <= x_end; x += step) {
+      const float zz = depth.depth_m(static_cast<int>(x), static_cast<int>(y));
+      if (!(zz > 0.f) || std::abs(zz - z) > tol) return true;
+    }
+  }
+  return false;
 }
 
 /// TUM convention: uint16, 5000 units per metre, 0 = no measurement.
