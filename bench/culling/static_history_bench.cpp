@@ -6,17 +6,18 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace {
 using namespace dyncull;
 
-// arg 0: tracks in creation order, as a front end keeps them (5 % dropped, as many new ids appended): the
-// merge walk. arg 1: new ids written over lost ones in place, so the ids are not sorted: a binary search per
-// track and a sort.
+// arg 0: tracks in creation order, as a front end keeps them (5 % dropped, as many new ids appended).
+// arg 1: new ids written over lost ones in place. arg 2: the ids in an order unrelated to their values, as
+// the culler gives them (keypoint order, a matched keypoint taking its keyframe point's id).
 void BM_StaticHistory_Update(benchmark::State& state) {
   constexpr std::size_t kTracks = 1100;
-  const bool in_place = state.range(0) == 1;
+  const bool in_place = state.range(0) == 1, shuffled = state.range(0) == 2;
   std::vector<std::int64_t> ids(kTracks);
   for (std::size_t i = 0; i < kTracks; ++i) ids[i] = static_cast<std::int64_t>(i);
   std::vector<FeatureLabel> labels(kTracks, FeatureLabel::Static);
@@ -31,7 +32,10 @@ void BM_StaticHistory_Update(benchmark::State& state) {
   std::int64_t next_id = static_cast<std::int64_t>(kTracks);
   for (auto _ : state) {
     ++frame;
-    if (in_place) {
+    if (shuffled) {
+      for (std::size_t k = 0; k < kTracks / 20; ++k) ids[(frame * 37 + k * 19) % kTracks] = next_id++;
+      for (std::size_t i = kTracks - 1; i > 0; --i) std::swap(ids[i], ids[(i * 7919 + frame) % (i + 1)]);
+    } else if (in_place) {
       for (std::size_t k = 0; k < kTracks / 20; ++k) ids[(frame * 37 + k * 19) % kTracks] = next_id++;
     } else {
       // Every 20th track lost (the erase keeps the order), as many new ones appended.
@@ -45,5 +49,5 @@ void BM_StaticHistory_Update(benchmark::State& state) {
   }
   state.counters["tracks"] = double(history.num_tracks());
 }
-BENCHMARK(BM_StaticHistory_Update)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_StaticHistory_Update)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 }  // namespace

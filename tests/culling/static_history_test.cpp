@@ -86,8 +86,7 @@ TYPED_TEST(StaticHistoryTest, TracksMissingFromAFrameAreForgottenAndOrderDoesNot
   EXPECT_EQ(history.count(9), 0);
 }
 
-// Tracks in creation order (ascending ids) take a merge walk instead of a binary search each: the counts must
-// not depend on the order the tracks come in.
+// The counts do not depend on the order the tracks come in (creation order, or a keyframe's order).
 TYPED_TEST(StaticHistoryTest, AscendingAndShuffledIdsGiveTheSameCounts) {
   using T = TypeParam;
   const std::vector<std::vector<std::int64_t>> frames = {{1, 2, 4, 7}, {1, 4, 7, 8}, {4, 4, 8, 9}, {2, 8, 9, 12}};

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace dyncull {
@@ -44,7 +45,8 @@ struct StaticHistoryOptions {
 
 /// Consecutive still frames per track, owned by the caller (PipelineState holds one) and advanced once per
 /// frame. Tracks missing from a frame are forgotten: front ends give a lost feature's id to no other track.
-/// Two sorted buffers swapped each frame: no allocation once they have grown to the track count.
+/// Two hash tables of the counts by id, swapped each frame: no allocation once they have grown to the track
+/// count, and no sort, whatever order the front end keeps its tracks in.
 class StaticHistory {
  public:
   /// Advances one frame over the n tracks `ids`. labels / residual_px (n each): each track's own geometric
@@ -52,8 +54,9 @@ class StaticHistory {
   /// evaluated == false when this frame is no evidence (a baseline too short to see a slow mover, or the
   /// check did not run): the counts then carry over unchanged. A Candidate label leaves its track's count
   /// unchanged; Dynamic, a residual at or above max_residual_px, or a non-finite one resets it to 0.
-  /// counts (resized to n): the track's count after this frame. A given labels or residual_px view whose
-  /// size is not ids.size(): InvalidInput with the reason (if asked), nothing read, history unchanged.
+  /// counts (resized to n): the track's count after this frame. An id given twice in a frame: each reads
+  /// the same history, and the first one's count is kept. A given labels or residual_px view whose size is
+  /// not ids.size(): InvalidInput with the reason (if asked), nothing read, history unchanged.
   /// (T is deduced from max_residual_px alone, so residual_px converts from a vector or nullptr.)
   template <class T>
   Status update(const std::vector<std::int64_t>& ids, ArrayView<FeatureLabel> labels,
@@ -68,53 +71,96 @@ class StaticHistory {
     }
     if (reason) reason->clear();
     counts->resize(n);
-    next_.resize(n);
+    next_.empty_for(n);
     const bool evidence = evaluated && labels.given && residual_px.given;
-    // Front ends usually keep their tracks in creation order (ascending ids): then one merge walk over the
-    // sorted history replaces a binary search per track, and the new buffer needs no sort.
-    const bool ascending = std::is_sorted(ids.begin(), ids.end());
-    std::size_t walk = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      Entry e{ids[i], 0};
-      if (ascending) {
-        while (walk < entries_.size() && entries_[walk].id < ids[i]) ++walk;
-        if (walk < entries_.size() && entries_[walk].id == ids[i]) e.count = entries_[walk].count;
-      } else {
-        e.count = previous_count(ids[i]);
-      }
+      std::uint16_t count = last_.find(ids[i]);
       if (evidence && labels[i] != FeatureLabel::Candidate) {
         const bool still = labels[i] == FeatureLabel::Static && residual_px[i] < max_residual_px;  // false for NaN
-        e.count = still ? static_cast<std::uint16_t>(std::min<int>(e.count + 1, kMaxCount)) : std::uint16_t(0);
+        count = still ? static_cast<std::uint16_t>(std::min<int>(count + 1, kMaxCount)) : std::uint16_t(0);
       }
-      next_[i] = e;
-      (*counts)[i] = e.count;
+      next_.insert_first(ids[i], count);
+      (*counts)[i] = count;
     }
-    if (!ascending) std::sort(next_.begin(), next_.end(), [](const Entry& a, const Entry& b) { return a.id < b.id; });
-    entries_.swap(next_);
+    std::swap(last_, next_);
+    num_tracks_ = n;
     return Status::Ok;
   }
 
   /// Count of a track after the last update (0 when unknown).
-  std::uint16_t count(std::int64_t id) const { return previous_count(id); }
-  std::size_t num_tracks() const { return entries_.size(); }
+  std::uint16_t count(std::int64_t id) const { return last_.find(id); }
+  /// Tracks given to the last update (an id given twice counts twice).
+  std::size_t num_tracks() const { return num_tracks_; }
   void clear() {
-    entries_.clear();
-    next_.clear();
+    last_.empty_for(0);
+    next_.empty_for(0);
+    num_tracks_ = 0;
   }
 
  private:
   static constexpr int kMaxCount = 0xFFFF;
-  struct Entry {
-    std::int64_t id = 0;
-    std::uint16_t count = 0;
-  };
-  std::uint16_t previous_count(std::int64_t id) const {
-    const auto it = std::lower_bound(entries_.begin(), entries_.end(), id,
-                                     [](const Entry& e, std::int64_t v) { return e.id < v; });
-    return it != entries_.end() && it->id == id ? it->count : std::uint16_t(0);
-  }
 
-  std::vector<Entry> entries_, next_;  ///< entries_: sorted by id (duplicates allowed, the first is read)
+  /// Open addressing with linear probing, at most half full. A slot is taken when its stamp is the
+  /// table's: emptying the table is one increment, not a pass over it.
+  class Table {
+   public:
+    /// Empties the table and makes room for n ids.
+    void empty_for(std::size_t n) {
+      std::size_t capacity = 16;
+      int bits = 4;
+      while (capacity < 2 * n) {
+        capacity *= 2;
+        ++bits;
+      }
+      if (capacity > slots_.size()) {
+        slots_.assign(capacity, Slot());
+        bits_ = bits;
+        stamp_ = 0;
+      }
+      if (++stamp_ == 0) {  // wrapped after 2^32 frames: stale stamps could match again
+        for (Slot& s : slots_) s.stamp = 0;
+        stamp_ = 1;
+      }
+    }
+    std::uint16_t find(std::int64_t id) const {
+      if (slots_.empty()) return 0;
+      for (std::size_t i = home(id);; i = (i + 1) & mask()) {
+        const Slot& s = slots_[i];
+        if (s.stamp != stamp_) return 0;
+        if (s.id == id) return s.count;
+      }
+    }
+    /// Stores id's count unless id is already in the table.
+    void insert_first(std::int64_t id, std::uint16_t count) {
+      for (std::size_t i = home(id);; i = (i + 1) & mask()) {
+        Slot& s = slots_[i];
+        if (s.stamp != stamp_) {
+          s = Slot{id, stamp_, count};
+          return;
+        }
+        if (s.id == id) return;
+      }
+    }
+
+   private:
+    struct Slot {
+      std::int64_t id = 0;
+      std::uint32_t stamp = 0;
+      std::uint16_t count = 0;
+    };
+    std::size_t mask() const { return slots_.size() - 1; }
+    /// Fibonacci hashing: front ends number their tracks consecutively, and the multiply spreads them.
+    std::size_t home(std::int64_t id) const {
+      return static_cast<std::size_t>((static_cast<std::uint64_t>(id) * 0x9E3779B97F4A7C15ull) >> (64 - bits_));
+    }
+
+    std::vector<Slot> slots_;
+    int bits_ = 4;
+    std::uint32_t stamp_ = 0;
+  };
+
+  Table last_, next_;
+  std::size_t num_tracks_ = 0;
 };
 
 }  // namespace dyncull
