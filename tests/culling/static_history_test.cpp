@@ -6,6 +6,8 @@
 
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -127,6 +129,46 @@ TYPED_TEST(StaticHistoryTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
   // Not given: no evidence this frame, the counts carry over.
   EXPECT_EQ(history.update(ids, nullptr, nullptr, true, T(0.8), &counts, &why), Status::Ok);
   EXPECT_EQ(counts, (std::vector<std::uint16_t>{1, 1, 1, 1}));
+}
+
+
+// Against a plain map over many frames of random ids: track counts from 0 to a few thousand (the tables grow
+// and are reused), negative ids, ids given twice, frames without evidence, and counts read back by id.
+TYPED_TEST(StaticHistoryTest, CountsMatchAMapOverManyFramesOfRandomIds) {
+  using T = TypeParam;
+  std::mt19937 rng(7);
+  auto uniform = [&rng](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  StaticHistory history;
+  std::map<std::int64_t, std::uint16_t> reference;
+  std::vector<std::uint16_t> counts;
+  for (int frame = 0; frame < 300; ++frame) {
+    const int n = frame % 50 == 49 ? 0 : uniform(0, frame < 150 ? 3000 : 40);
+    std::vector<std::int64_t> ids(static_cast<std::size_t>(n));
+    std::vector<FeatureLabel> labels(ids.size());
+    std::vector<T> residuals(ids.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      ids[i] = uniform(-100, 4000);
+      const int l = uniform(0, 9);
+      labels[i] = l == 0 ? D : l == 1 ? C : S;
+      residuals[i] = static_cast<T>(uniform(0, 16)) / T(10);
+    }
+    const bool evaluated = frame % 7 != 3;
+    ASSERT_EQ(history.update(ids, labels, residuals, evaluated, T(0.8), &counts), Status::Ok);
+    std::map<std::int64_t, std::uint16_t> next;
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      const auto it = reference.find(ids[i]);
+      int count = it == reference.end() ? 0 : it->second;
+      if (evaluated && labels[i] != C) count = labels[i] == S && residuals[i] < T(0.8) ? count + 1 : 0;
+      next.emplace(ids[i], static_cast<std::uint16_t>(count));  // an id given twice keeps its first count
+      ASSERT_EQ(counts[i], count) << "frame " << frame << " track " << i << " id " << ids[i];
+    }
+    reference.swap(next);
+    ASSERT_EQ(history.num_tracks(), ids.size());
+    for (std::int64_t id = -100; id <= 4000; id += 37) {
+      const auto it = reference.find(id);
+      ASSERT_EQ(history.count(id), it == reference.end() ? 0 : it->second) << "frame " << frame << " id " << id;
+    }
+  }
 }
 
 }  // namespace
