@@ -32,11 +32,10 @@ void BM_StaticHistory_Update(benchmark::State& state) {
   std::int64_t next_id = static_cast<std::int64_t>(kTracks);
   for (auto _ : state) {
     ++frame;
-    if (shuffled) {
+    if (in_place || shuffled) {
       for (std::size_t k = 0; k < kTracks / 20; ++k) ids[(frame * 37 + k * 19) % kTracks] = next_id++;
-      for (std::size_t i = kTracks - 1; i > 0; --i) std::swap(ids[i], ids[(i * 7919 + frame) % (i + 1)]);
-    } else if (in_place) {
-      for (std::size_t k = 0; k < kTracks / 20; ++k) ids[(frame * 37 + k * 19) % kTracks] = next_id++;
+      if (shuffled)
+        for (std::size_t i = kTracks - 1; i > 0; --i) std::swap(ids[i], ids[(i * 7919 + frame) % (i + 1)]);
     } else {
       // Every 20th track lost (the erase keeps the order), as many new ones appended.
       std::size_t w = 0;

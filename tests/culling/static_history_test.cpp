@@ -131,7 +131,6 @@ TYPED_TEST(StaticHistoryTest, ViewsOfAnotherLengthAreInvalidInputAndNotRead) {
   EXPECT_EQ(counts, (std::vector<std::uint16_t>{1, 1, 1, 1}));
 }
 
-
 // Against a plain map over many frames of random ids: track counts from 0 to a few thousand (the tables grow
 // and are reused), negative ids, ids given twice, frames without evidence, and counts read back by id.
 TYPED_TEST(StaticHistoryTest, CountsMatchAMapOverManyFramesOfRandomIds) {
