@@ -97,9 +97,12 @@ bool depth_step_near(const DepthView<Raw>& depth, int u, int v, int radius, doub
   };
   const long long y_end = std::min<long long>(static_cast<long long>(v) + radius, depth.height - 1);
   const long long x_end = std::min<long long>(static_cast<long long>(u) + radius, depth.width - 1);
+  // Every visited pixel is inside the image: its row is read directly, without depth_m's bounds test (the
+  // per-pixel call was not inlined in the culler's library).
   for (long long y = first_inside(v); y <= y_end; y += step) {
+    const Raw* row = depth.row(static_cast<int>(y));
     for (long long x = first_inside(u); x <= x_end; x += step) {
-      const float zz = depth.depth_m(static_cast<int>(x), static_cast<int>(y));
+      const float zz = depth.to_metres(row[x]);
       if (!(zz > 0.f) || std::abs(zz - z) > tol) return true;
     }
   }
