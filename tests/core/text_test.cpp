@@ -73,6 +73,18 @@ TEST(QuoteToken, PathsAreEscapedTheSameWayWithoutQuotes) {
   EXPECT_EQ(quote_path(long_path), std::string(kQuotedPathChars, 'p') + "... (5000 bytes)");
 }
 
+TEST(QuoteToken, EscapedBytesCountTowardTheBound) {
+  // Each byte outside printable ASCII shows as four characters: a path of such bytes stops at the bound.
+  const std::string binary_path(400, '\xd1');
+  const std::string shown = quote_path(binary_path);
+  EXPECT_EQ(shown, [] {
+    std::string s;
+    for (std::size_t i = 0; i < kQuotedPathChars / 4; ++i) s += "\\xd1";
+    return s + "... (400 bytes)";
+  }());
+  EXPECT_EQ(quote_token("ab\x01" "cd", 6), "'ab\\x01'... (5 bytes)");
+}
+
 TEST(IntegerInRange, ConvertsOnlyIntegersInsideTheBounds) {
   long long n = -7;
   EXPECT_TRUE(integer_in_range(1e15, 0, 1000000000000000LL, &n));

@@ -163,10 +163,13 @@ inline NumberStatus parse_python_float(std::string_view token, double* out) {
 inline std::string quote_token(std::string_view token, std::size_t max_chars = kQuotedTokenChars, bool quoted = true) {
   static const char* const kHex = "0123456789abcdef";
   std::string out = quoted ? "'" : "";
-  const std::size_t shown = token.size() < max_chars ? token.size() : max_chars;
-  for (std::size_t i = 0; i < shown; ++i) {
-    const unsigned char c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f && !(quoted && c == '\'') && c != '\\') {
+  const std::size_t start = out.size();
+  std::size_t shown = 0;  // bytes of token shown; an escaped byte takes four of the max_chars characters
+  for (; shown < token.size(); ++shown) {
+    const unsigned char c = static_cast<unsigned char>(token[shown]);
+    const bool plain = c >= 0x20 && c < 0x7f && !(quoted && c == '\'') && c != '\\';
+    if (out.size() - start + (plain ? 1 : 4) > max_chars) break;
+    if (plain) {
       out += static_cast<char>(c);
     } else {
       out += "\\x";
