@@ -283,26 +283,38 @@ run_once() {
     --json --poses-csv "$dir/poses.csv" >"$dir/ate.json" 2>"$dir/ate.err" || true
 }
 
-# run_sequence SEQ DEST [free]: every variant --runs times at the recorded rate; with "free", once more not
-# held to it (DYNCULL_FREE_RUN=1, in runs/VARIANT/free), for the frames per second the system sustains.
-# The live variants track on the colour frames (associations_color.txt) when the sequence has them.
+# run_sequence SEQ DEST [free]: every variant --runs times at the recorded rate, taken in turns (run 1 of
+# each variant, then run 2 of each, ...) so that a spell of slower CPU, which shared machines have, hits
+# every variant alike instead of one; with "free", once more not held to it (DYNCULL_FREE_RUN=1, in
+# runs/VARIANT/free), for the frames per second the system sustains. The live variants track on the colour
+# frames (associations_color.txt) when the sequence has them.
 run_sequence() {
-  local seq=$1 dest=$2 free=${3:-} variant run detections associations settings=()
+  local seq=$1 dest=$2 free=${3:-} variant run detections
   mkdir -p "$dest"
   sequence_tool prepare "$seq" "$dest" --host "$host" \
     --dyncull-eval "$dyncull_prefix/bin/dyncull_eval"
   detections=$(detections_of "$seq")
-  for variant in "${variant_list[@]}"; do
-    associations="$dest/associations.txt"
-    if [[ "$variant" == culler_live* && -f "$dest/associations_color.txt" ]]; then
-      associations="$dest/associations_color.txt"
-    fi
-    mapfile -t settings < <(variant_environment "$variant" "$detections")
-    for ((run = 1; run <= runs; run++)); do
-      run_once "$variant" "run$run"
+  for ((run = 1; run <= runs; run++)); do
+    for variant in "${variant_list[@]}"; do
+      run_variant "$variant" "$detections" "run$run"
     done
-    [[ -z "$free" ]] || run_once "$variant" free DYNCULL_FREE_RUN=1
   done
+  [[ -z "$free" ]] && return
+  for variant in "${variant_list[@]}"; do
+    run_variant "$variant" "$detections" free DYNCULL_FREE_RUN=1
+  done
+}
+
+# run_variant VARIANT DETECTIONS RUN_NAME [SETTING...]: run_once with the variant's settings and lists.
+run_variant() {
+  local variant=$1 detections=$2 name=$3 associations settings=()
+  shift 3
+  associations="$dest/associations.txt"
+  if [[ "$variant" == culler_live* && -f "$dest/associations_color.txt" ]]; then
+    associations="$dest/associations_color.txt"
+  fi
+  mapfile -t settings < <(variant_environment "$variant" "$detections")
+  run_once "$variant" "$name" "$@"
 }
 
 # Every family and motion of --families: run_sequence SEQ DEST for each, then the script's summary.
