@@ -43,7 +43,7 @@ struct Frame {
   }
 };
 
-enum Group { kBackground, kStillPerson, kWalkingPerson, kPushedChair, kStillChair, kTv };
+enum Group { kBackground, kStillPerson, kWalkingPerson, kPushedChair, kStillChair, kTvSet };
 
 TYPED_TEST(DynamicProbability, StillPersonStaticWalkingPersonDynamic) {
   using T = TypeParam;
@@ -103,14 +103,14 @@ TYPED_TEST(DynamicProbability, TemporalTermFromTheTrackStore) {
     f.add(rng, 100, Box<double>{0, 0, 640, 480}, MotionLevel::Ignore, {1, 0}, 0.2, kBackground);
     f.add(rng, 20, Box<double>{100, 100, 200, 400}, MotionLevel::High, Vec2<double>(1, 0) + person_motion, 0.2,
           kWalkingPerson);
-    f.add(rng, 10, Box<double>{400, 50, 500, 150}, MotionLevel::Low, Vec2<double>(1, 0) + tv_motion, 0.2, kTv);
+    f.add(rng, 10, Box<double>{400, 50, 500, 150}, MotionLevel::Low, Vec2<double>(1, 0) + tv_motion, 0.2, kTvSet);
     std::vector<std::int64_t> ids(f.group.size(), -1);
     for (std::size_t i = 100; i < 120; ++i) ids[i] = 1000 + std::int64_t(i);
     for (std::size_t i = 120; i < 130; ++i) ids[i] = 2000 + std::int64_t(i);
     DynamicProbabilityOptions<T> o;
     store.begin_frame();
     const auto r = dynamic_probability(f.prev, f.curr, f.levels, o, EgoMotion<T>{}, &store, &ids);
-    return std::make_pair(f.count(r, kWalkingPerson, FeatureLabel::Dynamic), f.count(r, kTv, FeatureLabel::Dynamic));
+    return std::make_pair(f.count(r, kWalkingPerson, FeatureLabel::Dynamic), f.count(r, kTvSet, FeatureLabel::Dynamic));
   };
   EXPECT_EQ(run({5, 0}, {0, 0}), std::make_pair(std::size_t(20), std::size_t(0)));  // walking
   EXPECT_EQ(run({0, 0}, {4, 0}), std::make_pair(std::size_t(20), std::size_t(0)));  // stopped: K keeps it one frame; tv glitch: not enough

@@ -38,7 +38,7 @@ bool defined(CullReason r) { return static_cast<int>(r) <= static_cast<int>(Cull
 
 /// A value for property tests: mostly ordinary, sometimes NaN, +-Inf, huge, negative or tiny.
 template <class T>
-T wild(Random& rng, double lo, double hi) {
+T wild_or_tiny(Random& rng, double lo, double hi) {
   switch (rng.index(16)) {
     case 0: return std::numeric_limits<T>::quiet_NaN();
     case 1: return std::numeric_limits<T>::infinity();
@@ -56,7 +56,7 @@ T wild(Random& rng, double lo, double hi) {
 template <class X>
 X maybe_wild(Random& rng, X normal) {
   if (rng.index(40) != 0) return normal;
-  return wild<X>(rng, -10, 10);
+  return wild_or_tiny<X>(rng, -10, 10);
 }
 int maybe_wild_int(Random& rng, int normal) {
   switch (rng.index(60)) {
@@ -72,8 +72,8 @@ int maybe_wild_int(Random& rng, int normal) {
 /// inverted, empty or non-finite).
 template <class T>
 Box<T> wild_box(Random& rng, double x_lo, double x_hi, double y_lo, double y_hi, double w_hi, double h_hi) {
-  const T x0 = wild<T>(rng, x_lo, x_hi), y0 = wild<T>(rng, y_lo, y_hi);
-  return Box<T>{x0, y0, x0 + wild<T>(rng, 0, w_hi), y0 + wild<T>(rng, 0, h_hi)};
+  const T x0 = wild_or_tiny<T>(rng, x_lo, x_hi), y0 = wild_or_tiny<T>(rng, y_lo, y_hi);
+  return Box<T>{x0, y0, x0 + wild_or_tiny<T>(rng, 0, w_hi), y0 + wild_or_tiny<T>(rng, 0, h_hi)};
 }
 
 /// The options fail validate() with InvalidInput and a reason that names the field.
@@ -126,9 +126,9 @@ TYPED_TEST(StageInputsTest, MultiViewPropertyStatusOrFiniteOutputs) {
   for (int trial = 0; trial < 300; ++trial) {
     const int w = 1 + static_cast<int>(rng.index(40)), h = 1 + static_cast<int>(rng.index(30));
     std::vector<float> depth(static_cast<std::size_t>(w * h));
-    for (float& d : depth) d = wild<float>(rng, 0, 8);
+    for (float& d : depth) d = wild_or_tiny<float>(rng, 0, 8);
     DepthView<float> view{depth.data(), w, h, 0, 1.f, 0.f, 1e30f};
-    if (rng.index(8) == 0) view.units_per_metre = wild<float>(rng, -2, 2);
+    if (rng.index(8) == 0) view.units_per_metre = wild_or_tiny<float>(rng, -2, 2);
     PinholeCamera<T> camera;
     camera.width = w;
     camera.height = h;
@@ -138,10 +138,10 @@ TYPED_TEST(StageInputsTest, MultiViewPropertyStatusOrFiniteOutputs) {
     const std::size_t n = rng.index(60);
     std::vector<Vec2<T>> points(n);
     std::vector<T> depths(rng.index(10) == 0 ? rng.index(60) : n);
-    for (auto& p : points) p = Vec2<T>(wild<T>(rng, 0, w), wild<T>(rng, 0, h));
-    for (T& d : depths) d = wild<T>(rng, 0, 8);
+    for (auto& p : points) p = Vec2<T>(wild_or_tiny<T>(rng, 0, w), wild_or_tiny<T>(rng, 0, h));
+    for (T& d : depths) d = wild_or_tiny<T>(rng, 0, 8);
     Rigid3<T> ref, cur;
-    cur.t = Vec3<T>(wild<T>(rng, -0.2, 0.2), T(rng.uniform(-0.2, 0.2)), T(rng.uniform(-0.2, 0.2)));
+    cur.t = Vec3<T>(wild_or_tiny<T>(rng, -0.2, 0.2), T(rng.uniform(-0.2, 0.2)), T(rng.uniform(-0.2, 0.2)));
     MultiViewOptions<T> o;
     o.search_radius_px = maybe_wild_int(rng, 2);
     o.depth_threshold_m = maybe_wild(rng, T(0.4));
@@ -274,7 +274,7 @@ TYPED_TEST(StageInputsTest, SubBoxPropertyStatusOrDefinedLabels) {
     std::vector<Vec2<T>> points(n);
     std::vector<FeatureLabel> geo(n);
     for (std::size_t i = 0; i < n; ++i) {
-      points[i] = Vec2<T>(wild<T>(rng, -10, 110), wild<T>(rng, -10, 90));
+      points[i] = Vec2<T>(wild_or_tiny<T>(rng, -10, 110), wild_or_tiny<T>(rng, -10, 90));
       geo[i] = static_cast<FeatureLabel>(rng.index(3));
     }
     std::vector<Box<T>> boxes(nb);
@@ -393,17 +393,17 @@ void depth_mask_property(std::uint64_t seed) {
       if constexpr (std::is_integral<Raw>::value)
         d = rng.index(4) == 0 ? Raw(0) : static_cast<Raw>(rng.index(65536));
       else
-        d = wild<Raw>(rng, 0, 6);
+        d = wild_or_tiny<Raw>(rng, 0, 6);
     }
     DepthView<Raw> view{depth.data(), w, h, 0, std::is_integral<Raw>::value ? 5000.f : 1.f, 0.f, 1e30f};
-    if (rng.index(6) == 0) view.units_per_metre = wild<float>(rng, -10, 10);
-    if (rng.index(6) == 0) view.min_m = wild<float>(rng, 0, 2);
-    if (rng.index(6) == 0) view.max_m = wild<float>(rng, 0, 10);
+    if (rng.index(6) == 0) view.units_per_metre = wild_or_tiny<float>(rng, -10, 10);
+    if (rng.index(6) == 0) view.min_m = wild_or_tiny<float>(rng, 0, 2);
+    if (rng.index(6) == 0) view.max_m = wild_or_tiny<float>(rng, 0, 10);
     const std::size_t nb = rng.index(4), n = rng.index(40);
     std::vector<Box<double>> boxes(nb);
     for (auto& b : boxes) b = wild_box<double>(rng, -10, w, -10, h, w, h);
     std::vector<Vec2<double>> points(n);
-    for (auto& p : points) p = Vec2<double>(wild<double>(rng, 0, w), wild<double>(rng, 0, h));
+    for (auto& p : points) p = Vec2<double>(wild_or_tiny<double>(rng, 0, w), wild_or_tiny<double>(rng, 0, h));
     DepthMaskOptions o;
     o.mode = rng.index(2) ? DepthMaskMode::Robust : DepthMaskMode::Plain;
     o.missing_depth = static_cast<MissingDepth>(rng.index(3));
@@ -473,8 +473,8 @@ TYPED_TEST(StageInputsTest, MovingConsistencyPropertyStatusOrDefinedLabels) {
     for (std::size_t i = 0; i < cur.size(); ++i) {
       const T inv_depth = T(rng.uniform(0.2, 1));
       cur[i] = i < n ? prev[i] + Vec2<T>(T(4) * inv_depth, T(1) * inv_depth) : Vec2<T>(T(1), T(1));
-      if (rng.index(8) == 0) cur[i] = Vec2<T>(wild<T>(rng, 0, 640), wild<T>(rng, 0, 480));
-      if (i < n && rng.index(12) == 0) prev[i] = Vec2<T>(wild<T>(rng, 0, 640), wild<T>(rng, 0, 480));
+      if (rng.index(8) == 0) cur[i] = Vec2<T>(wild_or_tiny<T>(rng, 0, 640), wild_or_tiny<T>(rng, 0, 480));
+      if (i < n && rng.index(12) == 0) prev[i] = Vec2<T>(wild_or_tiny<T>(rng, 0, 640), wild_or_tiny<T>(rng, 0, 480));
     }
     MovingConsistencyOptions<T> o;
     o.max_ransac_iterations = 100;
@@ -515,16 +515,16 @@ TYPED_TEST(StageInputsTest, ReprojectionPropertyStatusOrDefinedLabels) {
     std::vector<Vec2<T>> pixels(rng.index(12) == 0 ? rng.index(60) : n);
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3<T> X(T(rng.uniform(-2, 2)), T(rng.uniform(-1.5, 1.5)), T(rng.uniform(1, 5)));
-      points[i] = rng.index(8) == 0 ? Vec3<T>(wild<T>(rng, -2, 2), wild<T>(rng, -2, 2), wild<T>(rng, -1, 5)) : X;
+      points[i] = rng.index(8) == 0 ? Vec3<T>(wild_or_tiny<T>(rng, -2, 2), wild_or_tiny<T>(rng, -2, 2), wild_or_tiny<T>(rng, -1, 5)) : X;
     }
     for (std::size_t i = 0; i < pixels.size(); ++i) {
       const bool exact = i < n && rng.index(3) != 0 && points[i].z() > T(0) && points[i].allFinite();
-      pixels[i] = exact ? camera.project(points[i]) : Vec2<T>(wild<T>(rng, 0, 640), wild<T>(rng, 0, 480));
+      pixels[i] = exact ? camera.project(points[i]) : Vec2<T>(wild_or_tiny<T>(rng, 0, 640), wild_or_tiny<T>(rng, 0, 480));
     }
     std::vector<float> depth(640 * 480, 0.f);
-    for (int k = 0; k < 200; ++k) depth[rng.index(640 * 480)] = wild<float>(rng, 0, 5);
+    for (int k = 0; k < 200; ++k) depth[rng.index(640 * 480)] = wild_or_tiny<float>(rng, 0, 5);
     DepthView<float> view{depth.data(), 640, 480, 0, 1.f, 0.f, 1e30f};
-    if (rng.index(10) == 0) view.units_per_metre = wild<float>(rng, -1, 1);
+    if (rng.index(10) == 0) view.units_per_metre = wild_or_tiny<float>(rng, -1, 1);
     ReprojectionCheckOptions<T> o;
     o.max_ransac_iterations = 50;
     o.max_residual_px = maybe_wild(rng, T(3));
@@ -564,8 +564,8 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
     std::vector<Vec2<T>> points(n), residuals(n);
     std::vector<FeatureLabel> labels(n);
     for (std::size_t i = 0; i < n; ++i) {
-      points[i] = Vec2<T>(wild<T>(rng, 0, 100), wild<T>(rng, 0, 100));
-      residuals[i] = Vec2<T>(wild<T>(rng, -3, 3), wild<T>(rng, -3, 3));
+      points[i] = Vec2<T>(wild_or_tiny<T>(rng, 0, 100), wild_or_tiny<T>(rng, 0, 100));
+      residuals[i] = Vec2<T>(wild_or_tiny<T>(rng, -3, 3), wild_or_tiny<T>(rng, -3, 3));
       labels[i] = static_cast<FeatureLabel>(rng.index(3));
     }
     std::vector<Box<T>> boxes(nb);
@@ -576,7 +576,7 @@ TYPED_TEST(StageInputsTest, CoherentMotionPropertyStatusOrDefinedLabels) {
     o.sigmas = maybe_wild(rng, T(10));
     o.min_median_px = maybe_wild(rng, T(0.5));
     CoherentMotionResult<T> r;
-    flag_coherent_cells(points, residuals, boxes, grid, wild<T>(rng, 0, 2), o, labels.data(), &r);
+    flag_coherent_cells(points, residuals, boxes, grid, wild_or_tiny<T>(rng, 0, 2), o, labels.data(), &r);
     if (r.status != Status::Ok && r.status != Status::Skipped) {
       EXPECT_FALSE(r.reason.empty()) << trial;
       continue;
@@ -597,8 +597,8 @@ TYPED_TEST(StageInputsTest, DynamicProbabilityPropertyStatusOrFiniteOutputs) {
     std::vector<Vec2<T>> prev(n), cur(n);
     std::vector<MotionLevel> levels(rng.index(12) == 0 ? rng.index(60) : n);
     for (std::size_t i = 0; i < n; ++i) {
-      prev[i] = Vec2<T>(wild<T>(rng, 0, 640), wild<T>(rng, 0, 480));
-      cur[i] = Vec2<T>(wild<T>(rng, 0, 640), wild<T>(rng, 0, 480));
+      prev[i] = Vec2<T>(wild_or_tiny<T>(rng, 0, 640), wild_or_tiny<T>(rng, 0, 480));
+      cur[i] = Vec2<T>(wild_or_tiny<T>(rng, 0, 640), wild_or_tiny<T>(rng, 0, 480));
     }
     for (auto& l : levels) l = static_cast<MotionLevel>(rng.index(4));
     DynamicProbabilityOptions<T> o;
@@ -607,7 +607,7 @@ TYPED_TEST(StageInputsTest, DynamicProbabilityPropertyStatusOrFiniteOutputs) {
     EgoMotion<T> ego;
     ego.model = static_cast<FlowModel>(rng.index(3));
     if (ego.model != FlowModel::MeanFlow)
-      for (int k = 0; k < 9; ++k) ego.matrix(k / 3, k % 3) = rng.index(20) == 0 ? wild<T>(rng, -1, 1) : T(rng.uniform(-1, 1));
+      for (int k = 0; k < 9; ++k) ego.matrix(k / 3, k % 3) = rng.index(20) == 0 ? wild_or_tiny<T>(rng, -1, 1) : T(rng.uniform(-1, 1));
     const auto r = dynamic_probability(prev, cur, levels, o, ego);
     ASSERT_EQ(r.labels.size(), n);
     if (!r.ok()) {

@@ -93,8 +93,8 @@ TYPED_TEST_SUITE(TumReferenceTest, Scalars, );
 
 // Double must reproduce the scripts to 1e-6 (the requirement; in practice ~1e-12). Float poses carry
 // 1e-7 relative round-off on ~3 m coordinates, so float gets 2e-6 m and 2e-4 deg.
-template <class T> double tol_m() { return std::is_same<T, double>::value ? 1e-6 : 2e-6; }
-template <class T> double tol_deg() { return std::is_same<T, double>::value ? 1e-6 : 2e-4; }
+template <class T> double reference_tol_m() { return std::is_same<T, double>::value ? 1e-6 : 2e-6; }
+template <class T> double reference_tol_deg() { return std::is_same<T, double>::value ? 1e-6 : 2e-4; }
 
 TYPED_TEST(TumReferenceTest, AteMatchesEvaluateAtePy) {
   using T = TypeParam;
@@ -108,7 +108,7 @@ TYPED_TEST(TumReferenceTest, AteMatchesEvaluateAtePy) {
   const AteResult<T> ate = evaluate_ate(gt.trajectory, est.trajectory);
   ASSERT_TRUE(ate.ok()) << ate.reason;
   EXPECT_EQ(ate.num_pairs, static_cast<std::size_t>(json_number(data.json, {"ate", "pairs"})));
-  expect_stats(ate.error_m, data.json, "ate", nullptr, tol_m<T>());
+  expect_stats(ate.error_m, data.json, "ate", nullptr, reference_tol_m<T>());
   EXPECT_DOUBLE_EQ(static_cast<double>(ate.groundtruth_from_estimate.scale), 1.0);
 }
 
@@ -126,8 +126,8 @@ TYPED_TEST(TumReferenceTest, RpeOneFrameMatchesEvaluateRpePy) {
   const RpeResult<T> rpe = evaluate_rpe(gt.trajectory, est.trajectory, options);
   ASSERT_TRUE(rpe.ok()) << rpe.reason;
   EXPECT_EQ(rpe.num_pairs, static_cast<std::size_t>(json_number(data.json, {"rpe_1_frame", "pairs"})));
-  expect_stats(rpe.translation_m, data.json, "rpe_1_frame", "trans_m", tol_m<T>());
-  expect_stats(rpe.rotation_deg, data.json, "rpe_1_frame", "rot_deg", tol_deg<T>());
+  expect_stats(rpe.translation_m, data.json, "rpe_1_frame", "trans_m", reference_tol_m<T>());
+  expect_stats(rpe.rotation_deg, data.json, "rpe_1_frame", "rot_deg", reference_tol_deg<T>());
 }
 
 TYPED_TEST(TumReferenceTest, RpeOneSecondMatchesEvaluateRpePy) {
@@ -141,8 +141,8 @@ TYPED_TEST(TumReferenceTest, RpeOneSecondMatchesEvaluateRpePy) {
   const RpeResult<T> rpe = evaluate_rpe(gt.trajectory, est.trajectory);  // default: 1 second
   ASSERT_TRUE(rpe.ok()) << rpe.reason;
   EXPECT_EQ(rpe.num_pairs, static_cast<std::size_t>(json_number(data.json, {"rpe_1_second", "pairs"})));
-  expect_stats(rpe.translation_m, data.json, "rpe_1_second", "trans_m", tol_m<T>());
-  expect_stats(rpe.rotation_deg, data.json, "rpe_1_second", "rot_deg", tol_deg<T>());
+  expect_stats(rpe.translation_m, data.json, "rpe_1_second", "trans_m", reference_tol_m<T>());
+  expect_stats(rpe.rotation_deg, data.json, "rpe_1_second", "rot_deg", reference_tol_deg<T>());
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include <limits>
 #include <vector>
 
+using dyncull::test::solver_value;
+
 namespace {
 
 using dyncull::IcpOptions;
@@ -161,12 +163,6 @@ TEST(IcpOptionsValidate, NamesTheFieldAndBoundsTheIterations) {
   check(bad, "relative_rmse");
 }
 
-// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
-template <class T>
-T wild_value(Random& rng, double lo, double hi) {
-  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
-}
-
 // For any clouds, start and options: a non-Ok status with a reason, or a finite transform and statistics.
 TYPED_TEST(IcpTest, PropertyTransformIsFiniteOrTheCallFails) {
   using T = TypeParam;
@@ -181,17 +177,17 @@ TYPED_TEST(IcpTest, PropertyTransformIsFiniteOrTheCallFails) {
       for (auto* cloud : {&source, &target}) {
         for (auto& p : *cloud) {
           if (rng.uniform() < 0.2) {
-            p = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3));
+            p = Vec3<T>(solver_value<T>(rng, -3, 3), solver_value<T>(rng, -3, 3), solver_value<T>(rng, -3, 3));
           }
         }
       }
     }
     IcpOptions<T> o;
     o.max_iterations = static_cast<int>(rng.index(40)) - (rng.uniform() < 0.05 ? 50 : 0);
-    o.max_correspondence_distance_m = rng.uniform() < 0.1 ? wild_value<T>(rng, 0, 1) : T(rng.uniform(0.01, 1));
+    o.max_correspondence_distance_m = rng.uniform() < 0.1 ? solver_value<T>(rng, 0, 1) : T(rng.uniform(0.01, 1));
     o.estimate_scale = rng.uniform() < 0.3;
     Rigid3<T> start;
-    if (rng.uniform() < 0.1) start.t.y() = wild_value<T>(rng, -1, 1);
+    if (rng.uniform() < 0.1) start.t.y() = solver_value<T>(rng, -1, 1);
     const auto r = dyncull::icp_point_to_point(source, target, start, o);
     if (!r.ok()) {
       EXPECT_FALSE(r.reason.empty()) << trial;

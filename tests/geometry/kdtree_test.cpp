@@ -11,6 +11,8 @@
 #include <limits>
 #include <vector>
 
+using dyncull::test::solver_value;
+
 namespace {
 
 using dyncull::KdTree3;
@@ -118,12 +120,6 @@ TYPED_TEST(KdTreeTest, DuplicatesNonFiniteAndEmpty) {
   EXPECT_EQ(empty.build(dup, 0), Status::InvalidInput);
 }
 
-// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
-template <class T>
-T wild_value(Random& rng, double lo, double hi) {
-  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
-}
-
 // A container claiming 2^32 + 5 points (indices would wrap): refused before any point is read.
 struct HugeCloud {
   std::size_t size() const { return (std::size_t{1} << 32) + 5; }
@@ -143,7 +139,7 @@ TYPED_TEST(KdTreeTest, PropertyNearestIsExactAndFinite) {
   Random rng(87);
   for (int trial = 0; trial < 200; ++trial) {
     std::vector<Vec3<T>> pts(rng.index(80));
-    for (auto& p : pts) p = Vec3<T>(wild_value<T>(rng, -5, 5), wild_value<T>(rng, -5, 5), wild_value<T>(rng, -5, 5));
+    for (auto& p : pts) p = Vec3<T>(solver_value<T>(rng, -5, 5), solver_value<T>(rng, -5, 5), solver_value<T>(rng, -5, 5));
     KdTree3<T> tree;
     const int leaf = rng.uniform() < 0.05 ? 0 : 1 + static_cast<int>(rng.index(16));
     const Status s = tree.build(pts, leaf);
@@ -152,7 +148,7 @@ TYPED_TEST(KdTreeTest, PropertyNearestIsExactAndFinite) {
       continue;
     }
     for (int q = 0; q < 10; ++q) {
-      const Vec3<T> query(wild_value<T>(rng, -6, 6), wild_value<T>(rng, -6, 6), wild_value<T>(rng, -6, 6));
+      const Vec3<T> query(solver_value<T>(rng, -6, 6), solver_value<T>(rng, -6, 6), solver_value<T>(rng, -6, 6));
       T d2 = T(-1);
       const std::uint32_t i = tree.nearest(query, &d2);
       if (i == KdTree3<T>::kNone) continue;

@@ -15,6 +15,8 @@
 #ifdef DYNCULL_HAS_OPENCV
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+
+using dyncull::test::solver_value;
 #endif
 
 namespace {
@@ -352,12 +354,6 @@ TEST(PnpOptionsValidate, NamesTheFieldIncludingNestedOptions) {
   check(bad, "ransac.max_residual");
 }
 
-// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
-template <class T>
-T wild_value(Random& rng, double lo, double hi) {
-  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
-}
-
 // For any correspondences, camera and options: a non-Ok status with a reason, or a finite pose with a
 // consistent mask (solve_pnp, solve_pnp_ransac, solve_pnp_dlt, refine_pose), float and double.
 template <class T>
@@ -370,11 +366,11 @@ void pnp_property(std::uint64_t seed) {
     for (std::size_t i = 0; i < s.world.size(); ++i) {
       if (half_clean && rng.uniform() < 0.8) continue;
       if (rng.uniform() < 0.5) {
-        s.world[i] = Vec3<T>(wild_value<T>(rng, -3, 3), wild_value<T>(rng, -3, 3), wild_value<T>(rng, 0, 8));
+        s.world[i] = Vec3<T>(solver_value<T>(rng, -3, 3), solver_value<T>(rng, -3, 3), solver_value<T>(rng, 0, 8));
       }
-      if (rng.uniform() < 0.5) s.pixels[i] = Vec2<T>(wild_value<T>(rng, 0, 640), wild_value<T>(rng, 0, 480));
+      if (rng.uniform() < 0.5) s.pixels[i] = Vec2<T>(solver_value<T>(rng, 0, 640), solver_value<T>(rng, 0, 480));
     }
-    if (rng.uniform() < 0.1) s.camera.fx = wild_value<T>(rng, 1, 1000);
+    if (rng.uniform() < 0.1) s.camera.fx = solver_value<T>(rng, 1, 1000);
     PnpOptions<T> o;
     o.ransac.max_iterations = 1 + rng.index(200);
     o.ransac.seed = static_cast<std::uint64_t>(trial);
@@ -399,7 +395,7 @@ void pnp_property(std::uint64_t seed) {
     check(dyncull::solve_pnp_ransac(s.world, s.pixels, s.camera, o), "solve_pnp_ransac");
     check(dyncull::solve_pnp_dlt(s.world, s.pixels, s.camera), "solve_pnp_dlt");
     Rigid3<T> start = s.cam_from_world;
-    if (rng.uniform() < 0.2) start.t.x() = wild_value<T>(rng, -1, 1);
+    if (rng.uniform() < 0.2) start.t.x() = solver_value<T>(rng, -1, 1);
     const auto r = dyncull::refine_pose(s.world, s.pixels, s.camera, start, o.refinement);
     if (!r.ok()) {
       EXPECT_FALSE(r.reason.empty()) << "refine_pose trial " << trial;

@@ -201,7 +201,7 @@ TEST(UmeyamaVsEigen, MatchesEigenUmeyamaTo1e12) {
 
 // A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
 template <class T>
-T wild_value(Random& rng, double lo, double hi) {
+T alignment_value(Random& rng, double lo, double hi) {
   return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kAlignmentMix);
 }
 
@@ -216,12 +216,12 @@ TYPED_TEST(UmeyamaTest, PropertyAlignmentIsFiniteOrTheCallFails) {
     Points<T> src(3, n), dst(3, n);
     for (int i = 0; i < n; ++i) {
       for (int r = 0; r < 3; ++r) {
-        src(r, i) = clean ? T(rng.uniform(-1, 1) * magnitude) : wild_value<T>(rng, -magnitude, magnitude);
-        dst(r, i) = clean ? T(rng.uniform(-1, 1) * magnitude) : wild_value<T>(rng, -magnitude, magnitude);
+        src(r, i) = clean ? T(rng.uniform(-1, 1) * magnitude) : alignment_value<T>(rng, -magnitude, magnitude);
+        dst(r, i) = clean ? T(rng.uniform(-1, 1) * magnitude) : alignment_value<T>(rng, -magnitude, magnitude);
       }
     }
     std::vector<T> w(static_cast<std::size_t>(n));
-    for (auto& x : w) x = rng.uniform() < 0.1 ? wild_value<T>(rng, 0, 2) : T(rng.uniform(0, 2));
+    for (auto& x : w) x = rng.uniform() < 0.1 ? alignment_value<T>(rng, 0, 2) : T(rng.uniform(0, 2));
     AlignmentOptions o;
     o.estimate_scale = rng.uniform() < 0.5;
     const bool weighted = rng.uniform() < 0.4;

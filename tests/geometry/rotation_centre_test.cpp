@@ -19,6 +19,8 @@
 #include <limits>
 #include <vector>
 
+using dyncull::test::solver_value;
+
 namespace {
 
 using dyncull::RobustLoss;
@@ -386,12 +388,6 @@ TEST(RotationCentreOptionsValidate, NamesTheFieldIncludingNestedBfgs) {
   check(bad, "bfgs.max_iterations");
 }
 
-// A value for property tests: mostly ordinary, sometimes NaN, Inf, huge or tiny (tests/support/adversarial.hpp).
-template <class T>
-T wild_value(dyncull::Random& rng, double lo, double hi) {
-  return dyncull::test::adversarial_value<T>(rng, lo, hi, dyncull::test::kSolverMix);
-}
-
 // For any flow and options (both solvers, every loss): a non-Ok status with a reason, or a finite
 // centre, angle, cost and conditioning.
 TYPED_TEST(RotationCentreTest, PropertyCentreIsFiniteOrTheCallFails) {
@@ -403,7 +399,7 @@ TYPED_TEST(RotationCentreTest, PropertyCentreIsFiniteOrTheCallFails) {
     if (rng.uniform() < 0.7) {
       for (auto* pts : {&flow.p1, &flow.p2}) {
         for (auto& p : *pts) {
-          if (rng.uniform() < 0.15) p = Eigen::Matrix<T, 2, 1>(wild_value<T>(rng, 0, 640), wild_value<T>(rng, 0, 480));
+          if (rng.uniform() < 0.15) p = Eigen::Matrix<T, 2, 1>(solver_value<T>(rng, 0, 640), solver_value<T>(rng, 0, 480));
         }
       }
     }

@@ -8,6 +8,7 @@
 // compiled_culler_host.cpp (built twice, -Werror).
 #include "dyncull/culling/culler.hpp"
 
+#include "support/culler_inputs.hpp"
 #include "support/counting_allocator.hpp"
 
 #include "dyncull/culling/culler_core.hpp"
@@ -32,17 +33,8 @@
 namespace dyncull {
 namespace {
 
-std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
-  std::vector<DetectedBox> out;
-  for (const Detection<float>& d : detections)
-    out.emplace_back(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence);
-  return out;
-}
-
-DescriptorRows rows_of(const cv::Mat& d) {
-  return DescriptorRows(d.ptr<std::uint8_t>(0), static_cast<std::size_t>(d.rows), d.step[0],
-                        static_cast<std::size_t>(d.cols));
-}
+using test::boxes_of;
+using test::rows_of;
 
 
 /// The public culler's result equals the core's, element by element.

@@ -11,6 +11,8 @@
 #include "dyncull/opencv/culler.hpp"
 #include "dyncull/opencv/views.hpp"
 
+#include "support/culler_inputs.hpp"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
@@ -24,6 +26,9 @@
 
 namespace dyncull {
 namespace {
+
+using test::boxes_of;
+using test::rows_of;
 
 const cv::Mat kK = (cv::Mat_<double>(3, 3) << 525, 0, 319.5, 0, 525, 239.5, 0, 0, 1);
 const cv::Size kSize(640, 480);
@@ -86,18 +91,6 @@ Outcome outcome_of(const CullerResult& r) {
   return o;
 }
 
-DescriptorRows rows_of(const cv::Mat& d) {
-  return DescriptorRows(d.ptr<std::uint8_t>(0), static_cast<std::size_t>(d.rows), d.step[0],
-                        static_cast<std::size_t>(d.cols));
-}
-
-
-std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
-  std::vector<DetectedBox> out;
-  for (const Detection<float>& d : detections)
-    out.emplace_back(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence);
-  return out;
-}
 
 /// The public culler on the frame's data, read in place through plain views; the pose as 12 doubles.
 class PlainForm {

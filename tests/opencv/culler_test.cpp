@@ -11,6 +11,8 @@
 #include "dyncull/sim/families.hpp"
 #include "dyncull/sim/scene.hpp"
 
+#include "support/culler_inputs.hpp"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/calib3d.hpp>
@@ -27,12 +29,7 @@
 namespace dyncull {
 namespace {
 
-std::vector<DetectedBox> boxes_of(const std::vector<Detection<float>>& detections) {
-  std::vector<DetectedBox> out;
-  for (const Detection<float>& d : detections)
-    out.push_back(DetectedBox(d.box.x0, d.box.y0, d.box.x1, d.box.y1, d.class_id, d.confidence));
-  return out;
-}
+using test::boxes_of;
 
 /// Dynamic-label counts against the scene's per-pixel motion truth.
 struct Score {

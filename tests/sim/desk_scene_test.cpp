@@ -15,7 +15,7 @@
 namespace dyncull::sim {
 namespace {
 
-constexpr double kDt = 1.0 / 30.0;
+constexpr double kDeskFrameDt = 1.0 / 30.0;
 
 ActorOptions desk_actors() {
   ActorOptions a;
@@ -68,7 +68,7 @@ TEST(SimDeskScene, DeskAndWalkerInstancesMapToTheirCocoClasses) {
 
 TEST(SimDeskScene, DefaultSceneHasNoDeskActorsOrExtraWalkers) {
   std::vector<Primitive> prims;
-  build_scene(2.0, kDt, 1, ActorOptions{}, &prims);
+  build_scene(2.0, kDeskFrameDt, 1, ActorOptions{}, &prims);
   for (const Primitive& p : prims) EXPECT_LE(p.instance, SceneInstance::kTv);
 }
 
@@ -79,9 +79,9 @@ TEST(SimDeskScene, MovingTruthFollowsTheActualMotionAndTheSwivelIsEpisodic) {
   std::size_t legs_moving = 0, legs_still = 0, chair_moving = 0, samples = 0;
   for (int i = 1; i < 600; ++i) {  // 20 s: two swivel cycles of each person
     std::vector<Primitive> before, now, after;
-    build_scene((i - 1) * kDt, kDt, 7, o, &before);
-    build_scene(i * kDt, kDt, 7, o, &now);
-    build_scene((i + 1) * kDt, kDt, 7, o, &after);
+    build_scene((i - 1) * kDeskFrameDt, kDeskFrameDt, 7, o, &before);
+    build_scene(i * kDeskFrameDt, kDeskFrameDt, 7, o, &now);
+    build_scene((i + 1) * kDeskFrameDt, kDeskFrameDt, 7, o, &after);
     ASSERT_EQ(before.size(), now.size());
     ASSERT_EQ(after.size(), now.size());
     for (std::size_t k = 0; k < now.size(); ++k) {
@@ -128,8 +128,8 @@ TEST(SimDeskScene, StillOptionFreezesThePeople) {
   ActorOptions o = desk_actors();
   o.desk_motion_scale = 0;
   std::vector<Primitive> a, b;
-  build_scene(1.0, kDt, 3, o, &a);
-  build_scene(4.0, kDt, 3, o, &b);
+  build_scene(1.0, kDeskFrameDt, 3, o, &a);
+  build_scene(4.0, kDeskFrameDt, 3, o, &b);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t k = 0; k < a.size(); ++k) {
     EXPECT_EQ(a[k].moving, 0);
@@ -205,7 +205,7 @@ TEST(SimDeskScene, CrowdOfFourWalkersHasFourPeople) {
   o.walker_gap_rad = 1.5;
   std::vector<Primitive> prims;
   std::set<std::uint16_t> present;
-  build_scene(1.0, kDt, 1, o, &prims);
+  build_scene(1.0, kDeskFrameDt, 1, o, &prims);
   for (const Primitive& p : prims) present.insert(p.instance);
   for (int w = 0; w < 4; ++w) EXPECT_TRUE(present.count(SceneInstance::walker(w))) << "walker " << w;
   // Each walker is its own body on the loop (walker_gap_rad apart in phase; a crowd wants a gap

@@ -51,4 +51,10 @@ T adversarial_value(Random& rng, double lo, double hi, const AdversarialMix& mix
   return T(rng.uniform(lo, hi));
 }
 
+// A value for the geometry solvers' property tests: the solver mix.
+template <class T>
+T solver_value(Random& rng, double lo, double hi) {
+  return adversarial_value<T>(rng, lo, hi, kSolverMix);
+}
+
 }  // namespace dyncull::test

@@ -1,6 +1,7 @@
 // A counting global operator new for the tests that hold code to "no heap allocation per frame". It
 // replaces the allocation functions of the whole executable, so include it in exactly one translation unit
-// (each test file is its own executable) and read the count with dyncull::test::allocations().
+// (a test file that includes it gets its own executable: tests/CMakeLists.txt) and read the count with
+// dyncull::test::allocations().
 #pragma once
 
 // g++ cannot see that every operator new here is malloc and pairs it with a sized delete.
