@@ -1,5 +1,7 @@
-// Consumer check: the installed headers compile on their own and compute a known answer.
-#include <dyncull/dyncull.hpp>
+// Consumer check: an installed header and the generated version header compile against the package's
+// interface (its Eigen included) and compute a known answer. run_consumer_test.cmake checks that every
+// header is installed; headers.standalone compiles each of them on its own.
+#include <dyncull/core/camera.hpp>
 #include <dyncull/version.hpp>
 
 #include <cmath>

@@ -5,6 +5,20 @@ execute_process(COMMAND ${CMAKE_COMMAND} --install "${DYNCULL_BINARY_DIR}" --pre
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "install failed (${rc})")
 endif()
+# Every public header is installed, beside the generated version header.
+file(GLOB_RECURSE source_headers RELATIVE "${DYNCULL_SOURCE_DIR}/include" "${DYNCULL_SOURCE_DIR}/include/dyncull/*.hpp")
+file(GLOB_RECURSE installed_headers RELATIVE "${SCRATCH_DIR}/prefix/include" "${SCRATCH_DIR}/prefix/include/dyncull/*.hpp")
+list(APPEND source_headers dyncull/version.hpp)
+list(SORT source_headers)
+list(SORT installed_headers)
+if(NOT source_headers STREQUAL installed_headers)
+  set(missing ${source_headers})
+  list(REMOVE_ITEM missing ${installed_headers})
+  set(extra ${installed_headers})
+  list(REMOVE_ITEM extra ${source_headers})
+  message(FATAL_ERROR "the install's headers differ from include/: missing '${missing}', extra '${extra}'")
+endif()
+
 execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${SCRATCH_DIR}/build"
                         -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
                 RESULT_VARIABLE rc)
@@ -102,8 +116,10 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the add_subdirectory consumer ran but returned ${rc}")
 endif()
 
-# examples/ on its own against the install, as a user copies it: the README's front end, the monocular
-# one and the header-only one configure, build and run with find_package(dyncull) alone.
+# examples/ on its own against the install, as a user copies it: it configures with find_package(dyncull)
+# alone, and the README's front end and the monocular one build and run. The header-only example links
+# dyncull::dyncull alone, as the consumer above does; it builds and runs in dyncull's own tree (ctest
+# examples.header_only_*), and building it here again would take two minutes of one core.
 if(EXPECT_CULLER)
   execute_process(COMMAND ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}/../../examples" -B "${SCRATCH_DIR}/build_examples"
                           -DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
@@ -112,12 +128,12 @@ if(EXPECT_CULLER)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "configuring examples/ against the installed package failed (${rc})")
   endif()
-  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_examples" --target front_end monocular header_only
+  execute_process(COMMAND ${CMAKE_COMMAND} --build "${SCRATCH_DIR}/build_examples" --target front_end monocular
                   RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "building examples/ against the installed package failed (${rc})")
   endif()
-  foreach(example front_end monocular header_only)
+  foreach(example front_end monocular)
     execute_process(COMMAND "${SCRATCH_DIR}/build_examples/${example}" RESULT_VARIABLE rc)
     if(NOT rc EQUAL 0)
       message(FATAL_ERROR "examples/${example}, built against the install, returned ${rc}")
