@@ -8,7 +8,7 @@
 #       EGL and Boost's)
 set -euo pipefail
 
-packages=(g++ clang cmake make pkg-config libeigen3-dev libopencv-dev libceres-dev doxygen graphviz
+packages=(g++ clang cmake make ninja-build pkg-config libeigen3-dev libopencv-dev libceres-dev doxygen graphviz
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev locales
           python3 python3-matplotlib)  # python3-matplotlib: scripts/figures.py draws the docs' plots
 # Open3D is an optional benchmark peer (ICP); set DYNCULL_WITH_OPEN3D=1 to install it.
