@@ -12,10 +12,10 @@
 #include "dyncull/core/types.hpp"
 #include "dyncull/geometry/epipolar.hpp"
 #include "dyncull/geometry/ransac.hpp"
+#include "dyncull/geometry/symmetric_eigen.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
@@ -165,12 +165,12 @@ DYNCULL_SOLVER Mat3<double> enforce_rank2(const Mat3<double>& F) {
 /// when the null space is at least two-dimensional: the correspondences do not determine F.
 DYNCULL_SOLVER Status solve_normal_equations(const Eigen::Matrix<double, 9, 9>& ata, Mat3<double>* F,
                                              std::string* reason) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> es(ata);
-  if (es.info() != Eigen::Success) {
+  SymmetricEigen<9> es;
+  if (!symmetric_eigen(ata, &es)) {
     if (reason) *reason = "eigen-decomposition of the 8-point normal matrix failed";
     return Status::NotConverged;
   }
-  const auto& ev = es.eigenvalues();  // ascending
+  const auto& ev = es.values;  // ascending
   // Relative rank test: a second (near) zero eigenvalue means a family of solutions. The bound is loose
   // on purpose (exact degeneracy in double gives ~1e-16); noisy near-degenerate data is caught later by the
   // homography test of the RANSAC.
@@ -180,7 +180,7 @@ DYNCULL_SOLVER Status solve_normal_equations(const Eigen::Matrix<double, 9, 9>& 
                           "points, collinear points, or a planar scene / pure rotation without noise)";
     return Status::Degenerate;
   }
-  const Eigen::Matrix<double, 9, 1> f = es.eigenvectors().col(0);
+  const Eigen::Matrix<double, 9, 1> f = es.vectors.col(0);
   *F << f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8];
   return Status::Ok;
 }
@@ -389,9 +389,9 @@ DYNCULL_SOLVER bool homography_dlt(const double* x1, const double* y1, const dou
     ata.selfadjointView<Eigen::Upper>().rankUpdate(b);
   }
   ata.triangularView<Eigen::StrictlyLower>() = ata.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> es(ata);
-  if (es.info() != Eigen::Success) return false;
-  const Eigen::Matrix<double, 9, 1> h = es.eigenvectors().col(0);
+  SymmetricEigen<9> es;
+  if (!symmetric_eigen(ata, &es)) return false;
+  const Eigen::Matrix<double, 9, 1> h = es.vectors.col(0);
   *H << h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8];
   return H->allFinite() && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }

@@ -11,10 +11,10 @@
 #include "dyncull/core/traits.hpp"
 #include "dyncull/core/types.hpp"
 #include "dyncull/geometry/ransac.hpp"
+#include "dyncull/geometry/symmetric_eigen.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
@@ -841,8 +841,12 @@ Status pnp_dlt_data(const PnpData<T>& d, Rigid3<T>* out, std::string* reason) {
     const Vec3<double> q = Vec3<double>(d.X[i], d.Y[i], d.Z[i]) - mean;
     cov.noalias() += q * q.transpose();
   }
-  Eigen::SelfAdjointEigenSolver<Mat3<double>> es(cov);
-  const Vec3<double> ev = es.eigenvalues();  // ascending
+  SymmetricEigen<3> es;
+  if (!symmetric_eigen(cov, &es)) {
+    *reason = "DLT PnP: eigen-decomposition of the world points' covariance failed";
+    return Status::NotConverged;
+  }
+  const Vec3<double> ev = es.values;  // ascending
   // Coplanar points leave a 3-dimensional null space in the DLT: thickness below 1 % of the extent.
   if (!(ev(2) > 0) || ev(0) < 1e-4 * ev(2)) {
     *reason = "DLT PnP: world points are (nearly) coplanar";
@@ -861,8 +865,13 @@ Status pnp_dlt_data(const PnpData<T>& d, Rigid3<T>* out, std::string* reason) {
     AtA.selfadjointView<Eigen::Lower>().rankUpdate(r1);
     AtA.selfadjointView<Eigen::Lower>().rankUpdate(r2);
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> es12(AtA.selfadjointView<Eigen::Lower>());
-  const Eigen::Matrix<double, 12, 1> p = es12.eigenvectors().col(0);
+  AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
+  SymmetricEigen<12> es12;
+  if (!symmetric_eigen(AtA, &es12)) {
+    *reason = "DLT PnP: eigen-decomposition of the normal matrix failed";
+    return Status::NotConverged;
+  }
+  const Eigen::Matrix<double, 12, 1> p = es12.vectors.col(0);
   Eigen::Matrix<double, 3, 4> P;
   P << p.segment<4>(0).transpose(), p.segment<4>(4).transpose(), p.segment<4>(8).transpose();
   Mat3<double> M = P.leftCols<3>();
