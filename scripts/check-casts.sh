@@ -10,6 +10,8 @@
 # Casts of integral values (sizes, enum values, indices) are not flagged: clang's AST tells them apart
 # (clang++ -Xclang -ast-dump of one unit including every public header, of each src/ unit, and of each apps/
 # program with its apps/vo/ headers: their code in namespace dyncull, in anonymous namespaces and main).
+# The src/ and apps/ units are parsed as the build compiles them, with DYNCULL_PRECOMPILED: the solvers and
+# cull_frame's standard instantiations are then dumped once, from their own src/ units.
 # Prints file:line: what: source for each hit and exits 1 if there is any.
 #   scripts/check-casts.sh
 set -euo pipefail
@@ -65,9 +67,12 @@ dump() {  # unit, filter, extra flags...
       echo "$u" >"$tmp/$n.fail"; } &
   while (($(jobs -rp | wc -l) >= jobs_max)); do wait -n || true; done
 }
-for u in "${units[@]}"; do dump "$u" dyncull; done
+dump "${units[0]}" dyncull
+for u in "${units[@]:1}"; do dump "$u" dyncull -DDYNCULL_PRECOMPILED; done
 for u in "${app_units[@]}"; do
-  for filter in dyncull "(anonymous namespace)" main; do dump "$u" "$filter" -I"$root/apps" -DDYNCULL_HAS_OPENCV_DNN=1; done
+  for filter in dyncull "(anonymous namespace)" main; do
+    dump "$u" "$filter" -I"$root/apps" -DDYNCULL_HAS_OPENCV_DNN=1 -DDYNCULL_PRECOMPILED
+  done
 done
 wait
 for f in "$tmp"/*.fail; do
