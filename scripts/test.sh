@@ -43,8 +43,11 @@ case "$mode" in
     # the cases that repeat over many frames code that shorter cases run: the simulator's statistics
     # (against the real YOLO streams, of its detector, of people's coverage, of its motion truth and its
     # recorded trajectory; the SimScene and SceneFamilies cases render every family and motion),
-    # dynamic_vo's two accuracy bounds over 45 frames (its shorter cases run the same strategies) and the
-    # OpenCV culler against the hand-fed pipeline over 90 frames (the CullerContract cases run every form).
+    # dynamic_vo's two accuracy bounds over 45 frames (its shorter cases run the same strategies) and its
+    # truth-repaired copies of the recommended preset, the OpenCV culler against the hand-fed pipeline over
+    # 90 frames and the compiled culler's three forms against its core over 30 frames twice (the
+    # CullerContract cases and the culler fuzz target run every form), and the double-precision golden
+    # sequences (the float case runs the same presets and frames; clang's labels are not compared there).
     # Under the sanitizers each of these takes 25 s to 4 min.
     cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug -DDYNCULL_WERROR=ON -DCMAKE_CXX_COMPILER="$cxx" \
       -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_CHECK_HEADERS=OFF -DDYNCULL_CHECK_MIXING=OFF \
@@ -61,7 +64,10 @@ case "$mode" in
               SimScene.MovingTruthMatchesWorldMotion SimScene.MotionTruthIsTheSurfaceDisplacementPerFrame
               SimTrajectory.RecordedMotionFollowsTheRealTumGroundTruth
               DynamicVo.RecommendedPresetBeatsNoCullingOnShortXyz DynamicVo.CullerStrategyBeatsNoCullingOnShortXyz
-              OpenCvCuller.LabelsLikeTheHandFedPipelineOnTheWalkingScene)
+              DynamicVo.TruthRepairedStrategiesUndoOneKindOfError
+              OpenCvCuller.LabelsLikeTheHandFedPipelineOnTheWalkingScene
+              CompiledCuller.GivesTheCoresLabelsOnTheWalkingSceneForEveryKeypointTypeWithoutExtraAllocations
+              PipelineGolden.DoubleLabelsAndReasonsOfEveryPresetMatchTheRecordedOnes)
     export GTEST_FILTER="-$(IFS=:; echo "${left_out[*]}")"
     ctest_args=(-LE build_check)
     ;;
