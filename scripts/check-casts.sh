@@ -47,7 +47,7 @@ while IFS= read -r s; do
   units+=("$root/$s")
 done < <(cd "$root" && find src -name '*.cpp' | sort)
 
-# The apps: each program, dumped once per filter (the dump filter matches a declaration's qualified name).
+# The apps: each program with its apps/vo/ headers.
 app_units=()
 while IFS= read -r a; do
   case "$a" in
@@ -69,10 +69,12 @@ dump() {  # unit, filter, extra flags...
 }
 dump "${units[0]}" dyncull
 for u in "${units[@]:1}"; do dump "$u" dyncull -DDYNCULL_PRECOMPILED; done
+# A program's code lives in three places: namespace dyncull (its apps/vo/ headers), its anonymous namespace
+# and main. The dump filter takes one substring of a qualified name, so the program is parsed once with
+# dyncull and main renamed to names holding "anonymous" (quoted and <...> include names are not expanded).
 for u in "${app_units[@]}"; do
-  for filter in dyncull "(anonymous namespace)" main; do
-    dump "$u" "$filter" -I"$root/apps" -DDYNCULL_HAS_OPENCV_DNN=1 -DDYNCULL_PRECOMPILED
-  done
+  dump "$u" anonymous -Ddyncull=anonymous_dyncull -Dmain=anonymous_main -I"$root/apps" \
+    -DDYNCULL_HAS_OPENCV_DNN=1 -DDYNCULL_PRECOMPILED
 done
 wait
 for f in "$tmp"/*.fail; do
