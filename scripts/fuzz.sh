@@ -8,11 +8,14 @@
 #   DYNCULL_FUZZ_TARGETS="tum yolo"          run only these targets (culler needs OpenCV 4)
 #   DYNCULL_FUZZ_SEED=N                      libFuzzer's -seed (default: a random seed each run; .ci/run fixes
 #                                            it so that a failure in CI reproduces with the same command)
+#   DYNCULL_FUZZ_TREE=build/asan             the fuzz targets of that tree (scripts/test.sh --asan builds them
+#                                            with its libraries) instead of a build/fuzz of their own
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-${DYNCULL_FUZZ_SECONDS:-60}}
 jobs=${DYNCULL_JOBS:-$(nproc)}
 build="$root/build/fuzz"
+[[ -n "${DYNCULL_FUZZ_TREE:-}" ]] && build=$(cd "$DYNCULL_FUZZ_TREE" && pwd)
 cxx=$(command -v clang++ || true)
 if [[ -z "$cxx" ]]; then
   echo "fuzz.sh: clang++ not found (libFuzzer needs clang)" >&2
@@ -22,9 +25,16 @@ fi
 # builds the targets named on one command line one after another (each a single translation unit).
 generator=()
 if [[ ! -f "$build/CMakeCache.txt" ]] && command -v ninja >/dev/null; then generator=(-G Ninja); fi
-cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="" -DCMAKE_CXX_COMPILER="$cxx" \
-  -DDYNCULL_WERROR=ON -DDYNCULL_BUILD_FUZZERS=ON -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_BENCHMARKS=OFF \
-  -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=ON -DDYNCULL_WITH_CERES=OFF >/dev/null
+if [[ -n "${DYNCULL_FUZZ_TREE:-}" ]]; then
+  if ! grep -qx 'DYNCULL_BUILD_FUZZERS:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
+    echo "fuzz.sh: $DYNCULL_FUZZ_TREE is not a tree configured with DYNCULL_BUILD_FUZZERS=ON" >&2
+    exit 2
+  fi
+else
+  cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_CXX_COMPILER="$cxx" \
+    -DDYNCULL_WERROR=ON -DDYNCULL_BUILD_FUZZERS=ON -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_BENCHMARKS=OFF \
+    -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_WITH_OPENCV=ON -DDYNCULL_WITH_CERES=OFF >/dev/null
+fi
 
 # Every target this configuration builds (the culler target needs OpenCV: fuzz.sh says when it is left out).
 targets=${DYNCULL_FUZZ_TARGETS:-$(cat "$build/tests/fuzz/targets.txt")}

@@ -32,6 +32,8 @@ case "$mode" in
   --asan)
     # Benchmarks and examples are not rebuilt under the sanitizers: the tests exercise the same headers. Nor
     # is the header-only side of the precompiled cull_frame's comparison (the same code as the library's).
+    # The fuzz targets are (DYNCULL_FUZZ_TREE=build/asan scripts/fuzz.sh runs them): they share the compiled
+    # libraries with the tests, which then carry libFuzzer's coverage instrumentation too.
     # clang++ builds this run (g++ builds the Release run), so the whole suite compiles warning-free
     # under both; it also compiles the tests ~1.7x faster than g++ here. -g1 (line tables) is enough
     # for symbolised sanitizer reports and costs a third less than -g. -O1 only where cases run long: clang
@@ -53,7 +55,7 @@ case "$mode" in
     # sequences (the float case runs the same presets and frames; clang's labels are not compared there).
     # Under the sanitizers each of these takes 25 s to 4 min.
     cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug -DDYNCULL_WERROR=ON -DCMAKE_CXX_COMPILER="$cxx" \
-      -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_CHECK_HEADERS=OFF -DDYNCULL_CHECK_MIXING=OFF \
+      -DDYNCULL_BUILD_BENCHMARKS=OFF -DDYNCULL_BUILD_FUZZERS=ON -DDYNCULL_BUILD_EXAMPLES=OFF -DDYNCULL_BUILD_APPS=OFF -DDYNCULL_INSTALL=OFF -DDYNCULL_CHECK_HEADERS=OFF -DDYNCULL_CHECK_MIXING=OFF \
       -DDYNCULL_COMPARE_FORMS=OFF \
       -DDYNCULL_TEST_PER_EXECUTABLE=ON -DDYNCULL_UNOPTIMISED_TEST_MODULES="core;eval;ceres;opencv;host;culling;geometry" \
       -DDYNCULL_OPTIMISED_TEST_FILES="$(IFS=';'; echo "${optimised_test_files[*]}")" \
