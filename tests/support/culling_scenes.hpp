@@ -136,13 +136,34 @@ class SceneWorld {
     return world_from_cam.inverse();
   }
 
+  /// The world frozen at time tau: the camera's centre and orientation and every part's box, computed
+  /// once for the many rays of one image (a dense depth image casts one per pixel).
+  struct View {
+    Vec3<double> origin;
+    Mat3<double> world_from_cam;
+    std::vector<Vec3<double>> lo, hi;  // per part
+  };
+
+  View view_at(double tau) const {
+    const Rigid3<double> wc = cam_from_world(tau).inverse();
+    View view{wc.t, wc.R, {}, {}};
+    for (const ScenePart& p : parts_) {
+      view.lo.push_back(p.lo_at(tau));
+      view.hi.push_back(p.hi_at(tau));
+    }
+    return view;
+  }
+
   /// First surface hit by the ray through pixel (u, v) at time tau: world point, depth, part index
   /// (-1 for the room). Returns false when nothing is hit (never inside the room).
   bool raycast(double tau, double u, double v, Vec3<double>* world, double* depth, int* part) const {
-    const Rigid3<double> wc = cam_from_world(tau).inverse();
-    const Vec3<double> origin = wc.t;
+    return raycast(view_at(tau), u, v, world, depth, part);
+  }
+
+  bool raycast(const View& view, double u, double v, Vec3<double>* world, double* depth, int* part) const {
+    const Vec3<double>& origin = view.origin;
     const Vec3<double> dir_cam = config_.camera.ray(Vec2<double>(u, v));
-    const Vec3<double> dir = wc.R * dir_cam;  // t along dir == depth along the optical axis
+    const Vec3<double> dir = view.world_from_cam * dir_cam;  // t along dir == depth along the optical axis
     double best = std::numeric_limits<double>::infinity();
     int best_part = -1;
     // Room: exit distance of the interior box.
@@ -151,7 +172,8 @@ class SceneWorld {
       if (dir[a] < 0) best = std::min(best, (room_lo_[a] - origin[a]) / dir[a]);
     }
     for (std::size_t i = 0; i < parts_.size(); ++i) {
-      const Vec3<double> lo = parts_[i].lo_at(tau), hi = parts_[i].hi_at(tau);
+      const Vec3<double>& lo = view.lo[i];
+      const Vec3<double>& hi = view.hi[i];
       double t0 = 0, t1 = std::numeric_limits<double>::infinity();
       bool hit = true;
       for (int a = 0; a < 3 && hit; ++a) {
@@ -249,13 +271,14 @@ CullingScene<T> make_culling_scene(const SceneConfig& config = {}) {
   s.height = cam.height;
 
   // Depth image of the current frame.
+  const SceneWorld::View now = world.view_at(0.0);
   s.depth.assign(static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height), 0.f);
   for (int v = 0; v < cam.height; ++v)
     for (int u = 0; u < cam.width; ++u) {
       Vec3<double> X;
       double d = 0;
       int part = -1;
-      if (world.raycast(0.0, u, v, &X, &d, &part)) s.depth[static_cast<std::size_t>(v) * cam.width + u] = float(d);
+      if (world.raycast(now, u, v, &X, &d, &part)) s.depth[static_cast<std::size_t>(v) * cam.width + u] = float(d);
     }
 
   // Detections: one box per object, in the order of the objects.
@@ -278,7 +301,7 @@ CullingScene<T> make_culling_scene(const SceneConfig& config = {}) {
     Vec3<double> X;
     double d = 0;
     int part = -1;
-    if (!world.raycast(0.0, u, v, &X, &d, &part)) return;
+    if (!world.raycast(now, u, v, &X, &d, &part)) return;
     if (want_object >= 0 && (part < 0 || world.parts()[static_cast<std::size_t>(part)].object != want_object)) return;
     const Vec3<double> vel = part < 0 ? Vec3<double>::Zero() : world.parts()[static_cast<std::size_t>(part)].velocity_m;
     const Vec3<double> X_prev = X + tau_prev * vel;
@@ -317,12 +340,13 @@ SceneKeyframe<T> make_scene_keyframe(const SceneConfig& config, int frames_back,
   kf.cam_from_world = world.cam_from_world(tau).cast<T>();
   Random rng(seed);
   const PinholeCamera<double>& cam = config.camera;
+  const SceneWorld::View then = world.view_at(tau);
   for (int i = 0; i < num_features; ++i) {
     const double u = rng.uniform(4, cam.width - 5), v = rng.uniform(4, cam.height - 5);
     Vec3<double> X;
     double d = 0;
     int part = -1;
-    if (!world.raycast(tau, u, v, &X, &d, &part)) continue;
+    if (!world.raycast(then, u, v, &X, &d, &part)) continue;
     kf.keypoints.push_back(Vec2<T>(T(u), T(v)));
     kf.depth_m.push_back(T(d));
     kf.kind.push_back(world.kind_of(part));
