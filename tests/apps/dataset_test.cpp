@@ -3,6 +3,8 @@
 // the real Bonn crowd sequence (through DYNCULL_DATA_DIR; skipped loudly without it).
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #ifdef DYNCULL_HAS_OPENCV
 
 #include "../../apps/vo/dataset.hpp"
@@ -36,12 +38,9 @@ fs::path fresh_dir(const std::string& name) {
 // depth partner within 0.02 s.
 /// The real sequence under DYNCULL_DATA_DIR; false with why the real-data test cannot run.
 bool bonn_crowd_dir(std::string* dir, std::string* why_not) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') {
-    *why_not = "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
-    return false;
-  }
-  *dir = std::string(root) + "/bonn/crowd_part1";
+  const std::string root = dyncull::test::real_data_dir(why_not);
+  if (root.empty()) return false;
+  *dir = root + "/bonn/crowd_part1";
   if (!fs::is_directory(*dir)) {
     *why_not = *dir + " does not exist: the real-sequence run did not happen";
     return false;

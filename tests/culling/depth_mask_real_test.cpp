@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -30,9 +32,10 @@ struct Counts {
 class RealFrame : public ::testing::Test {
  protected:
   void SetUp() override {
-    const char* dir = std::getenv("DYNCULL_DATA_DIR");
-    if (!dir || !*dir) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set: real-data depth-mask test skipped";
-    const std::string base = std::string(dir) + "/tum/fr3_walking_xyz_frame/";
+    std::string why_not;
+    const std::string dir = dyncull::test::real_data_dir(&why_not);
+    if (dir.empty()) GTEST_SKIP() << why_not;
+    const std::string base = dir + "/tum/fr3_walking_xyz_frame/";
     depth_ = cv::imread(base + "depth_1341846313.592088.png", cv::IMREAD_UNCHANGED);
     person_ = cv::imread(base + "mask_1341846313.592026.png", cv::IMREAD_UNCHANGED);
     if (depth_.empty() || person_.empty())

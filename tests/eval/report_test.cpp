@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <algorithm>
 #include <clocale>
 #include <cstdlib>
@@ -136,9 +138,10 @@ TEST(EvalRun, AssociateListsPairsClosestFirstEachStampOnce) {
 }
 
 TEST(EvalRun, RealDataPrintsTheTumScriptsLines) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
-  const std::string dir = std::string(root) + "/tum/fr3_sitting_static";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
+  const std::string dir = root + "/tum/fr3_sitting_static";
   if (!std::ifstream(dir + "/groundtruth.txt")) GTEST_SKIP() << dir << "/groundtruth.txt is missing";
   const std::string gt = dir + "/groundtruth.txt";
   const std::string est = dir + "/estimate_dynaslam.txt";

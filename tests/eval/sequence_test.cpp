@@ -2,6 +2,7 @@
 // files reported and run without depth, camera.txt and command-line intrinsics, detections by stamp; and
 // the real Bonn crowd_part1 folder through DYNCULL_DATA_DIR (skipped loudly without it).
 #include "dyncull/eval/sequence.hpp"
+#include "support/real_data.hpp"
 #include "support/special_files.hpp"
 
 #include <gtest/gtest.h>
@@ -404,10 +405,10 @@ TEST_F(SequenceFolder, FifosAndDevicesAreRefusedPromptly) {
 // rgb goes from +14 ms to -17 ms over 7 s), and each unpublished frame sits where that offset wraps, so
 // the neighbours pair 16.7 ms apart instead of leaving a frame alone.
 TEST(SequenceBonnCrowd, IndexesTheRealFolder) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0')
-    GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
-  const std::string dir = std::string(root) + "/bonn/crowd_part1";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
+  const std::string dir = root + "/bonn/crowd_part1";
   if (!fs::is_directory(dir)) GTEST_SKIP() << dir << " does not exist: the real-sequence test did not run";
   const eval::SequenceIndex s = eval::read_sequence(dir);
   ASSERT_TRUE(s.ok()) << s.reason;

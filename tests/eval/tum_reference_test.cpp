@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -23,12 +25,9 @@ struct TumData {
 
 // Returns false (with a message) when DYNCULL_DATA_DIR or the files are missing.
 bool load_data(TumData* out, std::string* why) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') {
-    *why = "DYNCULL_DATA_DIR is not set; point it at the shared data directory, e.g. ../shared/data to run the TUM oracle test";
-    return false;
-  }
-  out->dir = std::string(root) + "/tum/fr3_sitting_static";
+  const std::string root = dyncull::test::real_data_dir(why);
+  if (root.empty()) return false;
+  out->dir = root + "/tum/fr3_sitting_static";
   std::ifstream file(out->dir + "/expected_tum_scripts.json");
   if (!file) {
     *why = out->dir + "/expected_tum_scripts.json is missing";

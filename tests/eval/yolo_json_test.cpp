@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
 #include "support/special_files.hpp"
 
 #include <clocale>
@@ -278,14 +279,10 @@ TEST(YoloJson, IntegerFieldsTakeIntegralValuesAndNameTheirRangeAndWhy) {
 // Real streams
 // ---------------------------------------------------------------------------------------------
 
-std::string data_dir() {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  return root == nullptr ? std::string() : std::string(root);
-}
-
 TEST(YoloJsonReal, ReadsEveryFrameOfTheFourRealStreams) {
-  const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
   const std::pair<const char*, std::size_t> streams[] = {
       {"fr3_walking_xyz", 859}, {"fr3_walking_static", 743}, {"fr3_sitting_static", 707}, {"fr3_sitting_xyz", 1261}};
   for (const auto& [name, frames] : streams) {
@@ -318,8 +315,9 @@ bool any_overlap(const std::vector<Detection<float>>& dets, const Box<float>& bo
 // overlapping it in the next frame either is carried falsely (the object left or the detector
 // lost it for longer).
 TEST(YoloJsonReal, BoxTrackerBridgesOneFramePersonDropoutsOnWalkingXyz) {
-  const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
   const auto seq = read_yolo_json_sequence<float>(root + "/tum/fr3_walking_xyz/yolov8n");
   ASSERT_TRUE(seq.ok()) << seq.reason;
   const int w = 640, h = 480;

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -339,10 +341,6 @@ TEST(LiveDetectionHost, TheLogRecordsTheBoxesAge) {
   fs::remove_all(dir);
 }
 
-std::string data_dir() {
-  const char* d = std::getenv("DYNCULL_DATA_DIR");
-  return d ? std::string(d) : std::string();
-}
 
 // A bad DYNCULL_DETECTOR stops the host at start with the variable, the file and the reason.
 TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
@@ -364,8 +362,10 @@ TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
   std::vector<std::pair<std::string, std::string>> all;
   for (const auto& c : cases) all.emplace_back(c.spec, c.expected);
   // Unreadable weights beside the real cfg (when the data is there): empty, and a directory.
-  const fs::path cfg = fs::path(data_dir()) / "models" / "yolo-fastest-1.1-xl" / "yolo-fastest-1.1-xl.cfg";
-  if (!data_dir().empty() && fs::exists(cfg)) {
+  std::string no_data;
+  const std::string root = dyncull::test::real_data_dir(&no_data);
+  const fs::path cfg = fs::path(root) / "models" / "yolo-fastest-1.1-xl" / "yolo-fastest-1.1-xl.cfg";
+  if (!root.empty() && fs::exists(cfg)) {
     fs::create_directories(dir / "folder.weights");
     all.emplace_back(cfg.string() + "," + (dir / "empty.weights").string(), "empty.weights: empty file");
     all.emplace_back(cfg.string() + "," + (dir / "folder.weights").string(), "folder.weights: not a regular file");
@@ -387,8 +387,9 @@ TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
 // runs it, one frame at a time: the first frame's own boxes, then at every frame the previous frame's
 // (age 1), with a person where the stored detections of that frame have one.
 TEST(LiveDetectionRealModel, FindsPeopleOnTheStoredColourSamples) {
-  const std::string root = data_dir();
-  if (root.empty()) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory): real-model test skipped";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
   const fs::path model = fs::path(root) / "models" / "yolo-fastest-1.1-xl";
   const fs::path samples = fs::path(root) / "bonn" / "crowd_part1" / "rgb_samples";
   if (!fs::exists(model) || !fs::exists(samples)) GTEST_SKIP() << model << " or " << samples << " is missing: skipped";
@@ -433,6 +434,7 @@ struct BonnFrames {
   std::vector<std::string> colour, depth;
   std::vector<double> stamps;
   cv::Mat K;
+  std::string data_dir;  ///< DYNCULL_DATA_DIR
   std::string skip;
 };
 
@@ -451,9 +453,11 @@ std::vector<std::pair<double, std::string>> tum_list(const fs::path& path) {
 
 BonnFrames bonn_frames(std::size_t first, std::size_t count) {
   BonnFrames b;
-  const fs::path seq = fs::path(data_dir()) / "bonn" / "crowd_part1";
-  if (data_dir().empty() || !fs::exists(seq / "rgb_color.txt")) {
-    b.skip = "DYNCULL_DATA_DIR is not set or has no bonn/crowd_part1/rgb_color.txt: skipped";
+  b.data_dir = dyncull::test::real_data_dir(&b.skip);
+  if (b.data_dir.empty()) return b;
+  const fs::path seq = fs::path(b.data_dir) / "bonn" / "crowd_part1";
+  if (!fs::exists(seq / "rgb_color.txt")) {
+    b.skip = (seq / "rgb_color.txt").string() + " is missing: skipped";
     return b;
   }
   std::map<std::string, double> camera;
@@ -480,9 +484,9 @@ BonnFrames bonn_frames(std::size_t first, std::size_t count) {
 // the tracking thread the culling alone, and its boxes are a few frames old; waited for, it costs the
 // detection too.
 TEST(LiveDetectionRealModel, TheHostCullsTheBonnFramesWithoutWaitingForTheDetector) {
-  const fs::path model = fs::path(data_dir()) / "models" / "yolo-fastest-1.1-xl";
   const BonnFrames b = bonn_frames(250, 60);
   if (!b.skip.empty()) GTEST_SKIP() << b.skip;
+  const fs::path model = fs::path(b.data_dir) / "models" / "yolo-fastest-1.1-xl";
   if (!fs::exists(model)) GTEST_SKIP() << model << " is missing: skipped";
   ASSERT_EQ(b.colour.size(), 60u);
   const cv::Ptr<cv::ORB> orb = cv::ORB::create(1000);

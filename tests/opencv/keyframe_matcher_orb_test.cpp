@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -28,9 +30,10 @@ template <class T>
 class KeyframeMatcherOrb : public ::testing::Test {
  protected:
   void SetUp() override {
-    const char* dir = std::getenv("DYNCULL_DATA_DIR");
-    if (!dir || !*dir) GTEST_SKIP() << "DYNCULL_DATA_DIR is not set: real-frame keyframe matcher test skipped";
-    const std::string base = std::string(dir) + "/tum/fr3_walking_xyz_frame/";
+    std::string why_not;
+    const std::string dir = dyncull::test::real_data_dir(&why_not);
+    if (dir.empty()) GTEST_SKIP() << why_not;
+    const std::string base = dir + "/tum/fr3_walking_xyz_frame/";
     const cv::Mat rgb = cv::imread(base + "rgb_1341846313.592026.png", cv::IMREAD_GRAYSCALE);
     depth_ = cv::imread(base + "depth_1341846313.592088.png", cv::IMREAD_UNCHANGED);
     if (rgb.empty() || depth_.empty()) GTEST_SKIP() << "TUM frame not found under " << base << ": test skipped";

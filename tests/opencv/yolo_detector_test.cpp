@@ -5,6 +5,7 @@
 #include "dyncull/opencv/yolo_detector.hpp"
 
 #include "support/counting_allocator.hpp"
+#include "support/real_data.hpp"
 #include "support/special_files.hpp"
 
 #include <gtest/gtest.h>
@@ -523,8 +524,8 @@ TEST(YoloDetectorOpen, ClassCountDifferentFromTheHeadsIsInvalidInput) {
 
 // The real model's files, read whole, for corrupt copies written into a test's scratch directory.
 bool real_model(std::string* cfg, std::string* weights, std::string* why_not) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') return (*why_not = "DYNCULL_DATA_DIR is not set: real-model test skipped", false);
+  const std::string root = dyncull::test::real_data_dir(why_not);
+  if (root.empty()) return false;
   const fs::path dir = fs::path(root) / "models" / "yolo-fastest-1.1-xl";
   std::ifstream c(dir / "yolo-fastest-1.1-xl.cfg", std::ios::binary), w(dir / "yolo-fastest-1.1-xl.weights", std::ios::binary);
   if (!c || !w) return (*why_not = dir.string() + " has no yolo-fastest-1.1-xl.cfg / .weights", false);
@@ -827,12 +828,8 @@ struct BonnData {
 
 BonnData load_bonn() {
   BonnData data;
-  const char* root_env = std::getenv("DYNCULL_DATA_DIR");
-  if (!root_env || !*root_env) {
-    data.skip = "DYNCULL_DATA_DIR is not set (point it at the shared data directory): real-detector test skipped";
-    return data;
-  }
-  const fs::path root(root_env);
+  const fs::path root = dyncull::test::real_data_dir(&data.skip);
+  if (root.empty()) return data;
   const fs::path seq = root / "bonn" / "crowd_part1";
   const fs::path model = root / "models" / "yolo-fastest-1.1-xl";
   for (const fs::path& p : {seq / "rgb_samples", seq / "detections", model / "yolo-fastest-1.1-xl.cfg",

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -140,8 +142,9 @@ Frames real_detections(const std::string& root, const char* sequence) {
 }
 
 TEST(SimDetectorCalibration, CalibratedModelMatchesTheRealYoloStreams) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
   const StreamStats real_sitting = stream_stats(real_detections(root, "fr3_sitting_static"), 640, 480);
   print("real sitting_static", real_sitting);
   double real_dropout_max = 0;

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/real_data.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -210,8 +212,9 @@ Rigid3<double> interpolate(const eval::Trajectory<double>& rec, double stamp) {
 }
 
 TEST(SimTrajectory, RecordedMotionFollowsTheRealTumGroundTruth) {
-  const char* root = std::getenv("DYNCULL_DATA_DIR");
-  if (root == nullptr || *root == '\0') GTEST_SKIP() << "DYNCULL_DATA_DIR is not set (point it at the shared data directory, e.g. ../shared/data)";
+  std::string why_not;
+  const std::string root = dyncull::test::real_data_dir(&why_not);
+  if (root.empty()) GTEST_SKIP() << why_not;
   for (const char* name : {"fr3_walking_xyz", "fr3_walking_static", "fr3_walking_rpy", "fr3_walking_halfsphere",
                            "fr3_sitting_static", "fr3_sitting_xyz"}) {
     const auto read = eval::read_tum_trajectory<double>(std::string(root) + "/tum/" + name + "/groundtruth.txt");
