@@ -12,7 +12,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>

@@ -8,7 +8,6 @@
 #include "support/real_data.hpp"
 
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <vector>

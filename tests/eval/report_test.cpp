@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <clocale>
-#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
