@@ -340,7 +340,6 @@ TEST(LiveDetectionHost, TheLogRecordsTheBoxesAge) {
   fs::remove_all(dir);
 }
 
-
 // A bad DYNCULL_DETECTOR stops the host at start with the variable, the file and the reason.
 TEST(LiveDetectionHost, ABadDetectorIsRefusedAtStartNamingTheFile) {
   const fs::path dir = fs::temp_directory_path() / "dyncull_bad_detector";
